@@ -1,0 +1,1 @@
+"""Package data: the URScript grammar (``urscript.lark``), loaded by :mod:`urdsl.script.parser`."""
