@@ -1,0 +1,128 @@
+"""Diagnostics: what urdsl tells a user about a program, with ``file:line:col`` and a caret.
+
+Inside the language core, problems are raised as :class:`ScriptSyntaxError`; at the boundary
+to the user they are shown as :class:`Diagnostic` objects, rendered like a compiler does::
+
+    course.script:1:44: error: unexpected ')': the pose opened at 1:6 is already closed
+      p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3])
+                                                 ^
+      hint: delete the ')'
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .nodes import Source, Span
+
+__all__ = ["Diagnostic", "ScriptSyntaxError", "ScriptError", "render"]
+
+SEVERITIES = ("error", "warning", "info")
+
+
+@dataclass(frozen=True)
+class Diagnostic:
+    """One finding about a program.
+
+    ``line`` and ``column`` are 1-based; ``code`` is a stable rule code (``URS001``);
+    ``severity`` is ``"error"``, ``"warning"`` or ``"info"``.
+    """
+
+    filename: str
+    line: int
+    column: int
+    severity: str
+    code: str
+    message: str
+    hint: str | None = None
+    source_line: str | None = None
+    end_column: int | None = None
+
+    @classmethod
+    def at(
+        cls,
+        span: Span,
+        message: str,
+        *,
+        code: str,
+        severity: str = "error",
+        hint: str | None = None,
+    ) -> Diagnostic:
+        """A diagnostic placed at a node's or token's span."""
+        if span.source is None:
+            return cls("<generated>", 0, 0, severity, code, message, hint)
+        line, column = span.line, span.column
+        end_column = span.end_column if span.end_line == line and span.end > span.start else None
+        return cls(
+            span.filename, line, column, severity, code, message, hint,
+            span.source.line_text(line), end_column,
+        )
+
+    def to_dict(self) -> dict[str, object]:
+        """The fields a JSON report carries."""
+        return {
+            "file": self.filename, "line": self.line, "column": self.column,
+            "code": self.code, "severity": self.severity, "message": self.message,
+            "hint": self.hint,
+        }
+
+    def render(self) -> str:
+        """``file:line:col: severity: message``, the source line, a caret, and the hint."""
+        head = f"{self.filename}:{self.line}:{self.column}: {self.severity}: {self.message}"
+        if self.code:
+            head += f" [{self.code}]"
+        lines = [head]
+        if self.source_line is not None:
+            text = self.source_line.expandtabs(1)
+            lines.append("  " + text)
+            width = 1
+            if self.end_column is not None and self.end_column > self.column:
+                width = self.end_column - self.column
+            lines.append("  " + " " * (self.column - 1) + "^" * max(width, 1))
+        if self.hint:
+            lines.append(f"  hint: {self.hint}")
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.render()
+
+
+class ScriptError(Exception):
+    """Base of errors about a URScript program; carries a :class:`Diagnostic`."""
+
+    def __init__(self, diagnostic: Diagnostic) -> None:
+        super().__init__(diagnostic.render())
+        self.diagnostic = diagnostic
+
+    @property
+    def line(self) -> int:
+        return self.diagnostic.line
+
+    @property
+    def column(self) -> int:
+        return self.diagnostic.column
+
+    @property
+    def hint(self) -> str | None:
+        return self.diagnostic.hint
+
+    @property
+    def message(self) -> str:
+        return self.diagnostic.message
+
+
+class ScriptSyntaxError(ScriptError):
+    """The text is not URScript. Rule code ``URS001``."""
+
+    CODE = "URS001"
+
+    @classmethod
+    def at_offset(
+        cls, source: Source, start: int, end: int, message: str, hint: str | None = None
+    ) -> ScriptSyntaxError:
+        return cls(Diagnostic.at(Span(source, start, end), message, code=cls.CODE, hint=hint))
+
+
+def render(diagnostics: list[Diagnostic]) -> str:
+    """All diagnostics, one block each, separated by blank lines."""
+    return "\n\n".join(d.render() for d in diagnostics)

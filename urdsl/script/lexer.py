@@ -1,0 +1,120 @@
+"""The URScript lexer: the grammar's terminals compiled into one regular expression.
+
+The terminals are defined once, in ``grammar/urscript.lark``; this module reads them from the
+Lark grammar and builds a scanner from them. It is faster than Lark's own lexer for this
+language because it produces plain tuples ``(type, value, start, end)`` (offsets into the
+text; lines and columns are computed only when a message needs them) and looks keywords up in
+a dictionary instead of trying each keyword pattern.
+
+Besides the grammar's terminals it makes ``BLANK`` tokens (a run of two or more line breaks
+between tokens) and marks each ``COMMENT`` as trailing or not, so that the parser can keep a
+program's layout.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
+
+from .diagnostics import ScriptSyntaxError
+from .nodes import Source
+
+if TYPE_CHECKING:
+    from lark import Lark
+
+__all__ = ["Lexer", "Token"]
+
+Token = tuple  # (type: str, value: str | tuple[str, bool], start: int, end: int)
+
+# Terminals matched by a regular expression of their own, in the order they are tried.
+_REGEX_TERMINALS = ("COMMENT", "MARKER", "STRING", "NUMBER", "POSE_OPEN", "NAME")
+
+# Characters that are not URScript, with what to write instead.
+_BAD_CHARACTER_HINTS = {
+    ";": "URScript needs no ';' between statements: delete it",
+    "{": "'{' is not URScript; if this is a template, fill in its placeholders first",
+    "}": "'}' is not URScript; if this is a template, fill in its placeholders first",
+    "&": "URScript writes 'and' for '&&' and '&'",
+    "|": "URScript writes 'or' for '||' and '|'",
+    "^": "URScript has no '^': use 'xor' for booleans or pow(a, b) for powers",
+    "`": "'`' is not URScript",
+    "@": "'@' is not URScript",
+    "?": "URScript has no '?:' operator: use if/else",
+    "~": "URScript has no '~' operator",
+    '"': "a string must close on the line where it opens (URScript strings have no escapes)",
+    "'": "a string must close on the line where it opens (URScript strings have no escapes)",
+    "\\": "a backslash is only allowed inside a string",
+}
+
+
+class Lexer:
+    """A scanner for the terminals of a Lark grammar (see the module docstring)."""
+
+    def __init__(self, grammar: Lark) -> None:
+        patterns: dict[str, str] = {}
+        keywords: dict[str, str] = {}
+        operators: dict[str, str] = {}
+        for terminal in grammar.terminals:
+            pattern = terminal.pattern
+            if terminal.name in _REGEX_TERMINALS:
+                patterns[terminal.name] = pattern.to_regexp()
+            elif pattern.type == "str" and re.fullmatch(r"[A-Za-z_]\w*", pattern.value):
+                keywords[pattern.value] = terminal.name
+            elif pattern.type == "str":
+                operators[pattern.value] = terminal.name
+            else:  # pragma: no cover - a grammar change the lexer does not know
+                raise ValueError(f"lexer: no rule for terminal {terminal.name}")
+        missing = [name for name in _REGEX_TERMINALS if name not in patterns]
+        if missing:  # pragma: no cover - grammar and lexer out of step
+            raise ValueError(f"lexer: grammar lacks terminals {missing}")
+        ops = "|".join(re.escape(op) for op in sorted(operators, key=len, reverse=True))
+        parts = [f"(?P<{name}>{patterns[name]})" for name in _REGEX_TERMINALS]
+        parts += [f"(?P<OP>{ops})", r"(?P<WS>[ \t\f\r\n\v]+)", r"(?P<ERROR>.)"]
+        self._regex = re.compile("|".join(parts), re.DOTALL)
+        self.keywords = keywords
+        self.operators = operators
+
+    def tokens(self, source: Source) -> Iterator[Token]:
+        """Yield the tokens of ``source`` as ``(type, value, start, end)`` tuples.
+
+        Raises :class:`ScriptSyntaxError` at the first character that starts no token.
+        """
+        text = source.text
+        keywords = self.keywords
+        operators = self.operators
+        last_end = -1  # end of the last real token; -1 before the first
+        for match in self._regex.finditer(text):
+            kind = match.lastgroup
+            if kind == "NAME":
+                value = match.group()
+                start, end = match.span()
+                last_end = end
+                yield (keywords.get(value, "NAME"), value, start, end)
+            elif kind == "WS":
+                if last_end >= 0:
+                    value = match.group()
+                    if value.count("\n") >= 2:
+                        start, end = match.span()
+                        yield ("BLANK", "", start, end)
+            elif kind == "OP":
+                value = match.group()
+                start, end = match.span()
+                last_end = end
+                yield (operators[value], value, start, end)
+            elif kind == "COMMENT":
+                start, end = match.span()
+                trailing = last_end >= 0 and "\n" not in text[last_end:start]
+                yield ("COMMENT", (match.group()[1:].rstrip(), trailing), start, end)
+            elif kind == "ERROR":
+                start = match.start()
+                char = text[start]
+                hint = _BAD_CHARACTER_HINTS.get(char)
+                message = (
+                    "string not closed" if char in "\"'" else f"unexpected character {char!r}"
+                )
+                raise ScriptSyntaxError.at_offset(source, start, start + 1, message, hint)
+            else:  # NUMBER, STRING, POSE_OPEN, MARKER
+                start, end = match.span()
+                last_end = end
+                yield (kind, match.group(), start, end)

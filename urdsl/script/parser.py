@@ -1,0 +1,579 @@
+"""The URScript parser: text in, :class:`~urdsl.script.nodes.Module` out.
+
+Lark compiles ``grammar/urscript.lark`` into LALR(1) tables. :class:`Parser` drives those
+tables itself with the tokens of :class:`~urdsl.script.lexer.Lexer` and calls one small
+builder per grammar rule (named by the rule's alias), so the syntax tree is built directly,
+with no parse tree in between and no per-token objects beyond plain tuples. This is what makes
+parsing large generated programs fast (see ``bench/parse_bench.py``).
+
+Comments, blank lines and ``$`` labels are tokens that the grammar accepts wherever a
+statement may stand. Where one appears elsewhere (a comment inside a call spread over several
+lines, say), the parser sets it aside and afterwards puts it in front of the statement it was
+written in, so nothing written is lost.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Callable, Iterable
+from dataclasses import replace
+from importlib import resources
+from typing import Any
+
+from .diagnostics import ScriptSyntaxError
+from .lexer import Lexer, Token
+from .nodes import (
+    BINARY_PRECEDENCE,
+    PREFIX_PRECEDENCE,
+    Assign,
+    Attribute,
+    BinOp,
+    Blank,
+    Bool,
+    Break,
+    Call,
+    Comment,
+    Continue,
+    Declare,
+    Elif,
+    EnterCritical,
+    ExitCritical,
+    ExprStmt,
+    FunctionDef,
+    Halt,
+    If,
+    Index,
+    Join,
+    Keyword,
+    Kill,
+    List,
+    Marker,
+    Module,
+    Name,
+    Node,
+    NoneLit,
+    Number,
+    Param,
+    Paren,
+    Pose,
+    Return,
+    Run,
+    SecDef,
+    Source,
+    Span,
+    String,
+    ThreadDef,
+    UnaryOp,
+    While,
+)
+
+__all__ = ["Parser", "parse", "grammar_text"]
+
+
+def grammar_text() -> str:
+    """The text of ``grammar/urscript.lark`` (shipped as package data ``urdsl.grammar``)."""
+    return resources.files("urdsl.grammar").joinpath("urscript.lark").read_text("utf-8")
+
+
+class _Prefixed(list):
+    """Prefix operator tokens followed by their operand, spliced into an operator sequence."""
+
+    __slots__ = ()
+
+
+# Tokens that may stand between statements; elsewhere they are set aside (see module doc).
+_LAYOUT = frozenset(("COMMENT", "BLANK"))
+
+_MARKER = re.compile(r"\$\s*(\d+)\s*(?:\"([^\"]*)\"\s*(?:\"([^\"]*)\")?\s*|(.*?))\s*$")
+
+
+class _Builder:
+    """One method per grammar alias; each takes the rule's children and returns a node.
+
+    Children are tokens ``(type, value, start, end)`` and the values of sub-rules, in the
+    order the rule writes them.
+    """
+
+    def __init__(self, source: Source) -> None:
+        self.src = source
+
+    # -- helpers -----------------------------------------------------------------------------
+
+    def span(self, start: int, end: int) -> Span:
+        return Span(self.src, start, end)
+
+    @staticmethod
+    def start_of(value: Any) -> int:
+        return value[2] if type(value) is tuple else value.span.start
+
+    @staticmethod
+    def end_of(value: Any) -> int:
+        return value[3] if type(value) is tuple else value.span.end
+
+    def error(self, start: int, end: int, message: str, hint: str | None = None) -> None:
+        raise ScriptSyntaxError.at_offset(self.src, start, end, message, hint)
+
+    @staticmethod
+    def strip_blanks(items: list) -> tuple:
+        begin, end = 0, len(items)
+        while begin < end and type(items[begin]) is Blank:
+            begin += 1
+        while end > begin and type(items[end - 1]) is Blank:
+            end -= 1
+        return tuple(items[begin:end])
+
+    # -- blocks ------------------------------------------------------------------------------
+
+    def start(self, s: list) -> Module:
+        return Module(self.strip_blanks(s[0]), self.span(0, len(self.src.text)))
+
+    @staticmethod
+    def block_empty(s: list) -> list:
+        return []
+
+    @staticmethod
+    def block_add(s: list) -> list:
+        block = s[0]
+        block.append(s[1])
+        return block
+
+    def comment(self, s: list) -> Comment:
+        _, (text, trailing), start, end = s[0]
+        return Comment(text, trailing, Span(self.src, start, end))
+
+    def blank(self, s: list) -> Blank:
+        return Blank(Span(self.src, s[0][2], s[0][3]))
+
+    def marker(self, s: list) -> Marker:
+        _, text, start, end = s[0]
+        span = Span(self.src, start, end)
+        match = _MARKER.match(text)
+        if match is None:
+            return Marker(None, text[1:].strip(), None, False, span)
+        number, label, flag, bare = match.groups()
+        if label is not None:
+            return Marker(int(number), label, flag, True, span)
+        return Marker(int(number), bare, None, False, span)
+
+    # -- simple statements -------------------------------------------------------------------
+
+    def assign(self, s: list) -> Assign:
+        target, _, value = s
+        if type(target) not in (Name, Index, Attribute):
+            what = "a call" if type(target) is Call else "this expression"
+            self.error(
+                target.span.start, target.span.end, f"cannot assign to {what}",
+                "the left of '=' must be a name, an element a[i] or a field s.f; "
+                "to compare, write '=='",
+            )
+        return Assign(target, value, Span(self.src, target.span.start, value.span.end))
+
+    @staticmethod
+    def expr_stmt(s: list) -> ExprStmt:
+        expr = s[0]
+        return ExprStmt(expr, expr.span)
+
+    def declare(self, s: list) -> Declare:
+        scope, name = s[0], s[1]
+        if len(s) == 2:
+            return Declare(scope[1], name[1], None, Span(self.src, scope[2], name[3]))
+        value = s[3]
+        return Declare(scope[1], name[1], value, Span(self.src, scope[2], value.span.end))
+
+    def return_stmt(self, s: list) -> Return:
+        keyword = s[0]
+        if len(s) == 1:
+            return Return(None, Span(self.src, keyword[2], keyword[3]))
+        return Return(s[1], Span(self.src, keyword[2], s[1].span.end))
+
+    def halt(self, s: list) -> Halt:
+        return Halt(Span(self.src, s[0][2], s[0][3]))
+
+    def break_stmt(self, s: list) -> Break:
+        return Break(Span(self.src, s[0][2], s[0][3]))
+
+    def continue_stmt(self, s: list) -> Continue:
+        return Continue(Span(self.src, s[0][2], s[0][3]))
+
+    def enter_critical(self, s: list) -> EnterCritical:
+        return EnterCritical(Span(self.src, s[0][2], s[0][3]))
+
+    def exit_critical(self, s: list) -> ExitCritical:
+        return ExitCritical(Span(self.src, s[0][2], s[0][3]))
+
+    def join(self, s: list) -> Join:
+        return Join(s[1], Span(self.src, s[0][2], s[1].span.end))
+
+    def kill(self, s: list) -> Kill:
+        return Kill(s[1], Span(self.src, s[0][2], s[1].span.end))
+
+    # -- compound statements -----------------------------------------------------------------
+
+    def function_def(self, s: list) -> FunctionDef:
+        params = tuple(s[3]) if len(s) == 8 else ()
+        seen: set[str] = set()
+        for param in params:
+            if param.name in seen:
+                self.error(
+                    param.span.start, param.span.end, f"parameter {param.name!r} appears twice"
+                )
+            seen.add(param.name)
+        return FunctionDef(
+            s[1][1], params, self.strip_blanks(s[-2]), Span(self.src, s[0][2], s[-1][3])
+        )
+
+    def thread_def(self, s: list) -> ThreadDef:
+        return ThreadDef(s[1][1], self.strip_blanks(s[5]), Span(self.src, s[0][2], s[6][3]))
+
+    def sec_def(self, s: list) -> SecDef:
+        return SecDef(s[1][1], self.strip_blanks(s[5]), Span(self.src, s[0][2], s[6][3]))
+
+    def if_stmt(self, s: list) -> If:
+        orelse = self.strip_blanks(s[7]) if len(s) == 9 else None
+        return If(
+            s[1], self.strip_blanks(s[3]), tuple(s[4]), orelse,
+            Span(self.src, s[0][2], s[-1][3]),
+        )
+
+    @staticmethod
+    def elifs_empty(s: list) -> list:
+        return []
+
+    def elifs_add(self, s: list) -> list:
+        elifs, keyword, test, colon, body = s
+        end = body[-1].span.end if body else colon[3]
+        elifs.append(Elif(test, self.strip_blanks(body), Span(self.src, keyword[2], end)))
+        return elifs
+
+    def while_stmt(self, s: list) -> While:
+        return While(s[1], self.strip_blanks(s[3]), Span(self.src, s[0][2], s[4][3]))
+
+    @staticmethod
+    def list_new(s: list) -> list:
+        return [s[0]]
+
+    @staticmethod
+    def list_add(s: list) -> list:
+        items = s[0]
+        items.append(s[2])
+        return items
+
+    def param(self, s: list) -> Param:
+        name = s[0]
+        if len(s) == 1:
+            return Param(name[1], None, Span(self.src, name[2], name[3]))
+        return Param(name[1], s[2], Span(self.src, name[2], s[2].span.end))
+
+    # -- expressions -------------------------------------------------------------------------
+
+    def expr(self, s: list) -> Any:
+        items = s[0]
+        if len(items) == 1:
+            return items[0]
+        return self.resolve(items)
+
+    @staticmethod
+    def seq_new(s: list) -> list:
+        operand = s[0]
+        return list(operand) if type(operand) is _Prefixed else [operand]
+
+    @staticmethod
+    def seq_add(s: list) -> list:
+        items, op, operand = s
+        items.append(op)
+        if type(operand) is _Prefixed:
+            items.extend(operand)
+        else:
+            items.append(operand)
+        return items
+
+    @staticmethod
+    def prefix(s: list) -> _Prefixed:
+        op, operand = s
+        if type(operand) is _Prefixed:
+            operand.insert(0, op)
+            return operand
+        return _Prefixed((op, operand))
+
+    def resolve(self, items: list) -> Any:
+        """Operator precedence over a flat ``operand op operand ...`` sequence (prefix
+        operators stand before their operand). All binary operators are left-associative."""
+        src = self.src
+        count = len(items)
+        position = 0
+
+        def climb(min_precedence: int) -> Any:
+            nonlocal position
+            item = items[position]
+            position += 1
+            if type(item) is tuple:  # a prefix operator
+                operand = climb(PREFIX_PRECEDENCE[item[1]])
+                left = UnaryOp(item[1], operand, Span(src, item[2], operand.span.end))
+            else:
+                left = item
+            while position < count:
+                op = items[position][1]
+                strength = BINARY_PRECEDENCE[op]
+                if strength < min_precedence:
+                    break
+                position += 1
+                right = climb(strength + 1)
+                left = BinOp(op, left, right, Span(src, left.span.start, right.span.end))
+            return left
+
+        return climb(0)
+
+    def call(self, s: list) -> Call:
+        func = s[0]
+        if type(func) not in (Name, Attribute):
+            self.error(
+                s[1][2], s[1][3], "only a function or a method can be called",
+                "put an operator or a line break between two expressions",
+            )
+        positional: list = []
+        keywords: list = []
+        if len(s) == 4:
+            for arg in s[2]:
+                if type(arg) is Keyword:
+                    if any(k.name == arg.name for k in keywords):
+                        self.error(
+                            arg.span.start, arg.span.end,
+                            f"keyword argument {arg.name!r} given twice",
+                        )
+                    keywords.append(arg)
+                elif keywords:
+                    self.error(
+                        arg.span.start, arg.span.end,
+                        "positional argument after a keyword argument",
+                        "give positional arguments first, then name=value arguments",
+                    )
+                else:
+                    positional.append(arg)
+        return Call(func, tuple(positional), tuple(keywords), Span(self.src, func.span.start,
+                                                                   s[-1][3]))
+
+    def keyword(self, s: list) -> Keyword:
+        name, _, value = s
+        return Keyword(name[1], value, Span(self.src, name[2], value.span.end))
+
+    def index(self, s: list) -> Index:
+        value, bracket, indices, close = s
+        if len(indices) > 2:
+            self.error(
+                indices[2].span.start, close[2], "too many indices",
+                "a list takes a[i], a matrix m[i, j]",
+            )
+        return Index(value, tuple(indices), Span(self.src, value.span.start, close[3]))
+
+    def attribute(self, s: list) -> Attribute:
+        value, _, name = s
+        return Attribute(value, name[1], Span(self.src, value.span.start, name[3]))
+
+    def name(self, s: list) -> Name:
+        _, value, start, end = s[0]
+        return Name(value, Span(self.src, start, end))
+
+    def number(self, s: list) -> Number:
+        _, text, start, end = s[0]
+        if "." in text or "e" in text or "E" in text:
+            value: int | float = float(text)
+        else:
+            value = int(text)
+        return Number(value, Span(self.src, start, end))
+
+    def string(self, s: list) -> String:
+        _, text, start, end = s[0]
+        return String(text[1:-1], Span(self.src, start, end))
+
+    def true(self, s: list) -> Bool:
+        return Bool(True, Span(self.src, s[0][2], s[0][3]))
+
+    def false(self, s: list) -> Bool:
+        return Bool(False, Span(self.src, s[0][2], s[0][3]))
+
+    def none(self, s: list) -> NoneLit:
+        return NoneLit(Span(self.src, s[0][2], s[0][3]))
+
+    def pose(self, s: list) -> Pose:
+        return Pose(tuple(s[1]), Span(self.src, s[0][2], s[2][3]))
+
+    def list_lit(self, s: list) -> List:
+        items = tuple(s[1]) if len(s) == 3 else ()
+        return List(items, Span(self.src, s[0][2], s[-1][3]))
+
+    def paren(self, s: list) -> Paren:
+        return Paren(s[1], Span(self.src, s[0][2], s[2][3]))
+
+    def run(self, s: list) -> Run:
+        return Run(s[1][1], Span(self.src, s[0][2], s[3][3]))
+
+
+class Parser:
+    """A URScript parser. Build one (or use :func:`parse`, which keeps one) and call
+    :meth:`parse` as often as needed; it holds no per-parse state."""
+
+    def __init__(self) -> None:
+        from lark import Lark
+        from lark.parsers.lalr_analysis import Shift
+
+        grammar = Lark(grammar_text(), parser="lalr", lexer="basic")
+        self.lexer = Lexer(grammar)
+        table = grammar.parser.parser.parser.parse_table
+        self.start_state = table.start_states["start"]
+        self.terminals = {t.name for t in grammar.terminals} | {"BLANK", "$END"}
+        # actions[state][terminal]: an int is "shift to that state"; a tuple is
+        # "reduce (size, builder name, rule name)". gotos[state][rule name]: next state.
+        self.actions: dict[int, dict[str, Any]] = {}
+        self.gotos: dict[int, dict[str, int]] = {}
+        for state, entries in table.states.items():
+            actions: dict[str, Any] = {}
+            gotos: dict[str, int] = {}
+            for symbol, (action, arg) in entries.items():
+                if symbol.isupper() or symbol == "$END":
+                    if action is Shift:
+                        actions[symbol] = arg
+                    else:
+                        builder = arg.alias or arg.origin.name
+                        actions[symbol] = (len(arg.expansion), builder, arg.origin.name)
+                else:
+                    gotos[symbol] = arg
+            self.actions[state] = actions
+            self.gotos[state] = gotos
+
+    def parse(self, text: str, filename: str = "<string>") -> Module:
+        """Parse URScript ``text``; ``filename`` is used in messages.
+
+        Raises :class:`~urdsl.script.diagnostics.ScriptSyntaxError` (with line, column and a
+        hint) when the text is not URScript.
+        """
+        source = Source(text, filename)
+        builder = _Builder(source)
+        callbacks: dict[str, Callable[[list], Any]] = {}
+        set_aside: list[Token] = []
+        actions = self.actions
+        gotos = self.gotos
+        stack = [self.start_state]
+        values: list[Any] = []
+
+        def builder_for(name: str) -> Callable[[list], Any]:
+            method = getattr(builder, name, None)
+            if method is None:  # `?rule` with one child: the child itself
+                method = _first
+            callbacks[name] = method
+            return method
+
+        tokens: Iterable[Token] = self.lexer.tokens(source)
+        end_token: Token = ("$END", "", len(text), len(text))
+        for token in _chain(tokens, end_token):
+            kind = token[0]
+            if kind in _LAYOUT and not self._accepts(stack, kind):
+                if kind == "COMMENT":
+                    set_aside.append(token)
+                continue
+            while True:
+                try:
+                    action = actions[stack[-1]][kind]
+                except KeyError:
+                    raise self._syntax_error(source, stack, token) from None
+                if type(action) is int:
+                    stack.append(action)
+                    values.append(token)
+                    break
+                size, name, rule = action
+                if size:
+                    children = values[-size:]
+                    del values[-size:]
+                    del stack[-size:]
+                else:
+                    children = []
+                callback = callbacks.get(name) or builder_for(name)
+                values.append(callback(children))
+                if rule == "start":
+                    module = values[-1]
+                    if set_aside:
+                        module = _place_comments(module, set_aside, source)
+                    return module
+                stack.append(gotos[stack[-1]][rule])
+        raise AssertionError("parser ran past the end of input")  # pragma: no cover
+
+    def _accepts(self, stack: list[int], kind: str) -> bool:
+        """Whether ``kind`` can be shifted after the reductions it would trigger (simulated on
+        a copy of the state stack, with no tree building)."""
+        actions = self.actions
+        gotos = self.gotos
+        states = list(stack)
+        while True:
+            action = actions[states[-1]].get(kind)
+            if action is None:
+                return False
+            if type(action) is int:
+                return True
+            size, _, rule = action
+            if size:
+                del states[-size:]
+            states.append(gotos[states[-1]][rule])
+
+    def _syntax_error(self, source: Source, stack: list[int], token: Token) -> ScriptSyntaxError:
+        from .errors import explain
+
+        expected = sorted(
+            name for name in self.actions[stack[-1]] if name in self.terminals
+        )
+        return explain(source, token, expected, self.lexer)
+
+
+def _first(children: list) -> Any:
+    return children[0]
+
+
+def _chain(tokens: Iterable[Token], last: Token):
+    yield from tokens
+    yield last
+
+
+def _place_comments(module: Module, comments: list[Token], source: Source) -> Module:
+    """Put comments that stood inside a statement in front of that statement, in the
+    innermost block that holds it."""
+    pending = sorted(comments, key=lambda token: token[2])
+
+    def place(items: tuple) -> tuple:
+        result: list = []
+        for item in items:
+            start, end = item.span.start, item.span.end
+            if any(start <= c[2] < end for c in pending):
+                item = descend(item)
+                for token in [c for c in pending if start <= c[2] < end]:
+                    _, (text, _trailing), c_start, c_end = token
+                    result.append(Comment(text, False, Span(source, c_start, c_end)))
+                    pending.remove(token)
+            result.append(item)
+        return tuple(result)
+
+    def descend(item: Node) -> Node:
+        if isinstance(item, (FunctionDef, ThreadDef, SecDef, While, Elif)):
+            return replace(item, body=place(item.body))
+        if isinstance(item, If):
+            return replace(
+                item,
+                body=place(item.body),
+                elifs=tuple(descend(branch) for branch in item.elifs),
+                orelse=None if item.orelse is None else place(item.orelse),
+            )
+        return item
+
+    return Module(place(module.body), module.span)
+
+
+@functools.cache
+def _default_parser() -> Parser:
+    return Parser()
+
+
+def parse(text: str, filename: str = "<string>") -> Module:
+    """Parse URScript text into a :class:`~urdsl.script.nodes.Module`.
+
+    >>> parse("movej([0, -1.57, 0, -1.57, 0, 0], a=1.4)").body[0].expr.func.id
+    'movej'
+    """
+    return _default_parser().parse(text, filename)
