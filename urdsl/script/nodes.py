@@ -25,7 +25,7 @@ __all__ = [
     "EnterCritical", "ExitCritical", "Join", "Kill", "If", "Elif", "While", "Param",
     "FunctionDef", "ThreadDef", "SecDef", "Comment", "Blank", "Marker", "Module",
     "Item", "BINARY_PRECEDENCE", "PREFIX_PRECEDENCE", "ATOM_PRECEDENCE", "precedence",
-    "walk",
+    "walk", "to_dict",
 ]
 
 
@@ -510,3 +510,25 @@ def walk(node: Node):
             elif isinstance(value, tuple):
                 children.extend(v for v in value if isinstance(v, Node))
         stack.extend(reversed(children))
+
+
+def to_dict(node: Node) -> dict:
+    """A JSON-ready dict of a tree: ``{"type": "Call", "span": {...}, <fields>}``. Spans are
+    ``{"line", "column", "end_line", "end_column"}`` (1-based), or absent for built nodes."""
+    result: dict = {"type": type(node).__name__}
+    span = getattr(node, "span", NO_SPAN)
+    if span.source is not None:
+        result["span"] = {
+            "line": span.line, "column": span.column,
+            "end_line": span.end_line, "end_column": span.end_column,
+        }
+    for name in node.__dataclass_fields__:  # type: ignore[attr-defined]
+        if name == "span":
+            continue
+        value = getattr(node, name)
+        if isinstance(value, Node):
+            value = to_dict(value)
+        elif isinstance(value, tuple):
+            value = [to_dict(v) if isinstance(v, Node) else v for v in value]
+        result[name] = value
+    return result

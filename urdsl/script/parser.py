@@ -15,8 +15,8 @@ written in, so nothing written is lost.
 from __future__ import annotations
 
 import functools
+import itertools
 import re
-from collections.abc import Callable, Iterable
 from dataclasses import replace
 from importlib import resources
 from typing import Any
@@ -70,6 +70,9 @@ from .nodes import (
 
 __all__ = ["Parser", "parse", "grammar_text"]
 
+_span = functools.partial(tuple.__new__, Span)
+"""``_span((source, start, end))``: a :class:`Span` made at C speed."""
+
 
 def grammar_text() -> str:
     """The text of ``grammar/urscript.lark`` (shipped as package data ``urdsl.grammar``)."""
@@ -101,7 +104,7 @@ class _Builder:
     # -- helpers -----------------------------------------------------------------------------
 
     def span(self, start: int, end: int) -> Span:
-        return Span(self.src, start, end)
+        return _span((self.src, start, end))
 
     @staticmethod
     def start_of(value: Any) -> int:
@@ -128,26 +131,24 @@ class _Builder:
     def start(self, s: list) -> Module:
         return Module(self.strip_blanks(s[0]), self.span(0, len(self.src.text)))
 
-    @staticmethod
-    def block_empty(s: list) -> list:
+    def block_empty(self, s: list) -> list:
         return []
 
-    @staticmethod
-    def block_add(s: list) -> list:
+    def block_add(self, s: list) -> list:
         block = s[0]
         block.append(s[1])
         return block
 
     def comment(self, s: list) -> Comment:
         _, (text, trailing), start, end = s[0]
-        return Comment(text, trailing, Span(self.src, start, end))
+        return Comment(text, trailing, _span((self.src, start, end)))
 
     def blank(self, s: list) -> Blank:
-        return Blank(Span(self.src, s[0][2], s[0][3]))
+        return Blank(_span((self.src, s[0][2], s[0][3])))
 
     def marker(self, s: list) -> Marker:
         _, text, start, end = s[0]
-        span = Span(self.src, start, end)
+        span = _span((self.src, start, end))
         match = _MARKER.match(text)
         if match is None:
             return Marker(None, text[1:].strip(), None, False, span)
@@ -167,46 +168,45 @@ class _Builder:
                 "the left of '=' must be a name, an element a[i] or a field s.f; "
                 "to compare, write '=='",
             )
-        return Assign(target, value, Span(self.src, target.span.start, value.span.end))
+        return Assign(target, value, _span((self.src, target.span.start, value.span.end)))
 
-    @staticmethod
-    def expr_stmt(s: list) -> ExprStmt:
+    def expr_stmt(self, s: list) -> ExprStmt:
         expr = s[0]
         return ExprStmt(expr, expr.span)
 
     def declare(self, s: list) -> Declare:
         scope, name = s[0], s[1]
         if len(s) == 2:
-            return Declare(scope[1], name[1], None, Span(self.src, scope[2], name[3]))
+            return Declare(scope[1], name[1], None, _span((self.src, scope[2], name[3])))
         value = s[3]
-        return Declare(scope[1], name[1], value, Span(self.src, scope[2], value.span.end))
+        return Declare(scope[1], name[1], value, _span((self.src, scope[2], value.span.end)))
 
     def return_stmt(self, s: list) -> Return:
         keyword = s[0]
         if len(s) == 1:
-            return Return(None, Span(self.src, keyword[2], keyword[3]))
-        return Return(s[1], Span(self.src, keyword[2], s[1].span.end))
+            return Return(None, _span((self.src, keyword[2], keyword[3])))
+        return Return(s[1], _span((self.src, keyword[2], s[1].span.end)))
 
     def halt(self, s: list) -> Halt:
-        return Halt(Span(self.src, s[0][2], s[0][3]))
+        return Halt(_span((self.src, s[0][2], s[0][3])))
 
     def break_stmt(self, s: list) -> Break:
-        return Break(Span(self.src, s[0][2], s[0][3]))
+        return Break(_span((self.src, s[0][2], s[0][3])))
 
     def continue_stmt(self, s: list) -> Continue:
-        return Continue(Span(self.src, s[0][2], s[0][3]))
+        return Continue(_span((self.src, s[0][2], s[0][3])))
 
     def enter_critical(self, s: list) -> EnterCritical:
-        return EnterCritical(Span(self.src, s[0][2], s[0][3]))
+        return EnterCritical(_span((self.src, s[0][2], s[0][3])))
 
     def exit_critical(self, s: list) -> ExitCritical:
-        return ExitCritical(Span(self.src, s[0][2], s[0][3]))
+        return ExitCritical(_span((self.src, s[0][2], s[0][3])))
 
     def join(self, s: list) -> Join:
-        return Join(s[1], Span(self.src, s[0][2], s[1].span.end))
+        return Join(s[1], _span((self.src, s[0][2], s[1].span.end)))
 
     def kill(self, s: list) -> Kill:
-        return Kill(s[1], Span(self.src, s[0][2], s[1].span.end))
+        return Kill(s[1], _span((self.src, s[0][2], s[1].span.end)))
 
     # -- compound statements -----------------------------------------------------------------
 
@@ -220,41 +220,38 @@ class _Builder:
                 )
             seen.add(param.name)
         return FunctionDef(
-            s[1][1], params, self.strip_blanks(s[-2]), Span(self.src, s[0][2], s[-1][3])
+            s[1][1], params, self.strip_blanks(s[-2]), _span((self.src, s[0][2], s[-1][3]))
         )
 
     def thread_def(self, s: list) -> ThreadDef:
-        return ThreadDef(s[1][1], self.strip_blanks(s[5]), Span(self.src, s[0][2], s[6][3]))
+        return ThreadDef(s[1][1], self.strip_blanks(s[5]), _span((self.src, s[0][2], s[6][3])))
 
     def sec_def(self, s: list) -> SecDef:
-        return SecDef(s[1][1], self.strip_blanks(s[5]), Span(self.src, s[0][2], s[6][3]))
+        return SecDef(s[1][1], self.strip_blanks(s[5]), _span((self.src, s[0][2], s[6][3])))
 
     def if_stmt(self, s: list) -> If:
         orelse = self.strip_blanks(s[7]) if len(s) == 9 else None
         return If(
             s[1], self.strip_blanks(s[3]), tuple(s[4]), orelse,
-            Span(self.src, s[0][2], s[-1][3]),
+            _span((self.src, s[0][2], s[-1][3])),
         )
 
-    @staticmethod
-    def elifs_empty(s: list) -> list:
+    def elifs_empty(self, s: list) -> list:
         return []
 
     def elifs_add(self, s: list) -> list:
         elifs, keyword, test, colon, body = s
         end = body[-1].span.end if body else colon[3]
-        elifs.append(Elif(test, self.strip_blanks(body), Span(self.src, keyword[2], end)))
+        elifs.append(Elif(test, self.strip_blanks(body), _span((self.src, keyword[2], end))))
         return elifs
 
     def while_stmt(self, s: list) -> While:
-        return While(s[1], self.strip_blanks(s[3]), Span(self.src, s[0][2], s[4][3]))
+        return While(s[1], self.strip_blanks(s[3]), _span((self.src, s[0][2], s[4][3])))
 
-    @staticmethod
-    def list_new(s: list) -> list:
+    def list_new(self, s: list) -> list:
         return [s[0]]
 
-    @staticmethod
-    def list_add(s: list) -> list:
+    def list_add(self, s: list) -> list:
         items = s[0]
         items.append(s[2])
         return items
@@ -262,8 +259,8 @@ class _Builder:
     def param(self, s: list) -> Param:
         name = s[0]
         if len(s) == 1:
-            return Param(name[1], None, Span(self.src, name[2], name[3]))
-        return Param(name[1], s[2], Span(self.src, name[2], s[2].span.end))
+            return Param(name[1], None, _span((self.src, name[2], name[3])))
+        return Param(name[1], s[2], _span((self.src, name[2], s[2].span.end)))
 
     # -- expressions -------------------------------------------------------------------------
 
@@ -273,13 +270,11 @@ class _Builder:
             return items[0]
         return self.resolve(items)
 
-    @staticmethod
-    def seq_new(s: list) -> list:
+    def seq_new(self, s: list) -> list:
         operand = s[0]
         return list(operand) if type(operand) is _Prefixed else [operand]
 
-    @staticmethod
-    def seq_add(s: list) -> list:
+    def seq_add(self, s: list) -> list:
         items, op, operand = s
         items.append(op)
         if type(operand) is _Prefixed:
@@ -288,8 +283,7 @@ class _Builder:
             items.append(operand)
         return items
 
-    @staticmethod
-    def prefix(s: list) -> _Prefixed:
+    def prefix(self, s: list) -> _Prefixed:
         op, operand = s
         if type(operand) is _Prefixed:
             operand.insert(0, op)
@@ -309,7 +303,7 @@ class _Builder:
             position += 1
             if type(item) is tuple:  # a prefix operator
                 operand = climb(PREFIX_PRECEDENCE[item[1]])
-                left = UnaryOp(item[1], operand, Span(src, item[2], operand.span.end))
+                left = UnaryOp(item[1], operand, _span((src, item[2], operand.span.end)))
             else:
                 left = item
             while position < count:
@@ -319,7 +313,7 @@ class _Builder:
                     break
                 position += 1
                 right = climb(strength + 1)
-                left = BinOp(op, left, right, Span(src, left.span.start, right.span.end))
+                left = BinOp(op, left, right, _span((src, left.span.start, right.span.end)))
             return left
 
         return climb(0)
@@ -350,12 +344,12 @@ class _Builder:
                     )
                 else:
                     positional.append(arg)
-        return Call(func, tuple(positional), tuple(keywords), Span(self.src, func.span.start,
-                                                                   s[-1][3]))
+        return Call(func, tuple(positional), tuple(keywords), _span((self.src, func.span.start,
+                                                                   s[-1][3])))
 
     def keyword(self, s: list) -> Keyword:
         name, _, value = s
-        return Keyword(name[1], value, Span(self.src, name[2], value.span.end))
+        return Keyword(name[1], value, _span((self.src, name[2], value.span.end)))
 
     def index(self, s: list) -> Index:
         value, bracket, indices, close = s
@@ -364,15 +358,15 @@ class _Builder:
                 indices[2].span.start, close[2], "too many indices",
                 "a list takes a[i], a matrix m[i, j]",
             )
-        return Index(value, tuple(indices), Span(self.src, value.span.start, close[3]))
+        return Index(value, tuple(indices), _span((self.src, value.span.start, close[3])))
 
     def attribute(self, s: list) -> Attribute:
         value, _, name = s
-        return Attribute(value, name[1], Span(self.src, value.span.start, name[3]))
+        return Attribute(value, name[1], _span((self.src, value.span.start, name[3])))
 
     def name(self, s: list) -> Name:
         _, value, start, end = s[0]
-        return Name(value, Span(self.src, start, end))
+        return Name(value, _span((self.src, start, end)))
 
     def number(self, s: list) -> Number:
         _, text, start, end = s[0]
@@ -380,33 +374,33 @@ class _Builder:
             value: int | float = float(text)
         else:
             value = int(text)
-        return Number(value, Span(self.src, start, end))
+        return Number(value, _span((self.src, start, end)))
 
     def string(self, s: list) -> String:
         _, text, start, end = s[0]
-        return String(text[1:-1], Span(self.src, start, end))
+        return String(text[1:-1], _span((self.src, start, end)))
 
     def true(self, s: list) -> Bool:
-        return Bool(True, Span(self.src, s[0][2], s[0][3]))
+        return Bool(True, _span((self.src, s[0][2], s[0][3])))
 
     def false(self, s: list) -> Bool:
-        return Bool(False, Span(self.src, s[0][2], s[0][3]))
+        return Bool(False, _span((self.src, s[0][2], s[0][3])))
 
     def none(self, s: list) -> NoneLit:
-        return NoneLit(Span(self.src, s[0][2], s[0][3]))
+        return NoneLit(_span((self.src, s[0][2], s[0][3])))
 
     def pose(self, s: list) -> Pose:
-        return Pose(tuple(s[1]), Span(self.src, s[0][2], s[2][3]))
+        return Pose(tuple(s[1]), _span((self.src, s[0][2], s[2][3])))
 
     def list_lit(self, s: list) -> List:
         items = tuple(s[1]) if len(s) == 3 else ()
-        return List(items, Span(self.src, s[0][2], s[-1][3]))
+        return List(items, _span((self.src, s[0][2], s[-1][3])))
 
     def paren(self, s: list) -> Paren:
-        return Paren(s[1], Span(self.src, s[0][2], s[2][3]))
+        return Paren(s[1], _span((self.src, s[0][2], s[2][3])))
 
     def run(self, s: list) -> Run:
-        return Run(s[1][1], Span(self.src, s[0][2], s[3][3]))
+        return Run(s[1][1], _span((self.src, s[0][2], s[3][3])))
 
 
 class Parser:
@@ -422,20 +416,30 @@ class Parser:
         table = grammar.parser.parser.parser.parse_table
         self.start_state = table.start_states["start"]
         self.terminals = {t.name for t in grammar.terminals} | {"BLANK", "$END"}
-        # actions[state][terminal]: an int is "shift to that state"; a tuple is
-        # "reduce (size, builder name, rule name)". gotos[state][rule name]: next state.
+        # actions[state][terminal]: an int is "shift to that state"; a str is "reduce a
+        # one-child rule that passes its child up (`?rule`), then go to gotos[state][str]";
+        # a tuple is "reduce (size, builder function, rule name)".
+        # gotos[state][rule name]: the state after reducing to that rule.
         self.actions: dict[int, dict[str, Any]] = {}
         self.gotos: dict[int, dict[str, int]] = {}
         for state, entries in table.states.items():
             actions: dict[str, Any] = {}
             gotos: dict[str, int] = {}
             for symbol, (action, arg) in entries.items():
+                # Lark's names are str subclasses with a slow __eq__: keep plain strings.
+                symbol = str(symbol)
                 if symbol.isupper() or symbol == "$END":
                     if action is Shift:
                         actions[symbol] = arg
+                        continue
+                    rule = str(arg.origin.name)
+                    function = getattr(_Builder, str(arg.alias or rule), None)
+                    if function is None and len(arg.expansion) == 1:
+                        actions[symbol] = rule
+                    elif function is None:  # pragma: no cover - grammar and builder disagree
+                        raise ValueError(f"no builder for grammar rule {arg}")
                     else:
-                        builder = arg.alias or arg.origin.name
-                        actions[symbol] = (len(arg.expansion), builder, arg.origin.name)
+                        actions[symbol] = (len(arg.expansion), function, rule)
                 else:
                     gotos[symbol] = arg
             self.actions[state] = actions
@@ -449,23 +453,13 @@ class Parser:
         """
         source = Source(text, filename)
         builder = _Builder(source)
-        callbacks: dict[str, Callable[[list], Any]] = {}
         set_aside: list[Token] = []
         actions = self.actions
         gotos = self.gotos
         stack = [self.start_state]
         values: list[Any] = []
-
-        def builder_for(name: str) -> Callable[[list], Any]:
-            method = getattr(builder, name, None)
-            if method is None:  # `?rule` with one child: the child itself
-                method = _first
-            callbacks[name] = method
-            return method
-
-        tokens: Iterable[Token] = self.lexer.tokens(source)
         end_token: Token = ("$END", "", len(text), len(text))
-        for token in _chain(tokens, end_token):
+        for token in itertools.chain(self.lexer.tokens(source), (end_token,)):
             kind = token[0]
             if kind in _LAYOUT and not self._accepts(stack, kind):
                 if kind == "COMMENT":
@@ -476,19 +470,23 @@ class Parser:
                     action = actions[stack[-1]][kind]
                 except KeyError:
                     raise self._syntax_error(source, stack, token) from None
-                if type(action) is int:
+                kind_of_action = type(action)
+                if kind_of_action is int:
                     stack.append(action)
                     values.append(token)
                     break
-                size, name, rule = action
+                if kind_of_action is str:  # `?rule` passing its only child up
+                    del stack[-1]
+                    stack.append(gotos[stack[-1]][action])
+                    continue
+                size, function, rule = action
                 if size:
                     children = values[-size:]
                     del values[-size:]
                     del stack[-size:]
                 else:
                     children = []
-                callback = callbacks.get(name) or builder_for(name)
-                values.append(callback(children))
+                values.append(function(builder, children))
                 if rule == "start":
                     module = values[-1]
                     if set_aside:
@@ -509,6 +507,9 @@ class Parser:
                 return False
             if type(action) is int:
                 return True
+            if type(action) is str:
+                states[-1:] = [gotos[states[-2]][action]]
+                continue
             size, _, rule = action
             if size:
                 del states[-size:]
@@ -521,15 +522,6 @@ class Parser:
             name for name in self.actions[stack[-1]] if name in self.terminals
         )
         return explain(source, token, expected, self.lexer)
-
-
-def _first(children: list) -> Any:
-    return children[0]
-
-
-def _chain(tokens: Iterable[Token], last: Token):
-    yield from tokens
-    yield last
 
 
 def _place_comments(module: Module, comments: list[Token], source: Source) -> Module:

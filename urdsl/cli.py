@@ -1,0 +1,222 @@
+"""The ``urdsl`` command.
+
+Each subcommand is a function ``cmd_<name>(args) -> int`` registered in :func:`build_parser`;
+the return value is the exit status. Bad input (a file that is not URScript, a missing file)
+is reported as a message naming ``file:line:col``, never as a Python traceback.
+
+Exit status: 0 success, 1 the input has problems (syntax errors, files that ``fmt --check``
+would change), 2 usage or I/O errors.
+"""
+
+from __future__ import annotations
+
+import argparse
+import difflib
+import json
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from . import __version__
+from .script.diagnostics import ScriptError
+from .script.nodes import to_dict
+from .script.parser import parse
+from .script.printer import format as format_tree
+
+EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE = 0, 1, 2
+
+
+class UsageError(Exception):
+    """A problem with the command line or the files it names (exit status 2)."""
+
+
+@dataclass
+class InputFile:
+    """A file read for a command: its name for messages, its text and its encoding."""
+
+    name: str
+    text: str
+    encoding: str
+    path: str | None  # None for standard input
+
+
+def read_input(name: str) -> InputFile:
+    """Read ``name`` (``-`` is standard input). URScript files are UTF-8; files that are not
+    valid UTF-8 are read as Latin-1 (PolyScope's 8-bit text), and written back the same way."""
+    if name == "-":
+        data = sys.stdin.buffer.read()
+        path = None
+        label = "<stdin>"
+    else:
+        try:
+            with open(name, "rb") as handle:
+                data = handle.read()
+        except OSError as error:
+            raise UsageError(f"cannot read {name}: {error.strerror}") from None
+        path = label = name
+    try:
+        return InputFile(label, data.decode("utf-8"), "utf-8", path)
+    except UnicodeDecodeError:
+        return InputFile(label, data.decode("latin-1"), "latin-1", path)
+
+
+def _error(message: str) -> None:
+    print(f"urdsl: error: {message}", file=sys.stderr)
+
+
+# ---- parse ---------------------------------------------------------------------------------
+
+
+def cmd_parse(args: argparse.Namespace) -> int:
+    status = EXIT_OK
+    trees = []
+    for name in args.files:
+        source = read_input(name)
+        try:
+            tree = parse(source.text, source.name)
+        except ScriptError as error:
+            print(error.diagnostic.render(), file=sys.stderr)
+            status = EXIT_PROBLEMS
+            continue
+        if args.json:
+            trees.append({"file": source.name, "tree": to_dict(tree)})
+        elif not args.quiet:
+            print(f"{source.name}: ok ({len(tree.body)} top-level items)", file=sys.stderr)
+    if args.json:
+        json.dump(trees, sys.stdout, indent=1 if args.pretty else None)
+        sys.stdout.write("\n")
+    return status
+
+
+# ---- fmt -----------------------------------------------------------------------------------
+
+
+def cmd_fmt(args: argparse.Namespace) -> int:
+    if args.in_place and "-" in args.files:
+        raise UsageError("-i cannot rewrite standard input")
+    status = EXIT_OK
+    indent = " " * args.indent
+    for name in args.files:
+        source = read_input(name)
+        try:
+            formatted = format_tree(parse(source.text, source.name), indent=indent)
+        except ScriptError as error:
+            print(error.diagnostic.render(), file=sys.stderr)
+            status = EXIT_PROBLEMS
+            continue
+        changed = formatted != source.text
+        if args.check or args.diff:
+            if changed:
+                status = EXIT_PROBLEMS
+                if args.diff:
+                    _write_diff(source.name, source.text, formatted)
+                else:
+                    print(f"would reformat {source.name}", file=sys.stderr)
+        elif args.in_place:
+            if changed and source.path is not None:
+                with open(source.path, "w", encoding=source.encoding, newline="") as handle:
+                    handle.write(formatted)
+                print(f"reformatted {source.name}", file=sys.stderr)
+        else:
+            sys.stdout.write(formatted)
+    return status
+
+
+def _write_diff(name: str, before: str, after: str) -> None:
+    """A unified diff on stdout; a last line without a line break is marked as diff does."""
+    for line in difflib.unified_diff(
+        before.splitlines(keepends=True), after.splitlines(keepends=True),
+        fromfile=f"{name} (original)", tofile=f"{name} (formatted)",
+    ):
+        sys.stdout.write(line)
+        if not line.endswith("\n"):
+            sys.stdout.write("\n\\ No newline at end of file\n")
+
+
+# ---- the parser ----------------------------------------------------------------------------
+
+_DESCRIPTION = """\
+urdsl: write, check, send and observe Universal Robots programs.
+
+Work with URScript files (.script, .urscript) as PolyScope, driver libraries and people
+write them. Every message about a program names file:line:col and shows the line.
+"""
+
+_EPILOG = """\
+examples:
+  urdsl parse program.script            check that a file is URScript
+  urdsl parse --json program.script     print its syntax tree as JSON
+  urdsl fmt program.script              print it in canonical form
+  urdsl fmt --check *.script            exit 1 if any file is not formatted
+  urdsl fmt -i program.script           reformat in place
+
+Run 'urdsl COMMAND --help' for the options of a command.
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="urdsl", description=_DESCRIPTION, epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"urdsl {__version__}")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    p = commands.add_parser(
+        "parse", help="check that files are URScript; print their syntax tree",
+        description="Parse URScript files. Exit 0 when all parse; otherwise print each "
+        "syntax error (file:line:col, the line, a caret and a hint) on stderr and exit 1.",
+        epilog="example:\n  urdsl parse --json --pretty course.script | less",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("files", nargs="+", metavar="FILE", help="URScript file; '-' reads stdin")
+    p.add_argument("--json", action="store_true",
+                   help="print the syntax trees as JSON on stdout: a list of "
+                   "{file, tree} objects; each node has its type, fields and span")
+    p.add_argument("--pretty", action="store_true", help="indent the JSON")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing for good files")
+    p.set_defaults(run=cmd_parse)
+
+    p = commands.add_parser(
+        "fmt", help="format URScript files canonically",
+        description="Print URScript files in canonical form: one statement per line, "
+        "blocks indented by two spaces, def/sec and their end in column 0, numbers in "
+        "their shortest exact form. Comments, blank-line breaks and $ labels are kept.",
+        epilog="examples:\n  urdsl fmt prog.script > clean.script\n"
+        "  urdsl fmt --diff prog.script\n  urdsl fmt -i *.script",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("files", nargs="+", metavar="FILE", help="URScript file; '-' reads stdin")
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--check", action="store_true",
+                      help="write nothing; exit 1 if any file would change")
+    mode.add_argument("--diff", action="store_true",
+                      help="print a unified diff of the changes; exit 1 if there are any")
+    mode.add_argument("-i", "--in-place", action="store_true",
+                      help="rewrite the files in place")
+    p.add_argument("--indent", type=int, default=2, metavar="N",
+                   help="spaces per block level (default: 2)")
+    p.set_defaults(run=cmd_fmt)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``urdsl`` console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None):
+        parser.print_help()
+        return EXIT_USAGE
+    try:
+        return args.run(args)
+    except UsageError as error:
+        _error(str(error))
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        return EXIT_OK
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

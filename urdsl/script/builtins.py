@@ -1,0 +1,246 @@
+"""The builtin catalog: every URScript builtin with its parameters, defaults, return type,
+controller versions and deprecation.
+
+This is the one source that the linter, the DSL and the interpreter read. The data is
+``builtins.tsv`` (package data, from ``../shared/reference/builtins.tsv``; its columns are
+explained in ``../shared/reference/BUILTINS.md``)::
+
+    >>> from urdsl.script.builtins import catalog
+    >>> movej = catalog()["movej"]
+    >>> [(p.name, p.default) for p in movej.params]
+    [('q', None), ('a', '1.4'), ('v', '1.05'), ('t', '0'), ('r', '0')]
+    >>> movej.available_in("5.15"), catalog()["get_euromap_input"].available_in("5.15")
+    (True, False)
+
+Versions are PolyScope software versions: 1.x–3.x CB-Series, 5.x e-Series, 10.x and later
+PolyScope X.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from dataclasses import dataclass
+from importlib import resources
+
+__all__ = ["BuiltinParam", "Builtin", "catalog", "lookup", "parse_version", "methods"]
+
+Version = tuple[int, int]
+
+
+def parse_version(text: str) -> Version:
+    """``"5.15"`` or ``"5.15.2"`` → ``(5, 15)``. Raises ValueError for anything else."""
+    match = re.fullmatch(r"\s*(\d+)(?:\.(\d+))?(?:\.\d+)*\s*", text)
+    if match is None:
+        raise ValueError(f"not a controller version: {text!r} (expected e.g. 5.15 or 3.14)")
+    return int(match.group(1)), int(match.group(2) or 0)
+
+
+def _series(version: Version) -> str:
+    if version[0] <= 4:
+        return "cb"
+    if version[0] < 10:
+        return "e"
+    return "x"
+
+
+@dataclass(frozen=True)
+class BuiltinParam:
+    """A builtin's parameter. ``default`` is the default as URScript text (``None`` when the
+    parameter has none); ``optional`` is true when the argument may be left out."""
+
+    name: str
+    default: str | None = None
+    optional: bool = False
+
+
+@dataclass(frozen=True)
+class Builtin:
+    """One row of the catalog (see ``BUILTINS.md`` for the meaning of each field)."""
+
+    module: str
+    name: str
+    params: tuple[BuiltinParam, ...]
+    returns: tuple[str, ...]
+    since: str
+    deprecated: bool
+    replaced_by: tuple[str, ...]
+    remarks: str
+    callable: bool = True
+    variadic_keywords: bool = False
+
+    @property
+    def min_args(self) -> int:
+        """How many arguments a call needs at least."""
+        return sum(1 for p in self.params if not p.optional)
+
+    @property
+    def max_args(self) -> int:
+        """How many positional arguments a call may give at most."""
+        return len(self.params)
+
+    @property
+    def is_method(self) -> bool:
+        """A method of lists or RPC handles (``list.append``), not a free function."""
+        return "." in self.name
+
+    @property
+    def confirmed(self) -> bool:
+        """False when the catalog marks this row unconfirmed ([U], ``~`` or ``?``)."""
+        return not (self.remarks.startswith("[U]") or self.since.startswith(("~", "?")))
+
+    @property
+    def signature(self) -> str:
+        """``movej(q, a=1.4, v=1.05, t=0, r=0)``."""
+        parts = []
+        for p in self.params:
+            if p.default is not None:
+                parts.append(f"{p.name}={p.default}")
+            elif p.optional:
+                parts.append(f"[{p.name}]")
+            else:
+                parts.append(p.name)
+        if self.variadic_keywords:
+            parts.append("name=value, ...")
+        return f"{self.name}({', '.join(parts)})"
+
+    def param(self, name: str) -> BuiltinParam | None:
+        """The parameter called ``name``, if there is one."""
+        return next((p for p in self.params if p.name == name), None)
+
+    def first_versions(self) -> dict[str, Version | None]:
+        """First version per series (``"cb"``, ``"e"``, ``"x"``) that has this builtin;
+        a series missing from the dict does not have it; ``None`` means "from the first
+        version we know of"."""
+        since = self.since.lstrip("~")
+        if since.startswith("doc"):  # documented in the 2020-era (or 2022-23) manuals
+            return {"cb": None, "e": None if "2020" in since else (5, 11), "x": None}
+        if since.startswith("<="):
+            return {"e": None, "x": None}
+        if since == "3.x":
+            return {"cb": None}
+        if since == "5.x":
+            return {"e": None, "x": None}
+        if since == "10.x":
+            return {"x": None}
+        if since == "?":
+            return {}
+        result: dict[str, Version | None] = {}
+        for part in since.split("/"):
+            version = parse_version(part)
+            result[_series(version)] = version
+        if "e" in result and "x" not in result:
+            result["x"] = None  # PolyScope X carries the e-Series language forward
+        return result
+
+    def available_in(self, version: str | Version) -> bool | None:
+        """Whether controller software ``version`` has this builtin: True, False, or None
+        when the catalog cannot tell (an unconfirmed or open-ended first version)."""
+        if isinstance(version, str):
+            version = parse_version(version)
+        if self.since == "?":
+            return None
+        firsts = self.first_versions()
+        series = _series(version)
+        if series not in firsts:
+            if self.since == "3.x" and "CB3 only" not in self.remarks:
+                return None
+            return False
+        first = firsts[series]
+        if first is None:
+            if self.since.startswith("<=") and series == "e":
+                bound = parse_version(self.since[2:].split("/")[0])
+                return True if version >= bound else None
+            return True
+        if version >= first:
+            return True
+        return None if self.since.startswith("~") else False
+
+
+def _split_params(text: str) -> list[str]:
+    """Split ``a, b=[1, 2], c='x'`` at the commas that are not inside brackets or quotes."""
+    parts, depth, quote, current = [], 0, "", []
+    for char in text:
+        if quote:
+            if char == quote:
+                quote = ""
+        elif char in "\"'":
+            quote = char
+        elif char in "([":
+            depth += 1
+        elif char in ")]":
+            depth -= 1
+        elif char == "," and depth == 0:
+            parts.append("".join(current).strip())
+            current = []
+            continue
+        current.append(char)
+    if "".join(current).strip():
+        parts.append("".join(current).strip())
+    return parts
+
+
+def _row(fields: list[str]) -> Builtin:
+    module, name, params_text, returns, since, deprecated, replaced_by, remarks = fields
+    params: list[BuiltinParam] = []
+    variadic = False
+    is_callable = params_text.strip() != "-"
+    if is_callable:
+        for part in _split_params(params_text):
+            if part == "...":
+                variadic = True
+            elif part.startswith("[") and part.endswith("]"):
+                params.append(BuiltinParam(part[1:-1].strip(), None, True))
+            elif "=" in part:
+                pname, default = part.split("=", 1)
+                if name == "struct":
+                    variadic = True
+                    continue
+                params.append(BuiltinParam(pname.strip(), default.strip(), True))
+            else:
+                params.append(BuiltinParam(part, None, False))
+    return Builtin(
+        module=module, name=name, params=tuple(params),
+        returns=tuple(returns.split("|")) if returns not in ("", "-") else (),
+        since=since, deprecated=deprecated == "yes",
+        replaced_by=tuple(r for r in replaced_by.split(",") if r),
+        remarks=remarks, callable=is_callable, variadic_keywords=variadic,
+    )
+
+
+@functools.cache
+def _load() -> tuple[dict[str, Builtin], dict[str, Builtin]]:
+    text = resources.files("urdsl.script").joinpath("builtins.tsv").read_text("utf-8")
+    functions: dict[str, Builtin] = {}
+    method_rows: dict[str, Builtin] = {}
+    lines = text.splitlines()
+    header = lines[0].split("\t")
+    if len(header) != 8:  # pragma: no cover - package data damaged
+        raise ValueError(f"builtins.tsv: expected 8 columns, found {len(header)}")
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        fields = line.split("\t")
+        if len(fields) != 8:  # pragma: no cover - package data damaged
+            raise ValueError(f"builtins.tsv:{number}: expected 8 columns, found {len(fields)}")
+        builtin = _row(fields)
+        if builtin.is_method:
+            method_rows[builtin.name.split(".", 1)[1]] = builtin
+        else:
+            functions[builtin.name] = builtin
+    return functions, method_rows
+
+
+def catalog() -> dict[str, Builtin]:
+    """All free builtins (functions, ``struct``, interpreter-socket commands) by name."""
+    return _load()[0]
+
+
+def methods() -> dict[str, Builtin]:
+    """List and RPC-handle methods by method name (``append``, ``pop``, ...)."""
+    return _load()[1]
+
+
+def lookup(name: str) -> Builtin | None:
+    """The builtin function called ``name``, or None."""
+    return _load()[0].get(name)
