@@ -70,8 +70,10 @@ class Lexer:
             raise ValueError(f"lexer: grammar lacks terminals {missing}")
         ops = "|".join(re.escape(op) for op in sorted(operators, key=len, reverse=True))
         parts = [f"(?P<{name}>{patterns[name]})" for name in _REGEX_TERMINALS]
-        parts += [f"(?P<OP>{ops})", r"(?P<WS>[ \t\f\r\n\v]+)", r"(?P<ERROR>.)"]
-        self._regex = re.compile("|".join(parts), re.DOTALL)
+        parts += [f"(?P<OP>{ops})", r"(?P<ERROR>[^ \t\f\r\n\v])"]
+        # Each match is the white space before a token (group 1) and the token: one match
+        # per token, and white space costs no loop turn of its own.
+        self._regex = re.compile(r"([ \t\f\r\n\v]*)(?:" + "|".join(parts) + ")", re.DOTALL)
         self.keywords = keywords
         self.operators = operators
 
@@ -86,35 +88,32 @@ class Lexer:
         last_end = -1  # end of the last real token; -1 before the first
         for match in self._regex.finditer(text):
             kind = match.lastgroup
-            if kind == "NAME":
-                value = match.group()
-                start, end = match.span()
+            start = match.end(1)
+            end = match.end()
+            if start - match.start() > 1 and last_end >= 0 and text.count("\n", last_end,
+                                                                          start) >= 2:
+                yield ("BLANK", "", last_end, start)
+            if kind == "NUMBER" or kind == "STRING" or kind == "POSE_OPEN":
                 last_end = end
-                yield (keywords.get(value, "NAME"), value, start, end)
-            elif kind == "WS":
-                if last_end >= 0:
-                    value = match.group()
-                    if value.count("\n") >= 2:
-                        start, end = match.span()
-                        yield ("BLANK", "", start, end)
+                yield (kind, text[start:end], start, end)
             elif kind == "OP":
-                value = match.group()
-                start, end = match.span()
+                value = text[start:end]
                 last_end = end
                 yield (operators[value], value, start, end)
+            elif kind == "NAME":
+                value = text[start:end]
+                last_end = end
+                yield (keywords.get(value, "NAME"), value, start, end)
             elif kind == "COMMENT":
-                start, end = match.span()
                 trailing = last_end >= 0 and "\n" not in text[last_end:start]
-                yield ("COMMENT", (match.group()[1:].rstrip(), trailing), start, end)
-            elif kind == "ERROR":
-                start = match.start()
+                yield ("COMMENT", (text[start + 1:end].rstrip(), trailing), start, end)
+            elif kind == "MARKER":
+                last_end = end
+                yield (kind, text[start:end], start, end)
+            else:  # ERROR
                 char = text[start]
                 hint = _BAD_CHARACTER_HINTS.get(char)
                 message = (
                     "string not closed" if char in "\"'" else f"unexpected character {char!r}"
                 )
                 raise ScriptSyntaxError.at_offset(source, start, start + 1, message, hint)
-            else:  # NUMBER, STRING, POSE_OPEN, MARKER
-                start, end = match.span()
-                last_end = end
-                yield (kind, match.group(), start, end)

@@ -15,6 +15,7 @@ written in, so nothing written is lost.
 from __future__ import annotations
 
 import functools
+import gc
 import itertools
 import re
 from dataclasses import replace
@@ -79,10 +80,8 @@ def grammar_text() -> str:
     return resources.files("urdsl.grammar").joinpath("urscript.lark").read_text("utf-8")
 
 
-class _Prefixed(list):
-    """Prefix operator tokens followed by their operand, spliced into an operator sequence."""
-
-    __slots__ = ()
+# Prefix operators that bind looser than comparisons (see _Builder.resolve).
+_LOOSE_PREFIX = frozenset(("not", "!"))
 
 
 # Tokens that may stand between statements; elsewhere they are set aside (see module doc).
@@ -265,34 +264,26 @@ class _Builder:
     # -- expressions -------------------------------------------------------------------------
 
     def expr(self, s: list) -> Any:
-        items = s[0]
-        if len(items) == 1:
-            return items[0]
-        return self.resolve(items)
+        return self.resolve(s[0])
 
-    def seq_new(self, s: list) -> list:
-        operand = s[0]
-        return list(operand) if type(operand) is _Prefixed else [operand]
+    def seq_pair(self, s: list) -> list:
+        return s
 
     def seq_add(self, s: list) -> list:
-        items, op, operand = s
-        items.append(op)
-        if type(operand) is _Prefixed:
-            items.extend(operand)
-        else:
-            items.append(operand)
+        items = s[0]
+        items.append(s[1])
+        items.append(s[2])
         return items
 
-    def prefix(self, s: list) -> _Prefixed:
+    def unary(self, s: list) -> UnaryOp:
         op, operand = s
-        if type(operand) is _Prefixed:
-            operand.insert(0, op)
-            return operand
-        return _Prefixed((op, operand))
+        return UnaryOp(op[1], operand, _span((self.src, op[2], operand.span.end)))
 
     def resolve(self, items: list) -> Any:
-        """Operator precedence over a flat ``operand op operand ...`` sequence (prefix
-        operators stand before their operand). All binary operators are left-associative."""
+        """Operator precedence over a flat ``operand op operand ...`` sequence; all binary
+        operators are left-associative. ``not x`` was built before its right neighbours were
+        known: here it takes the comparison (or sum, product) that follows ``x`` under it,
+        since ``not`` binds looser than those."""
         src = self.src
         count = len(items)
         position = 0
@@ -300,12 +291,13 @@ class _Builder:
         def climb(min_precedence: int) -> Any:
             nonlocal position
             item = items[position]
-            position += 1
-            if type(item) is tuple:  # a prefix operator
-                operand = climb(PREFIX_PRECEDENCE[item[1]])
-                left = UnaryOp(item[1], operand, _span((src, item[2], operand.span.end)))
+            if type(item) is UnaryOp and item.op in _LOOSE_PREFIX:
+                items[position] = item.operand
+                operand = climb(PREFIX_PRECEDENCE[item.op])
+                left = UnaryOp(item.op, operand, _span((src, item.span.start, operand.span.end)))
             else:
                 left = item
+                position += 1
             while position < count:
                 op = items[position][1]
                 strength = BINARY_PRECEDENCE[op]
@@ -330,7 +322,7 @@ class _Builder:
         if len(s) == 4:
             for arg in s[2]:
                 if type(arg) is Keyword:
-                    if any(k.name == arg.name for k in keywords):
+                    if keywords and arg.name in {k.name for k in keywords}:
                         self.error(
                             arg.span.start, arg.span.end,
                             f"keyword argument {arg.name!r} given twice",
@@ -370,10 +362,7 @@ class _Builder:
 
     def number(self, s: list) -> Number:
         _, text, start, end = s[0]
-        if "." in text or "e" in text or "E" in text:
-            value: int | float = float(text)
-        else:
-            value = int(text)
+        value: int | float = int(text) if text.isdigit() else float(text)
         return Number(value, _span((self.src, start, end)))
 
     def string(self, s: list) -> String:
@@ -433,13 +422,13 @@ class Parser:
                         actions[symbol] = arg
                         continue
                     rule = str(arg.origin.name)
-                    function = getattr(_Builder, str(arg.alias or rule), None)
-                    if function is None and len(arg.expansion) == 1:
+                    if arg.alias is None and arg.options.expand1 and len(arg.expansion) == 1:
                         actions[symbol] = rule
-                    elif function is None:  # pragma: no cover - grammar and builder disagree
+                        continue
+                    function = getattr(_Builder, str(arg.alias or rule), None)
+                    if function is None:  # pragma: no cover - grammar and builder disagree
                         raise ValueError(f"no builder for grammar rule {arg}")
-                    else:
-                        actions[symbol] = (len(arg.expansion), function, rule)
+                    actions[symbol] = (len(arg.expansion), function, rule)
                 else:
                     gotos[symbol] = arg
             self.actions[state] = actions
@@ -451,6 +440,18 @@ class Parser:
         Raises :class:`~urdsl.script.diagnostics.ScriptSyntaxError` (with line, column and a
         hint) when the text is not URScript.
         """
+        # The tree is acyclic and the parser makes no cycles: pausing the cyclic garbage
+        # collector, which would otherwise rescan the growing tree again and again, makes
+        # large files parse about a third faster.
+        collecting = gc.isenabled()
+        gc.disable()
+        try:
+            return self._parse(text, filename)
+        finally:
+            if collecting:
+                gc.enable()
+
+    def _parse(self, text: str, filename: str) -> Module:
         source = Source(text, filename)
         builder = _Builder(source)
         set_aside: list[Token] = []
@@ -458,6 +459,8 @@ class Parser:
         gotos = self.gotos
         stack = [self.start_state]
         values: list[Any] = []
+        push_state = stack.append
+        push_value = values.append
         end_token: Token = ("$END", "", len(text), len(text))
         for token in itertools.chain(self.lexer.tokens(source), (end_token,)):
             kind = token[0]
@@ -472,12 +475,12 @@ class Parser:
                     raise self._syntax_error(source, stack, token) from None
                 kind_of_action = type(action)
                 if kind_of_action is int:
-                    stack.append(action)
-                    values.append(token)
+                    push_state(action)
+                    push_value(token)
                     break
                 if kind_of_action is str:  # `?rule` passing its only child up
                     del stack[-1]
-                    stack.append(gotos[stack[-1]][action])
+                    push_state(gotos[stack[-1]][action])
                     continue
                 size, function, rule = action
                 if size:
@@ -486,13 +489,13 @@ class Parser:
                     del stack[-size:]
                 else:
                     children = []
-                values.append(function(builder, children))
+                push_value(function(builder, children))
                 if rule == "start":
                     module = values[-1]
                     if set_aside:
                         module = _place_comments(module, set_aside, source)
                     return module
-                stack.append(gotos[stack[-1]][rule])
+                push_state(gotos[stack[-1]][rule])
         raise AssertionError("parser ran past the end of input")  # pragma: no cover
 
     def _accepts(self, stack: list[int], kind: str) -> bool:
