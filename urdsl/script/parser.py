@@ -378,8 +378,20 @@ class _Builder:
     def none(self, s: list) -> NoneLit:
         return NoneLit(_span((self.src, s[0][2], s[0][3])))
 
-    def pose(self, s: list) -> Pose:
-        return Pose(tuple(s[1]), _span((self.src, s[0][2], s[2][3])))
+    def pose(self, s: list) -> Pose | Index:
+        """``p[...]``: six values make a pose literal; one or two are an element of a
+        variable called ``p`` (ur_rtde's control script writes ``p[0] = p[0] * factor``)."""
+        opener, items, close = s
+        if len(items) == 6:
+            return Pose(tuple(items), _span((self.src, opener[2], close[3])))
+        if len(items) <= 2:
+            name = Name("p", _span((self.src, opener[2], opener[2] + 1)))
+            return Index(name, tuple(items), _span((self.src, opener[2], close[3])))
+        self.error(
+            opener[2], close[3],
+            f"a pose has 6 values (x, y, z, rx, ry, rz); this one has {len(items)}",
+            "positions in metres, then the rotation vector in radians",
+        )
 
     def list_lit(self, s: list) -> List:
         items = tuple(s[1]) if len(s) == 3 else ()
