@@ -85,17 +85,24 @@ class Lexer:
         text = source.text
         keywords = self.keywords
         operators = self.operators
-        last_end = -1  # end of the last real token; -1 before the first
+        last_end = -1  # end of the last token that is not a comment; -1 before the first
         for match in self._regex.finditer(text):
             kind = match.lastgroup
             start = match.end(1)
             end = match.end()
-            if start - match.start() > 1 and last_end >= 0 and text.count("\n", last_end,
-                                                                          start) >= 2:
-                yield ("BLANK", "", last_end, start)
-            if kind == "NUMBER" or kind == "STRING" or kind == "POSE_OPEN":
+            space = match.start()  # the white space before this token starts here
+            if start - space > 1 and space > 0 and text.count("\n", space, start) >= 2:
+                yield ("BLANK", "", space, start)
+            if kind == "NUMBER" or kind == "STRING":
                 last_end = end
                 yield (kind, text[start:end], start, end)
+            elif kind == "POSE_OPEN":
+                if last_end > 0 and text[last_end - 1] == ".":  # field `s.p[0]`: no pose
+                    yield ("NAME", "p", start, start + 1)
+                    yield (operators["["], "[", start + 1, end)
+                else:
+                    yield (kind, text[start:end], start, end)
+                last_end = end
             elif kind == "OP":
                 value = text[start:end]
                 last_end = end
