@@ -29,6 +29,10 @@ class CorpusFile:
         return self.path.read_text(encoding="utf-8")
 
 
+def corpus_available() -> bool:
+    return (CORPUS / "MANIFEST.tsv").exists()
+
+
 def corpus_files() -> list[CorpusFile]:
     """The files listed in MANIFEST.tsv. Without the corpus, fail in CI and skip elsewhere."""
     manifest = CORPUS / "MANIFEST.tsv"
