@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import importlib
 import json
 import sys
 from collections.abc import Sequence
@@ -197,7 +198,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--indent", type=int, default=2, metavar="N",
                    help="spaces per block level (default: 2)")
     p.set_defaults(run=cmd_fmt)
+
+    # Commands of the other layers register themselves here, each from its own module:
+    # a function add_commands(commands) that calls commands.add_parser(...) and sets
+    # run=<function(args) -> exit status>.
+    for module in _COMMAND_MODULES:
+        importlib.import_module(module).add_commands(commands)
     return parser
+
+
+_COMMAND_MODULES: list[str] = []
+"""Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""
 
 
 def main(argv: Sequence[str] | None = None) -> int:
