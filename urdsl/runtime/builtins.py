@@ -1,0 +1,561 @@
+"""Builtin functions bound to an interpreter: their Python implementations.
+
+Arguments are bound by the builtin catalog (:mod:`urdsl.script.builtins`): its parameter
+names, defaults and arity are the contract, so a call with a wrong keyword or too many
+arguments fails with the catalog's signature in the message. Each implementation is a
+function ``impl(rt, node, **arguments)``.
+
+Motion goes to the interpreter's robot (:mod:`urdsl.motion`), pose maths to
+:mod:`urdsl.kinematics`, I/O, registers, sockets and messages to the environment. A catalog
+builtin without an implementation here is "not simulated": it returns a neutral value of its
+return type and leaves an event (or stops the program, if the environment says so).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Callable
+from typing import Any
+
+from ..script.builtins import Builtin, lookup, methods
+from ..script.nodes import Node
+from .values import (
+    ListValue,
+    PoseValue,
+    StructValue,
+    format_value,
+    is_number,
+    type_name,
+)
+
+__all__ = ["BuiltinTable", "IMPLEMENTATIONS"]
+
+IMPLEMENTATIONS: dict[str, Callable[..., Any]] = {}
+
+
+def implements(*names: str):
+    def register(function: Callable[..., Any]) -> Callable[..., Any]:
+        for name in names:
+            IMPLEMENTATIONS[name] = function
+        return function
+
+    return register
+
+
+_NEUTRAL = {"Int": 0, "Float": 0.0, "Number": 0, "Bool": False, "String": "",
+            "Array": None, "Pose": None, "None": None}
+
+
+class BuiltinTable:
+    """Calls builtins for one interpreter."""
+
+    def __init__(self, rt: Any) -> None:
+        self.rt = rt
+
+    def call(self, name: str, args: list, named: dict, node: Node) -> Any:
+        rt = self.rt
+        row = lookup(name)
+        implementation = IMPLEMENTATIONS.get(name)
+        if row is None and implementation is None:
+            raise rt.error("undefined", f"name '{name}' is not defined", node,
+                           _builtin_hint(name))
+        if row is not None:
+            bound = self.bind(row, args, named, node)
+        else:
+            bound = dict(named)
+            if args:
+                bound["__args__"] = args
+        if implementation is None:
+            return self.unsupported(row, node)
+        return implementation(rt, node, **bound)
+
+    def bind(self, row: Builtin, args: list, named: dict, node: Node) -> dict[str, Any]:
+        rt = self.rt
+        if not row.callable:
+            raise rt.error("call", f"'{row.name}' is a command of the interpreter socket, "
+                           "not a function", node)
+        if row.variadic_keywords:
+            if args:
+                raise rt.error("arguments", f"{row.name}() takes only name=value arguments",
+                               node)
+            return {"__members__": named}
+        params = row.params
+        if len(args) > len(params):
+            raise rt.error("arguments", f"{row.signature} takes at most {len(params)} "
+                           f"arguments, {len(args)} given", node)
+        bound = {param.name: value for param, value in zip(params, args, strict=False)}
+        for key, value in named.items():
+            if row.param(key) is None:
+                raise rt.error("arguments", f"{row.name}() has no parameter '{key}'", node,
+                               f"the signature is {row.signature}")
+            if key in bound:
+                raise rt.error("arguments", f"{row.name}() got '{key}' twice", node)
+            bound[key] = value
+        for param in params:
+            if param.name not in bound and not param.optional:
+                raise rt.error("arguments", f"{row.name}() needs argument '{param.name}'",
+                               node, f"the signature is {row.signature}")
+        return bound
+
+    def unsupported(self, row: Builtin, node: Node) -> Any:
+        rt = self.rt
+        if rt.env.unsupported == "error":
+            raise rt.error("unsupported", f"{row.name}() is not simulated by urdsl", node)
+        rt.event("unsupported", f"{row.name}() is not simulated; it did nothing here", node.span)
+        kind = row.returns[0] if row.returns else "None"
+        if kind == "Array":
+            return ListValue([])
+        if kind == "Pose":
+            return PoseValue([0.0] * 6)
+        return _NEUTRAL.get(kind)
+
+    def call_method(self, receiver: Any, method: str, args: list, named: dict,
+                    node: Node) -> Any:
+        rt = self.rt
+        if type(receiver) is ListValue:
+            row = methods().get(method)
+            if row is None or not row.module.startswith("language-list"):
+                raise rt.error("undefined", f"a list has no method '{method}'", node,
+                               "lists have append, insert, pop, clear, length, capacity")
+            bound = self.bind(row, args, named, node)
+            return _list_method(rt, node, receiver, method, bound)
+        if type(receiver) is _RemoteHandle:
+            rt.event("rpc", f"{receiver.kind} call {method}() is not simulated; it did "
+                     "nothing here", node.span)
+            return None
+        raise rt.error("type", f"a {type_name(receiver)} has no method '{method}'", node)
+
+
+class _RemoteHandle:
+    """What ``rpc_factory`` and URCap factories give: calls on it are recorded, not made."""
+
+    __slots__ = ("kind", "url")
+
+    def __init__(self, kind: str, url: str) -> None:
+        self.kind = kind
+        self.url = url
+
+
+def _builtin_hint(name: str) -> str | None:
+    import difflib
+
+    from ..script.builtins import catalog
+
+    close = difflib.get_close_matches(name, list(catalog()), n=1)
+    return f"did you mean '{close[0]}'?" if close else None
+
+
+def _list_method(rt: Any, node: Node, items: ListValue, method: str, bound: dict) -> Any:
+    if method == "append":
+        if len(items) >= items.capacity:
+            raise rt.error("index", f"append: the list is full (capacity {items.capacity})",
+                           node, "make a longer list with make_list(length, value, capacity)")
+        items.append(bound["value"])
+        return None
+    if method == "insert":
+        if len(items) >= items.capacity:
+            raise rt.error("index", f"insert: the list is full (capacity {items.capacity})",
+                           node)
+        items.insert(int(bound["index"]), bound["value"])
+        return None
+    if method == "pop":
+        if not items:
+            raise rt.error("index", "pop from an empty list", node)
+        return items.pop()
+    if method == "clear":
+        items.clear()
+        return None
+    if method == "length":
+        return len(items)
+    return items.capacity
+
+
+# ---- numbers ------------------------------------------------------------------------------
+
+
+def _number(rt: Any, node: Node, value: Any, what: str = "argument") -> float:
+    if is_number(value):
+        return value
+    raise rt.error("type", f"{what} must be a number, not a {type_name(value)}", node)
+
+
+def _math1(function: Callable[[float], float], name: str, domain=None):
+    def apply(rt, node, **kw):
+        value = _number(rt, node, next(iter(kw.values())))
+        if domain is not None and not domain(value):
+            raise rt.error("arithmetic", f"{name}({format_value(value)}) is undefined", node)
+        return function(value)
+
+    return apply
+
+
+for _name, _function, _domain in [
+    ("sin", math.sin, None), ("cos", math.cos, None), ("tan", math.tan, None),
+    ("asin", math.asin, lambda x: -1 <= x <= 1), ("acos", math.acos, lambda x: -1 <= x <= 1),
+    ("atan", math.atan, None), ("sqrt", math.sqrt, lambda x: x >= 0),
+    ("d2r", math.radians, None), ("r2d", math.degrees, None),
+]:
+    IMPLEMENTATIONS[_name] = _math1(_function, _name, _domain)
+
+
+@implements("floor")
+def _floor(rt, node, f):
+    return math.floor(_number(rt, node, f))
+
+
+@implements("ceil")
+def _ceil(rt, node, f):
+    return math.ceil(_number(rt, node, f))
+
+
+@implements("atan2")
+def _atan2(rt, node, x, y):
+    # UR names the numerator x: atan2(x, y) is the angle of x/y (builtins.tsv remarks).
+    return math.atan2(_number(rt, node, x), _number(rt, node, y))
+
+
+@implements("pow")
+def _pow(rt, node, base, exponent):
+    base, exponent = _number(rt, node, base), _number(rt, node, exponent)
+    try:
+        result = math.pow(base, exponent)
+    except (ValueError, OverflowError):
+        raise rt.error("arithmetic", f"pow({base}, {exponent}) is undefined", node) from None
+    return result
+
+
+@implements("log")
+def _log(rt, node, b, f):
+    b, f = _number(rt, node, b), _number(rt, node, f)
+    if b <= 0 or f <= 0 or b == 1:
+        raise rt.error("arithmetic", f"log({b}, {f}) is undefined", node)
+    return math.log(f, b)
+
+
+@implements("norm")
+def _norm(rt, node, a):
+    if is_number(a):
+        return abs(a)
+    if type(a) in (ListValue, PoseValue):
+        return math.sqrt(sum(_number(rt, node, v) ** 2 for v in a))
+    raise rt.error("type", f"norm() needs a number or a list, not a {type_name(a)}", node)
+
+
+@implements("normalize")
+def _normalize(rt, node, v):
+    length = _norm(rt, node, v)
+    if length == 0:
+        raise rt.error("arithmetic", "normalize() of a zero vector", node)
+    return ListValue([x / length for x in v])
+
+
+@implements("random")
+def _random(rt, node):
+    return random.random()
+
+
+@implements("to_num")
+def _to_num(rt, node, str):  # noqa: A002 - the catalog's parameter name
+    text = str.strip()
+    try:
+        return int(text, 0) if text.lower().startswith(("0x", "0b", "0o")) else int(text)
+    except ValueError:
+        try:
+            return float(text)
+        except ValueError:
+            raise rt.error("type", f"to_num({text!r}): not a number", node) from None
+
+
+# ---- strings ------------------------------------------------------------------------------
+
+_STRING_LIMIT = 1023  # str_cat/to_str results are limited to 1023 characters (URSCRIPT_LANGUAGE §2)
+
+
+def _limited(rt, node, text: str) -> str:
+    if len(text.encode("utf-8")) > _STRING_LIMIT:
+        raise rt.error("arithmetic", f"string longer than {_STRING_LIMIT} bytes", node)
+    return text
+
+
+@implements("to_str")
+def _to_str(rt, node, val):
+    return _limited(rt, node, format_value(val))
+
+
+@implements("str_cat")
+def _str_cat(rt, node, op1, op2):
+    return _limited(rt, node, format_value(op1) + format_value(op2))
+
+
+@implements("str_len")
+def _str_len(rt, node, str):  # noqa: A002
+    return len(str.encode("utf-8"))
+
+
+@implements("str_empty")
+def _str_empty(rt, node, str):  # noqa: A002
+    return len(str) == 0
+
+
+@implements("str_at")
+def _str_at(rt, node, src, index):
+    if not 0 <= index < len(src):
+        raise rt.error("index", f"str_at: index {index} is out of range", node)
+    return src[index]
+
+
+@implements("str_sub")
+def _str_sub(rt, node, src, index, len=None):  # noqa: A002
+    if not 0 <= index <= builtins_len(src):
+        raise rt.error("index", f"str_sub: index {index} is out of range", node)
+    return src[index:] if len is None else src[index:index + len]
+
+
+builtins_len = len
+
+
+@implements("str_find")
+def _str_find(rt, node, src, target, start_from=0):
+    return src.find(target, start_from)
+
+
+# ---- lists and matrices --------------------------------------------------------------------
+
+
+@implements("get_list_length", "length")
+def _length(rt, node, **kw):
+    value = next(iter(kw.values()))
+    if type(value) in (ListValue, str):
+        return len(value)
+    raise rt.error("type", f"length of a {type_name(value)}", node)
+
+
+@implements("size")
+def _size(rt, node, v):
+    if type(v) is ListValue and v and type(v[0]) is ListValue:
+        return ListValue([len(v), len(v[0])])
+    if type(v) in (ListValue, str, PoseValue):
+        return len(v)
+    raise rt.error("type", f"size of a {type_name(v)}", node)
+
+
+@implements("make_list")
+def _make_list(rt, node, length, initial_value, capacity=None):
+    capacity = length if capacity is None else capacity
+    if capacity < length:
+        raise rt.error("index", "make_list: capacity is smaller than length", node)
+    return ListValue([initial_value] * length, capacity)
+
+
+@implements("transpose")
+def _transpose(rt, node, m):
+    if type(m) is not ListValue:
+        raise rt.error("type", f"transpose of a {type_name(m)}", node)
+    if m and type(m[0]) is ListValue:
+        return ListValue([ListValue(list(column)) for column in zip(*m, strict=True)])
+    return ListValue([ListValue([v]) for v in m])
+
+
+@implements("binary_list_to_integer")
+def _binary_list_to_integer(rt, node, l):  # noqa: E741 - the catalog's parameter name
+    if len(l) > 32:
+        raise rt.error("index", "binary_list_to_integer takes at most 32 bools", node)
+    return sum(1 << i for i, bit in enumerate(l) if bit)
+
+
+@implements("integer_to_binary_list")
+def _integer_to_binary_list(rt, node, x):
+    return ListValue([bool((x >> i) & 1) for i in range(32)])
+
+
+@implements("struct")
+def _struct(rt, node, __members__):
+    return StructValue(__members__)
+
+
+# ---- messages, time --------------------------------------------------------------------------
+
+
+@implements("textmsg")
+def _textmsg(rt, node, s1, s2=""):
+    text = format_value(s1) + format_value(s2)
+    rt.env.messages.append((rt.time, "textmsg", text))
+    rt.event("textmsg", text, node.span)
+
+
+@implements("popup")
+def _popup(rt, node, s, title="Popup", warning=False, error=False, blocking=False):
+    text = format_value(s)
+    rt.env.messages.append((rt.time, "popup", text))
+    rt.event("popup", f"{title}: {text}", node.span)
+
+
+@implements("sleep")
+def _sleep(rt, node, t):
+    seconds = _number(rt, node, t, "sleep time")
+    if seconds < 0:
+        raise rt.error("arithmetic", "sleep() with a negative time", node)
+    if rt.robot is not None:
+        rt.robot.stop_blending(rt.time)
+    rt.wait(seconds)
+
+
+@implements("sync")
+def _sync(rt, node):
+    rt.sync()
+
+
+@implements("get_steptime")
+def _get_steptime(rt, node):
+    return rt.config.step_time
+
+
+# ---- I/O and registers ---------------------------------------------------------------------
+
+
+def _io_index(rt, node, n, size: int, what: str) -> int:
+    if type(n) is not int or not 0 <= n < size:
+        raise rt.error("index", f"{what} {n} does not exist (0..{size - 1})", node)
+    return n
+
+
+def _setter(attribute: str, what: str, convert=bool):
+    def apply(rt, node, n, b):
+        bank = getattr(rt.env, attribute)
+        bank[_io_index(rt, node, n, len(bank), what)] = convert(b)
+
+    return apply
+
+
+def _getter(attribute: str, what: str):
+    def apply(rt, node, n=None, address=None):
+        bank = getattr(rt.env, attribute)
+        index = n if address is None else address
+        return bank[_io_index(rt, node, index, len(bank), what)]
+
+    return apply
+
+
+for _names, _attribute, _what in [
+    (("set_standard_digital_out", "set_digital_out"), "standard_digital_out", "digital output"),
+    (("set_configurable_digital_out",), "configurable_digital_out", "configurable output"),
+    (("set_tool_digital_out",), "tool_digital_out", "tool output"),
+    (("set_flag",), "flags", "flag"),
+]:
+    for _n in _names:
+        IMPLEMENTATIONS[_n] = _setter(_attribute, _what)
+
+for _names, _attribute, _what in [
+    (("get_standard_digital_in", "get_digital_in"), "standard_digital_in", "digital input"),
+    (("get_standard_digital_out", "get_digital_out"), "standard_digital_out", "digital output"),
+    (("get_configurable_digital_in",), "configurable_digital_in", "configurable input"),
+    (("get_configurable_digital_out",), "configurable_digital_out", "configurable output"),
+    (("get_tool_digital_in",), "tool_digital_in", "tool input"),
+    (("get_tool_digital_out",), "tool_digital_out", "tool output"),
+    (("get_standard_analog_in", "get_analog_in"), "standard_analog_in", "analog input"),
+    (("get_tool_analog_in",), "tool_analog_in", "tool analog input"),
+    (("get_flag",), "flags", "flag"),
+    (("read_input_integer_register",), "input_int_registers", "register"),
+    (("read_output_integer_register",), "output_int_registers", "register"),
+    (("read_input_float_register",), "input_float_registers", "register"),
+    (("read_output_float_register",), "output_float_registers", "register"),
+    (("read_input_boolean_register",), "input_bool_registers", "register"),
+    (("read_output_boolean_register",), "output_bool_registers", "register"),
+]:
+    for _n in _names:
+        IMPLEMENTATIONS[_n] = _getter(_attribute, _what)
+
+
+def _register_writer(attribute: str, convert):
+    def apply(rt, node, address, value):
+        bank = getattr(rt.env, attribute)
+        bank[_io_index(rt, node, address, len(bank), "register")] = convert(value)
+
+    return apply
+
+
+IMPLEMENTATIONS["write_output_integer_register"] = _register_writer("output_int_registers", int)
+IMPLEMENTATIONS["write_output_float_register"] = _register_writer("output_float_registers",
+                                                                  float)
+IMPLEMENTATIONS["write_output_boolean_register"] = _register_writer("output_bool_registers",
+                                                                    bool)
+
+
+@implements("set_standard_analog_out", "set_analog_out")
+def _set_analog_out(rt, node, n, f):
+    rt.env.standard_analog_out[_io_index(rt, node, n, 2, "analog output")] = float(f)
+
+
+# ---- sockets (modelled; nothing leaves the machine) -----------------------------------------
+
+
+@implements("socket_open")
+def _socket_open(rt, node, address, port, socket_name="socket_0"):
+    from .environment import SocketModel
+
+    allowed = rt.env.connectable
+    ok = allowed is None or address in allowed or f"{address}:{port}" in allowed
+    model = SocketModel(address, int(port), connected=ok)
+    model.incoming.extend(rt.env.socket_replies.get(socket_name, []))
+    rt.env.sockets[socket_name] = model
+    rt.event("socket", f"socket_open({address}, {port}) -> {ok} (modelled)", node.span)
+    return ok
+
+
+def _socket(rt, node, name: str):
+    model = rt.env.sockets.get(name)
+    if model is None or not model.connected:
+        return None
+    return model
+
+
+@implements("socket_close")
+def _socket_close(rt, node, socket_name="socket_0"):
+    rt.env.sockets.pop(socket_name, None)
+
+
+@implements("socket_send_string", "socket_send_line", "socket_send_byte", "socket_send_int")
+def _socket_send(rt, node, **kw):
+    name = kw.get("socket_name", "socket_0")
+    model = _socket(rt, node, name)
+    if model is None:
+        return False
+    value = next(iter(v for k, v in kw.items() if k != "socket_name"))
+    model.sent.append(value)
+    return True
+
+
+@implements("socket_read_string", "socket_read_line")
+def _socket_read_string(rt, node, socket_name="socket_0", timeout=2, **_):
+    model = _socket(rt, node, socket_name)
+    if model is None or not model.incoming:
+        rt.wait(float(timeout))
+        return ""
+    return str(model.incoming.popleft())
+
+
+@implements("socket_read_ascii_float", "socket_read_binary_integer", "socket_read_byte_list")
+def _socket_read_numbers(rt, node, number, socket_name="socket_0", timeout=2, **_):
+    model = _socket(rt, node, socket_name)
+    if model is None or not model.incoming:
+        rt.wait(float(timeout))
+        return ListValue([0])  # the controller's "nothing read" answer: [0]
+    values = model.incoming.popleft()
+    return ListValue([len(values), *values])
+
+
+@implements("socket_get_var")
+def _socket_get_var(rt, node, name, socket_name="socket_0"):
+    return 0
+
+
+@implements("socket_set_var")
+def _socket_set_var(rt, node, name, value, socket_name="socket_0"):
+    return None
+
+
+@implements("rpc_factory")
+def _rpc_factory(rt, node, type, url):  # noqa: A002
+    rt.event("rpc", f"rpc_factory({type!r}, {url!r}): calls are recorded, not made", node.span)
+    return _RemoteHandle(str(type), str(url))

@@ -1,0 +1,897 @@
+"""The URScript interpreter: runs a syntax tree against a robot, in robot time.
+
+The tree is compiled once into Python closures (one per node), which then run fast without
+walking the tree again. Each URScript thread runs in a greenlet; a builtin that uses physical
+time (a move, ``sleep``, ``sync``) switches back to the scheduler with the robot time at which
+the thread wants to go on. The scheduler always resumes the thread that is due first (round
+robin among equals), so robot time jumps from event to event instead of ticking every
+controller frame: checking a long program takes a fraction of the time the robot needs.
+
+Scoping follows the controller (../shared/reference/URSCRIPT_LANGUAGE.md §4): variables at
+the first level of the program are global, even when written ``local``; inside functions
+and threads a free name is the global if one exists, else a local; ``local`` forces a new
+local and ``global`` a global. Arguments and assignments copy values.
+
+The interpreter never evaluates Python, opens files or reaches the network: everything a
+script does to the outside world goes through the :class:`~urdsl.runtime.environment.Environment`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import greenlet
+
+from ..script import nodes as n
+from ..script.nodes import NO_SPAN, Span
+from .errors import ScriptRuntimeError
+from .values import (
+    ListValue,
+    PoseValue,
+    StructValue,
+    ThreadHandle,
+    copy_value,
+    is_number,
+    type_name,
+)
+
+__all__ = ["Interpreter", "RuntimeConfig", "RunResult", "Event"]
+
+BREAK, CONTINUE, RETURN = 1, 2, 3
+
+
+@dataclass(frozen=True)
+class RuntimeConfig:
+    """How the interpreter behaves.
+
+    ``step_time``: controller frame in s (0.002 e-Series, 0.008 CB3).
+    ``runaway_limit``: loop turns a thread may make without using physical time before the
+    program is stopped as the controller would ("Runtime is too much behind").
+    ``max_time``: robot time in s after which a program that runs on (a ``while True`` cell
+    program) is stopped; the result says so.
+    ``max_call_depth``: nested user function calls before the program is stopped.
+    """
+
+    step_time: float = 0.002
+    runaway_limit: int = 200_000
+    max_time: float = 3600.0
+    max_call_depth: int = 200
+
+
+@dataclass(frozen=True)
+class Event:
+    """Something a program did that a user may want to see: ``textmsg``, ``popup``, a thread
+    left running, a builtin modelled as a no-op. ``time`` is robot time in s."""
+
+    time: float
+    kind: str
+    message: str
+    span: Span = NO_SPAN
+
+
+@dataclass
+class RunResult:
+    """The outcome of running a program: final robot time (s), events, and the error that
+    stopped it (None when it ended normally)."""
+
+    time: float
+    events: list[Event] = field(default_factory=list)
+    error: ScriptRuntimeError | None = None
+    stopped_at_max_time: bool = False
+    threads_left_running: list[str] = field(default_factory=list)
+    globals: dict[str, Any] = field(default_factory=dict)
+
+
+class Frame:
+    """The variables of one function call (or the program's first level, ``top``)."""
+
+    __slots__ = ("vars", "local_names", "global_names", "top", "retval")
+
+    def __init__(self, variables: dict, top: bool) -> None:
+        self.vars = variables
+        self.local_names: set[str] = set()
+        self.global_names: set[str] = set()
+        self.top = top
+        self.retval: Any = None
+
+
+class Thread:
+    """A running URScript thread (the main program is one too)."""
+
+    __slots__ = ("name", "glet", "wake", "order", "done", "parent", "children", "joiners",
+                 "span", "handle")
+
+    def __init__(self, name: str, parent: Thread | None, span: Span) -> None:
+        self.name = name
+        self.glet: greenlet.greenlet | None = None
+        self.wake = 0.0
+        self.order = 0
+        self.done = False
+        self.parent = parent
+        self.children: list[Thread] = []
+        self.joiners: list[Thread] = []
+        self.span = span
+        self.handle = ThreadHandle(self)
+
+
+class _Function:
+    __slots__ = ("name", "params", "body", "node", "defaults")
+
+    def __init__(self, node: n.FunctionDef, body: Callable, defaults: list) -> None:
+        self.name = node.name
+        self.params = [p.name for p in node.params]
+        self.defaults = defaults
+        self.body = body
+        self.node = node
+
+
+class Interpreter:
+    """Runs one program (a :class:`~urdsl.script.nodes.Module`).
+
+    ``robot`` provides motion and robot state, ``environment`` everything else a script
+    touches (I/O, registers, sockets, messages); see :mod:`urdsl.runtime.environment`.
+    """
+
+    def __init__(self, module: n.Module, robot: Any = None, environment: Any = None,
+                 config: RuntimeConfig | None = None) -> None:
+        from .builtins import BuiltinTable
+        from .environment import Environment
+
+        self.module = module
+        self.config = config or RuntimeConfig()
+        self.robot = robot
+        self.env = environment or Environment()
+        self.globals: dict[str, Any] = {}
+        self.functions: dict[str, _Function] = {}
+        self.threads_defs: dict[str, Callable] = {}
+        self.events: list[Event] = []
+        self.time = 0.0
+        self.steps = 0
+        self.depth = 0
+        self.current: Thread | None = None
+        self.critical: Thread | None = None
+        self.halted = False
+        self._threads: list[Thread] = []
+        self._order = 0
+        self._scheduler: greenlet.greenlet | None = None
+        self.builtins = BuiltinTable(self)
+        self._compiler = _Compiler(self)
+        self.entry = self._compiler.program(module)
+
+    # ---- running ---------------------------------------------------------------------------
+
+    def run(self) -> RunResult:
+        """Run the program to its end (or its first runtime error, or ``max_time``)."""
+        result = RunResult(0.0)
+        self._scheduler = greenlet.getcurrent()
+        main = self._spawn("main", self.entry, None, self.module.span)
+        try:
+            self._schedule(main, result)
+        except ScriptRuntimeError as error:
+            error.time = self.time
+            result.error = error
+        finally:
+            for thread in self._threads:
+                if thread.glet is not None and not thread.glet.dead:
+                    thread.glet.throw(greenlet.GreenletExit)
+        if self.robot is not None:
+            self.robot.finish(self.time)
+            self.time = max(self.time, getattr(self.robot, "end_time", self.time))
+        result.time = self.time
+        result.events = self.events
+        result.globals = self.globals
+        return result
+
+    def _schedule(self, main: Thread, result: RunResult) -> None:
+        threads = self._threads
+        while not main.done and not self.halted:
+            if self.critical is not None and not self.critical.done:
+                thread = self.critical
+            else:
+                thread = min((t for t in threads if not t.done),
+                             key=lambda t: (t.wake, t.order))
+            if thread.wake == math.inf:
+                raise ScriptRuntimeError(
+                    "call", "every thread waits for another one: the program can never go on",
+                    thread.span)
+            if thread.wake > self.config.max_time:
+                result.stopped_at_max_time = True
+                self.time = self.config.max_time
+                break
+            self.time = max(self.time, thread.wake)
+            self.current = thread
+            self.steps = 0
+            thread.glet.switch()
+        left = [t.name for t in threads if not t.done and t is not main]
+        for thread in threads:
+            thread.done = True
+        result.threads_left_running = left
+        for name in left:
+            self.event("thread", f"the program ended while thread {name} was still running")
+
+    def _spawn(self, name: str, body: Callable, parent: Thread | None, span: Span) -> Thread:
+        thread = Thread(name, parent, span)
+        thread.wake = self.time
+        self._order += 1
+        thread.order = self._order
+
+        def run() -> None:
+            try:
+                body()
+            except _Halt:
+                self.halted = True
+            finally:
+                self._finish(thread)
+
+        thread.glet = greenlet.greenlet(run, parent=self._scheduler)
+        if parent is not None:
+            parent.children.append(thread)
+        self._threads.append(thread)
+        return thread
+
+    def _finish(self, thread: Thread) -> None:
+        thread.done = True
+        if self.critical is thread:
+            self.critical = None
+        for joiner in thread.joiners:
+            joiner.wake = self.time
+        for child in thread.children:
+            self._kill(child)
+
+    def _kill(self, thread: Thread) -> None:
+        if thread.done:
+            return
+        thread.done = True
+        for joiner in thread.joiners:
+            joiner.wake = self.time
+        for child in thread.children:
+            self._kill(child)
+
+    # ---- what builtins and statements call -------------------------------------------------
+
+    def wait_until(self, when: float) -> None:
+        """Block the current thread until robot time ``when`` (s)."""
+        thread = self.current
+        thread.wake = max(when, self.time)
+        self._order += 1
+        thread.order = self._order
+        self._scheduler.switch()
+        if thread.done:  # killed while waiting
+            raise greenlet.GreenletExit
+
+    def wait(self, seconds: float) -> None:
+        """Block the current thread for ``seconds`` of robot time."""
+        self.wait_until(self.time + max(seconds, 0.0))
+
+    def sync(self) -> None:
+        """Give up the rest of the current controller frame."""
+        step = self.config.step_time
+        frames = math.floor(self.time / step + 1e-9) + 1
+        self.wait_until(frames * step)
+
+    def event(self, kind: str, message: str, span: Span = NO_SPAN) -> None:
+        self.events.append(Event(self.time, kind, message, span))
+
+    def error(self, kind: str, message: str, node: Any = None, hint: str | None = None):
+        span = node.span if node is not None and hasattr(node, "span") else NO_SPAN
+        return ScriptRuntimeError(kind, message, span, hint, self.time)
+
+    def start_thread(self, name: str, node: n.Node) -> ThreadHandle:
+        body = self.threads_defs.get(name)
+        if body is None:
+            raise self.error("undefined", f"thread '{name}' is not defined", node)
+        thread = self._spawn(name, body, self.current, node.span)
+        return thread.handle
+
+    def join(self, handle: Any, node: n.Node) -> None:
+        if type(handle) is not ThreadHandle:
+            raise self.error("type", f"join needs a thread handle, not a {type_name(handle)}",
+                             node)
+        target = handle.thread
+        if target is self.current:
+            raise self.error("call", "a thread cannot join itself", node)
+        if not target.done:
+            target.joiners.append(self.current)
+            self.wait_until(math.inf)
+
+    def kill(self, handle: Any, node: n.Node) -> None:
+        if type(handle) is not ThreadHandle:
+            raise self.error("type", f"kill needs a thread handle, not a {type_name(handle)}",
+                             node)
+        target = handle.thread
+        self._kill(target)
+        if target is self.current:
+            raise greenlet.GreenletExit
+
+    def count_step(self, node: n.Node) -> None:
+        """Called on every loop turn: stop a loop that never uses physical time."""
+        self.steps += 1
+        if self.steps > self.config.runaway_limit:
+            raise self.error(
+                "runaway",
+                f"thread {self.current.name} looped {self.config.runaway_limit:,} times "
+                "without using physical time: the controller stops the program "
+                "(\"Runtime is too much behind\")",
+                node, "call sync() in a loop that only waits or computes")
+
+
+# ---- the compiler --------------------------------------------------------------------------
+
+
+def _truth(value: Any, rt: Interpreter, node: n.Node) -> bool:
+    kind = type(value)
+    if kind is bool:
+        return value
+    if kind is int or kind is float:
+        return value != 0
+    raise rt.error("type", f"a condition must be a bool, not a {type_name(value)}", node)
+
+
+def _index(value: Any) -> int:
+    kind = type(value)
+    if kind is int:
+        return value
+    if kind is float and value.is_integer():
+        return int(value)
+    raise TypeError(type_name(value))
+
+
+class _Compiler:
+    """Turns tree nodes into closures bound to one :class:`Interpreter`."""
+
+    def __init__(self, rt: Interpreter) -> None:
+        self.rt = rt
+
+    # -- program -----------------------------------------------------------------------------
+
+    def program(self, module: n.Module) -> Callable[[], None]:
+        """The program's entry: a single top-level ``def`` (with nothing else but
+        definitions, comments and labels) is run; otherwise the top-level statements are."""
+        rt = self.rt
+        defs = [s for s in module.body if isinstance(s, n.FunctionDef)]
+        statements = [s for s in module.body if isinstance(s, n.Stmt)
+                      and not isinstance(s, (n.FunctionDef, n.ThreadDef, n.SecDef))]
+        self.collect(module.body)
+        if not statements and len(defs) == 1 and not defs[0].params:
+            body = self.block(defs[0].body)
+        elif not statements and not defs:
+            secs = [s for s in module.body if isinstance(s, n.SecDef)]
+            body = self.block(secs[0].body) if secs else self.block(())
+        else:
+            body = self.block(module.body)
+
+        def entry() -> None:
+            frame = Frame(rt.globals, top=True)
+            body(frame)
+
+        return entry
+
+    def collect(self, items) -> None:
+        """Register every function and thread definition (nested ones too: all are global)."""
+        for item in items:
+            if isinstance(item, n.FunctionDef):
+                defaults = [None if p.default is None else self.expr(p.default)
+                            for p in item.params]
+                function = _Function(item, None, defaults)
+                self.rt.functions[item.name] = function
+                self.collect(item.body)
+                function.body = self.block(item.body)
+            elif isinstance(item, n.ThreadDef):
+                self.collect(item.body)
+                self.rt.threads_defs[item.name] = self.thread_body(item)
+            elif isinstance(item, (n.If, n.While)):
+                self.collect(item.body)
+                if isinstance(item, n.If):
+                    for branch in item.elifs:
+                        self.collect(branch.body)
+                    if item.orelse:
+                        self.collect(item.orelse)
+
+    def thread_body(self, node: n.ThreadDef) -> Callable[[], None]:
+        body = self.block(node.body)
+        rt = self.rt
+
+        def run() -> None:
+            body(Frame({}, top=False))
+
+        run.__name__ = node.name
+        del rt  # threads take no arguments; nothing else to bind
+        return run
+
+    # -- statements --------------------------------------------------------------------------
+
+    def block(self, items) -> Callable[[Frame], int | None]:
+        statements = [self.statement(item) for item in items
+                      if isinstance(item, n.Stmt)
+                      and not isinstance(item, (n.FunctionDef, n.ThreadDef, n.SecDef))]
+        if not statements:
+            return lambda frame: None
+        if len(statements) == 1:
+            return statements[0]
+
+        def run(frame: Frame) -> int | None:
+            for statement in statements:
+                signal = statement(frame)
+                if signal:
+                    return signal
+            return None
+
+        return run
+
+    def statement(self, node: n.Stmt) -> Callable[[Frame], int | None]:
+        method = getattr(self, "s_" + type(node).__name__)
+        return method(node)
+
+    def s_ExprStmt(self, node: n.ExprStmt):
+        evaluate = self.expr(node.expr)
+
+        def run(frame):
+            evaluate(frame)
+
+        return run
+
+    def s_Assign(self, node: n.Assign):
+        store = self.target(node.target)
+        value = self.expr(node.value)
+
+        def run(frame):
+            store(frame, copy_value(value(frame)))
+
+        return run
+
+    def s_Declare(self, node: n.Declare):
+        rt = self.rt
+        name = node.name
+        value = self.expr(node.value) if node.value is not None else None
+        if node.scope == "global":
+            def run(frame):
+                frame.global_names.add(name)
+                frame.local_names.discard(name)
+                if value is not None:
+                    rt.globals[name] = copy_value(value(frame))
+            return run
+
+        def run_local(frame):
+            if frame.top:  # the program's first level: global even when written local
+                if value is not None:
+                    rt.globals[name] = copy_value(value(frame))
+                return
+            frame.local_names.add(name)
+            frame.global_names.discard(name)
+            if value is not None:
+                frame.vars[name] = copy_value(value(frame))
+            else:
+                frame.vars.pop(name, None)
+
+        return run_local
+
+    def s_Return(self, node: n.Return):
+        value = self.expr(node.value) if node.value is not None else None
+
+        def run(frame):
+            frame.retval = None if value is None else value(frame)
+            return RETURN
+
+        return run
+
+    def s_Halt(self, node):
+        def run(frame):
+            raise _Halt
+
+        return run
+
+    def s_Break(self, node):
+        return lambda frame: BREAK
+
+    def s_Continue(self, node):
+        return lambda frame: CONTINUE
+
+    def s_EnterCritical(self, node):
+        rt = self.rt
+
+        def run(frame):
+            rt.critical = rt.current
+
+        return run
+
+    def s_ExitCritical(self, node):
+        rt = self.rt
+
+        def run(frame):
+            if rt.critical is rt.current:
+                rt.critical = None
+
+        return run
+
+    def s_Join(self, node: n.Join):
+        rt = self.rt
+        handle = self.expr(node.thread)
+        return lambda frame: rt.join(handle(frame), node)
+
+    def s_Kill(self, node: n.Kill):
+        rt = self.rt
+        handle = self.expr(node.thread)
+        return lambda frame: rt.kill(handle(frame), node)
+
+    def s_If(self, node: n.If):
+        rt = self.rt
+        branches = [(self.expr(node.test), self.block(node.body), node.test)]
+        branches += [(self.expr(b.test), self.block(b.body), b.test) for b in node.elifs]
+        orelse = self.block(node.orelse) if node.orelse is not None else None
+
+        def run(frame):
+            for test, body, test_node in branches:
+                if _truth(test(frame), rt, test_node):
+                    return body(frame)
+            if orelse is not None:
+                return orelse(frame)
+            return None
+
+        return run
+
+    def s_While(self, node: n.While):
+        rt = self.rt
+        test = self.expr(node.test)
+        body = self.block(node.body)
+        test_node = node.test
+
+        def run(frame):
+            while _truth(test(frame), rt, test_node):
+                signal = body(frame)
+                if signal == BREAK:
+                    break
+                if signal == RETURN:
+                    return RETURN
+                rt.steps += 1
+                if rt.steps > rt.config.runaway_limit:
+                    rt.count_step(node)
+            return None
+
+        return run
+
+    def s_FunctionDef(self, node):  # definitions are collected beforehand
+        return lambda frame: None
+
+    s_ThreadDef = s_SecDef = s_FunctionDef
+
+    # -- assignment targets ------------------------------------------------------------------
+
+    def target(self, node: n.Expr) -> Callable[[Frame, Any], None]:
+        rt = self.rt
+        if isinstance(node, n.Name):
+            name = node.id
+
+            def store(frame, value):
+                if frame.top or name in frame.global_names:
+                    rt.globals[name] = value
+                elif name in frame.local_names:
+                    frame.vars[name] = value
+                elif name in rt.globals:
+                    rt.globals[name] = value
+                else:
+                    frame.local_names.add(name)
+                    frame.vars[name] = value
+
+            return store
+        if isinstance(node, n.Index):
+            container = self.expr(node.value)
+            store_container = self.target(node.value)
+            indices = [self.expr(i) for i in node.indices]
+
+            def store_item(frame, value):
+                target = container(frame)
+                keys = [idx(frame) for idx in indices]
+                kind = type(target)
+                try:
+                    positions = [_index(k) for k in keys]
+                except TypeError as error:
+                    raise rt.error("type", f"an index must be an int, not a {error}", node) \
+                        from None
+                try:
+                    if kind is ListValue:
+                        if len(positions) == 2:
+                            target[positions[0]][positions[1]] = value
+                        else:
+                            _check_bounds(positions[0], len(target), rt, node)
+                            target[positions[0]] = value
+                    elif kind is PoseValue:
+                        _check_bounds(positions[0], 6, rt, node)
+                        if not is_number(value):
+                            raise rt.error("type", f"a pose holds numbers, not a "
+                                           f"{type_name(value)}", node)
+                        store_container(frame, target.replace(positions[0], value))
+                    elif kind is StructValue:
+                        member = list(target.members)[positions[0]]
+                        target.members[member] = value
+                    else:
+                        raise rt.error("type", f"cannot assign to an element of a "
+                                       f"{type_name(target)}", node)
+                except IndexError:
+                    raise rt.error("index", f"index {keys} is out of range", node) from None
+
+            return store_item
+        if isinstance(node, n.Attribute):
+            container = self.expr(node.value)
+            attr = node.attr
+
+            def store_field(frame, value):
+                target = container(frame)
+                if type(target) is not StructValue:
+                    raise rt.error("type", f"a {type_name(target)} has no field '{attr}'", node)
+                if attr not in target.members:
+                    raise rt.error("undefined", f"the struct has no member '{attr}'", node,
+                                   "a struct's members are fixed when it is made")
+                target.members[attr] = value
+
+            return store_field
+        raise rt.error("type", "cannot assign to this expression", node)
+
+    # -- expressions -------------------------------------------------------------------------
+
+    def expr(self, node: n.Expr) -> Callable[[Frame], Any]:
+        return getattr(self, "e_" + type(node).__name__)(node)
+
+    def e_Number(self, node):
+        value = node.value
+        return lambda frame: value
+
+    e_String = e_Bool = e_Number
+
+    def e_NoneLit(self, node):
+        return lambda frame: None
+
+    def e_Paren(self, node):
+        return self.expr(node.expr)
+
+    def e_Name(self, node: n.Name):
+        rt = self.rt
+        name = node.id
+        globals_ = rt.globals
+
+        def read(frame):
+            if name in frame.local_names:
+                try:
+                    return frame.vars[name]
+                except KeyError:
+                    pass
+            elif name in globals_:
+                return globals_[name]
+            raise rt.error("undefined", f"name '{name}' is not defined", node,
+                           _name_hint(name, frame, rt))
+
+        return read
+
+    def e_List(self, node: n.List):
+        items = [self.expr(i) for i in node.items]
+        return lambda frame: ListValue([copy_value(item(frame)) for item in items])
+
+    def e_Pose(self, node: n.Pose):
+        rt = self.rt
+        items = [self.expr(i) for i in node.items]
+
+        def make(frame):
+            values = [item(frame) for item in items]
+            for value, item in zip(values, node.items, strict=True):
+                if not is_number(value):
+                    raise rt.error("type", f"a pose holds numbers, not a {type_name(value)}",
+                                   item)
+            return PoseValue(values)
+
+        return make
+
+    def e_UnaryOp(self, node: n.UnaryOp):
+        rt = self.rt
+        operand = self.expr(node.operand)
+        if node.op in ("not", "!"):
+            def negate(frame):
+                value = operand(frame)
+                if type(value) is not bool:
+                    raise rt.error("type", f"'{node.op}' needs a bool, not a "
+                                   f"{type_name(value)}", node)
+                return not value
+            return negate
+        sign = -1 if node.op == "-" else 1
+
+        def minus(frame):
+            value = operand(frame)
+            kind = type(value)
+            if kind is int or kind is float:
+                return sign * value
+            if kind is ListValue and all(is_number(v) for v in value):
+                return ListValue([sign * v for v in value])
+            raise rt.error("type", f"unary '{node.op}' needs a number, not a "
+                           f"{type_name(value)}", node)
+
+        return minus
+
+    def e_BinOp(self, node: n.BinOp):
+        from .operators import binary
+
+        rt = self.rt
+        left = self.expr(node.left)
+        right = self.expr(node.right)
+        op = node.op
+        if op == "and":
+            def conj(frame):
+                if not _bool_operand(left(frame), rt, node):
+                    return False
+                return _bool_operand(right(frame), rt, node)
+            return conj
+        if op == "or":
+            def disj(frame):
+                if _bool_operand(left(frame), rt, node):
+                    return True
+                return _bool_operand(right(frame), rt, node)
+            return disj
+        operation = binary(op)
+
+        def apply(frame):
+            a = left(frame)
+            b = right(frame)
+            try:
+                return operation(a, b)
+            except ZeroDivisionError:
+                raise rt.error("arithmetic", "division by zero", node) from None
+            except (TypeError, ValueError) as error:
+                raise rt.error("type", f"'{op}' cannot combine a {type_name(a)} and a "
+                               f"{type_name(b)}" + (f": {error}" if str(error) else ""),
+                               node, _operator_hint(op, a, b)) from None
+
+        return apply
+
+    def e_Index(self, node: n.Index):
+        rt = self.rt
+        container = self.expr(node.value)
+        indices = [self.expr(i) for i in node.indices]
+
+        def get(frame):
+            target = container(frame)
+            keys = [idx(frame) for idx in indices]
+            try:
+                positions = [_index(k) for k in keys]
+            except TypeError as error:
+                raise rt.error("type", f"an index must be an int, not a {error}", node) \
+                    from None
+            kind = type(target)
+            if kind is ListValue or kind is PoseValue:
+                size = len(target)
+                first = positions[0]
+                _check_bounds(first, size, rt, node)
+                item = target[first]
+                if len(positions) == 2:
+                    if type(item) is not ListValue:
+                        raise rt.error("type", "m[i, j] needs a matrix", node)
+                    _check_bounds(positions[1], len(item), rt, node)
+                    return item[positions[1]]
+                return item
+            if kind is StructValue:
+                values = list(target.members.values())
+                _check_bounds(positions[0], len(values), rt, node)
+                return values[positions[0]]
+            raise rt.error("type", f"a {type_name(target)} cannot be indexed", node)
+
+        return get
+
+    def e_Attribute(self, node: n.Attribute):
+        rt = self.rt
+        container = self.expr(node.value)
+        attr = node.attr
+
+        def get(frame):
+            target = container(frame)
+            if type(target) is StructValue:
+                try:
+                    return target.members[attr]
+                except KeyError:
+                    raise rt.error("undefined", f"the struct has no member '{attr}'",
+                                   node) from None
+            raise rt.error("type", f"a {type_name(target)} has no field '{attr}'", node)
+
+        return get
+
+    def e_Run(self, node: n.Run):
+        rt = self.rt
+        name = node.thread
+        return lambda frame: rt.start_thread(name, node)
+
+    def e_Call(self, node: n.Call):
+        rt = self.rt
+        args = [self.expr(a) for a in node.args]
+        keywords = [(k.name, self.expr(k.value)) for k in node.keywords]
+        if isinstance(node.func, n.Attribute):
+            receiver = self.expr(node.func.value)
+            method = node.func.attr
+
+            def call_method(frame):
+                return rt.builtins.call_method(
+                    receiver(frame), method, [a(frame) for a in args],
+                    {k: v(frame) for k, v in keywords}, node)
+
+            return call_method
+        if not isinstance(node.func, n.Name):
+            raise rt.error("call", "only functions can be called", node)
+        name = node.func.id
+
+        def call(frame):
+            values = [a(frame) for a in args]
+            named = {k: v(frame) for k, v in keywords} if keywords else {}
+            function = rt.functions.get(name)
+            if function is not None:
+                return self.call_user(function, values, named, node)
+            return rt.builtins.call(name, values, named, node)
+
+        return call
+
+    def call_user(self, function: _Function, args: list, named: dict, node: n.Call) -> Any:
+        rt = self.rt
+        params = function.params
+        if len(args) > len(params):
+            raise rt.error("arguments", f"{function.name}() takes {len(params)} arguments, "
+                           f"{len(args)} given", node)
+        frame = Frame({}, top=False)
+        bound = frame.vars
+        for name, value in zip(params, args, strict=False):
+            bound[name] = copy_value(value)
+        for name, value in named.items():
+            if name not in params:
+                raise rt.error("arguments", f"{function.name}() has no parameter '{name}'",
+                               node)
+            if name in bound:
+                raise rt.error("arguments", f"{function.name}() got '{name}' twice", node)
+            bound[name] = copy_value(value)
+        for name, default in zip(params, function.defaults, strict=True):
+            if name not in bound:
+                if default is None:
+                    raise rt.error("arguments", f"{function.name}() needs argument '{name}'",
+                                   node)
+                bound[name] = copy_value(default(frame))
+        frame.local_names.update(params)
+        rt.depth += 1
+        if rt.depth > rt.config.max_call_depth:
+            rt.depth = 0
+            raise rt.error("call", f"calls nested deeper than {rt.config.max_call_depth}",
+                           node, "is the recursion meant to end?")
+        try:
+            function.body(frame)
+        finally:
+            rt.depth -= 1
+        return frame.retval
+
+
+class _Halt(Exception):
+    """``halt``: the program ends here."""
+
+
+def _check_bounds(position: int, size: int, rt: Interpreter, node: n.Node) -> None:
+    if not 0 <= position < size:
+        raise rt.error("index", f"index {position} is out of range (size {size})", node,
+                       "indices count from 0")
+
+
+def _bool_operand(value: Any, rt: Interpreter, node: n.BinOp) -> bool:
+    if type(value) is bool:
+        return value
+    raise rt.error("type", f"'{node.op}' needs bools, not a {type_name(value)}", node)
+
+
+def _operator_hint(op: str, a: Any, b: Any) -> str | None:
+    if op == "+" and (type(a) is str or type(b) is str):
+        return "join strings with str_cat(a, b); to_str(x) turns a value into a string"
+    if type(a) is PoseValue or type(b) is PoseValue:
+        return "combine poses with pose_add, pose_sub or pose_trans"
+    return None
+
+
+def _name_hint(name: str, frame: Frame, rt: Interpreter) -> str | None:
+    import difflib
+
+    known = list(rt.globals) + list(frame.local_names) + list(rt.functions)
+    close = difflib.get_close_matches(name, known, n=1)
+    if close:
+        return f"did you mean '{close[0]}'?"
+    if frame.top:
+        return None
+    return "inside a function or thread, assign it first or declare it global at the top"
