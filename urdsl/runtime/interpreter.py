@@ -238,8 +238,9 @@ class Interpreter:
             self.critical = None
         for joiner in thread.joiners:
             joiner.wake = self.time
-        for child in thread.children:
-            self._kill(child)
+        if thread.parent is not None:  # the main thread's end is the scheduler's business
+            for child in thread.children:
+                self._kill(child)
 
     def _kill(self, thread: Thread) -> None:
         if thread.done:

@@ -1,0 +1,208 @@
+"""The interpreter runs URScript with the controller's rules and stops where it would."""
+
+from __future__ import annotations
+
+import pytest
+
+from urdsl import parse
+from urdsl.runtime import Environment, Interpreter, RuntimeConfig
+from urdsl.runtime.values import ListValue, PoseValue, StructValue
+
+
+def run(text: str, **config):
+    interpreter = Interpreter(parse(text, "prog.script"), config=RuntimeConfig(**config))
+    return interpreter.run()
+
+
+def value(text: str, name: str = "x"):
+    result = run(text)
+    assert result.error is None, result.error
+    return result.globals[name]
+
+
+def error(text: str, **config):
+    result = run(text, **config)
+    assert result.error is not None, "the program should have failed"
+    return result.error
+
+
+# ---- values and operators ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("expression", "expected"), [
+    ("1 + 2 * 3", 7), ("7 / 2", 3.5), ("7 % 3", 1), ("2.5 - 1", 1.5), ("-3 + 1", -2),
+    ("1 < 2 and 2 <= 2", True), ("not 1 == 2", True), ("True xor True", False),
+    ("\"ab\" + \"cd\"", "abcd"), ("[1, 2] + [3, 4]", ListValue([4, 6])),
+    ("[1, 2] * 2", ListValue([2, 4])), ("[[1, 2], [3, 4]] * [1, 1]", ListValue([3, 7])),
+    ("str_cat(\"n=\", 3)", "n=3"), ("to_str(1.5)", "1.5"), ("sqrt(16)", 4.0),
+    ("pow(2, 10)", 1024.0), ("floor(2.7)", 2), ("norm([3, 4])", 5.0),
+    ("length([1, 2, 3])", 3), ("str_len(\"abc\")", 3), ("to_num(\"42\")", 42),
+    ("binary_list_to_integer([True, False, True])", 5), ("d2r(180)", 3.141592653589793),
+])
+def test_expressions(expression, expected):
+    assert value(f"x = {expression}") == expected
+
+
+def test_poses_lists_structs_matrices():
+    assert value("x = p[1, 2, 3, 0, 0, 0]\nx[2] = 9") == PoseValue([1, 2, 9, 0, 0, 0])
+    assert value("x = [[1, 2], [3, 4]]\nx[1, 0] = 7\n") == ListValue([ListValue([1, 2]),
+                                                                     ListValue([7, 4])])
+    assert value("m = [[1, 2], [3, 4]]\nx = m[1, 1]") == 4
+    s = value("x = struct(a=1, b=\"t\")\nx.a = 5\n")
+    assert s == StructValue({"a": 5, "b": "t"})
+    assert value("s = struct(a=1, b=2)\nx = s[1] + s.a") == 3
+    assert value("x = make_list(2, 0, 5)\nx.append(7)\nx.append(8)\n") == ListValue([0, 0, 7, 8])
+
+
+# ---- scoping and calls ---------------------------------------------------------------------
+
+
+def test_first_level_is_global_even_when_local():
+    result = run("def prog():\n  local a = 1\n  b = 2\n  def f():\n    return a + b\n  end\n"
+                 "  c = f()\nend\n")
+    assert result.error is None
+    assert result.globals == {"a": 1, "b": 2, "c": 3}
+
+
+def test_function_locals_shadow_and_globals_assign():
+    src = ("g = 1\n"
+           "def f():\n  g = 5\n  local g2 = 7\n  h = 3\n  return h\nend\n"
+           "def k():\n  local g = 100\n  return g\nend\n"
+           "r = f()\nr2 = k()\n")
+    result = run(src)
+    assert result.error is None
+    assert result.globals["g"] == 5  # unqualified: the global exists, so it is assigned
+    assert result.globals["r"] == 3 and result.globals["r2"] == 100
+    assert "h" not in result.globals and "g2" not in result.globals
+
+
+def test_pass_by_value():
+    src = ("def change(l):\n  l[0] = 99\n  return l\nend\n"
+           "a = [1, 2]\nb = change(a)\nc = a\nc[1] = 5\n")
+    result = run(src)
+    assert result.globals["a"] == ListValue([1, 2])
+    assert result.globals["b"] == ListValue([99, 2]) and result.globals["c"] == ListValue([1, 5])
+
+
+def test_defaults_and_keywords():
+    assert value("def f(a, b=10, c=100):\n  return a + b + c\nend\nx = f(1, c=2)") == 13
+
+
+def test_halt_return_break_continue():
+    src = ("x = 0\ni = 0\nwhile True:\n  i = i + 1\n  if i > 5:\n    break\n  elif i == 2:\n"
+           "    continue\n  end\n  x = x + i\nend\nhalt\nx = -1\n")
+    assert value(src) == 1 + 3 + 4 + 5
+
+
+# ---- threads and time ----------------------------------------------------------------------
+
+
+def test_threads_run_round_robin_in_robot_time():
+    src = ("global n = 0\nthread counter():\n  while True:\n    n = n + 1\n    sync()\n  end\n"
+           "end\nh = run counter()\nsleep(0.1)\nkill h\n")
+    result = run(src)
+    assert result.error is None
+    assert result.time == pytest.approx(0.1)
+    assert result.globals["n"] == 50  # one turn per 2 ms frame
+
+
+def test_cb3_frames_are_8_ms():
+    src = ("global n = 0\nthread counter():\n  while True:\n    n = n + 1\n    sync()\n  end\n"
+           "end\nh = run counter()\nsleep(0.08)\nkill h\n")
+    assert run(src, step_time=0.008).globals["n"] == 10
+
+
+def test_join_waits_for_the_thread():
+    src = ("global done = 0\nthread worker():\n  sleep(0.5)\n  done = 1\nend\n"
+           "h = run worker()\njoin h\nt = done\n")
+    result = run(src)
+    assert result.globals["t"] == 1 and result.time == pytest.approx(0.5)
+
+
+def test_program_end_with_threads_running_is_reported():
+    result = run("thread t():\n  while True:\n    sync()\n  end\nend\nrun t()\nsleep(0.01)\n")
+    assert result.error is None and result.threads_left_running == ["t"]
+    assert any(e.kind == "thread" for e in result.events)
+
+
+def test_critical_section_keeps_other_threads_out():
+    src = ("global log = 0\nthread other():\n  log = log + 1\nend\n"
+           "enter_critical\nrun other()\nsleep(0.01)\nseen = log\nexit_critical\nsleep(0.01)\n")
+    result = run(src)
+    assert result.globals["seen"] == 0 and result.globals["log"] == 1
+
+
+def test_textmsg_and_popup_are_events():
+    result = run("textmsg(\"hello \", 3)\npopup(\"careful\")\n")
+    assert [(e.kind, e.message) for e in result.events] == [
+        ("textmsg", "hello 3"), ("popup", "Popup: careful")]
+
+
+def test_io_and_registers_go_to_the_environment():
+    environment = Environment()
+    environment.standard_digital_in[2] = True
+    interpreter = Interpreter(parse("set_standard_digital_out(1, True)\n"
+                                    "write_output_float_register(3, 1.5)\n"
+                                    "x = get_standard_digital_in(2)\n"), environment=environment)
+    result = interpreter.run()
+    assert result.error is None and result.globals["x"] is True
+    assert environment.standard_digital_out[1] and environment.output_float_registers[3] == 1.5
+
+
+# ---- runtime errors name the line ------------------------------------------------------------
+
+
+def test_undefined_name():
+    err = error("def prog():\n  x = 1\n  y = z + x\nend\n")
+    assert (err.line, err.column, err.diagnostic.code) == (3, 7, "URS201")
+    assert "name 'z' is not defined" in str(err) and "  y = z + x" in str(err)
+
+
+def test_undefined_in_thread_suggests_a_name():
+    err = error("count = 0\nthread t():\n  x = cuont + 1\nend\nh = run t()\njoin h\n")
+    assert err.line == 3 and "did you mean 'count'" in str(err)
+
+
+def test_index_out_of_range():
+    err = error("l = [1, 2, 3]\nx = l[3]\n")
+    assert (err.line, err.column, err.diagnostic.code) == (2, 5, "URS202")
+
+
+def test_type_mismatch():
+    err = error("x = 1 + \"a\"\n")
+    assert err.diagnostic.code == "URS203" and "str_cat" in (err.hint or "")
+
+
+def test_division_by_zero():
+    assert error("x = 1 / 0\n").diagnostic.code == "URS205"
+
+
+def test_busy_thread_is_stopped_like_the_controller():
+    err = error("thread t():\n  while True:\n    x = 1\n  end\nend\nrun t()\nsleep(1)\n",
+                runaway_limit=10_000)
+    assert (err.line, err.diagnostic.code) == (2, "URS207")
+    assert "sync()" in (err.hint or "")
+
+
+def test_wrong_builtin_arguments():
+    err = error("sleep(1, 2)\n")
+    assert err.diagnostic.code == "URS206" and "sleep(t)" in str(err)
+    assert "no parameter 'speed'" in str(error("textmsg(\"a\", speed=1)\n"))
+    assert "did you mean 'textmsg'" in str(error("textmgs(\"a\")\n"))
+
+
+def test_runaway_recursion_is_stopped():
+    err = error("def f(n):\n  return f(n + 1)\nend\nx = f(0)\n", max_call_depth=50)
+    assert err.diagnostic.code == "URS208" and err.line == 2
+
+
+def test_max_time_stops_endless_programs():
+    result = run("while True:\n  sleep(1)\nend\n", max_time=10)
+    assert result.stopped_at_max_time and result.error is None
+    assert result.time == pytest.approx(10)
+
+
+def test_unsupported_builtin_is_an_event_by_default():
+    result = run("modbus_set_output_signal(\"x\", True, False)\n")
+    assert result.error is None
+    assert any(e.kind == "unsupported" for e in result.events)
