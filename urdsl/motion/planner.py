@@ -34,7 +34,7 @@ from typing import Protocol
 
 import numpy as np
 
-from ..script.nodes import NO_SPAN, Span
+from ..script.nodes import Span
 from .profiles import Trapezoid
 
 __all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel"]

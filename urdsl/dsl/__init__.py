@@ -1,0 +1,1 @@
+"""Python DSL that builds URScript syntax trees."""

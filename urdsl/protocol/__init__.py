@@ -1,0 +1,1 @@
+"""Sans-I/O codecs for the controller's interfaces (realtime, primary, RTDE, dashboard)."""

@@ -1,0 +1,1 @@
+"""Talking to a robot over sockets: sender, state reader, RTDE recorder, dashboard."""

@@ -1,0 +1,1 @@
+"""Virtual UR controller serving the controller's protocols on loopback."""

@@ -1,0 +1,1 @@
+"""Offline verifier: run a program on a simulated robot and report findings."""

@@ -1,0 +1,73 @@
+"""Findings of the verifier: what would go wrong on the robot, and where in the program.
+
+Codes are stable (documented in ``urdsl check --help`` and the README):
+
+=======  ========  =============================================================
+code     severity  what
+=======  ========  =============================================================
+URS2xx   error     a runtime error stopped the program (see urdsl.runtime.errors)
+URS301   error     a target pose is out of reach (inverse kinematics fails)
+URS302   error     a movel/movec path leaves the workspace or needs an IK branch
+                   flip (a jump in joint space), even though both ends are reachable
+URS303   error     a joint position limit is exceeded
+URS304   error     a joint speed limit is exceeded
+URS305   warning   a joint acceleration limit is exceeded
+URS306   error     the TCP speed limit set for the cell is exceeded
+URS307   warning   the arm passes close to a singularity (shoulder, elbow, wrist)
+URS308   error     collision with the cell (floor, boxes, cylinders) or itself
+URS309   warning   Overlapping Blends: the robot skips the move
+URS310   warning   a blend radius larger than half of a neighbouring segment
+URS311   warning   the program ended while threads were still running
+URS312   info      the program was stopped at the time limit (it loops forever)
+=======  ========  =============================================================
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..script.diagnostics import Diagnostic
+from ..script.nodes import NO_SPAN, Span
+
+__all__ = ["Finding", "RULES"]
+
+RULES: dict[str, tuple[str, str]] = {
+    "URS301": ("error", "unreachable pose"),
+    "URS302": ("error", "path leaves the workspace or flips IK branch"),
+    "URS303": ("error", "joint position limit"),
+    "URS304": ("error", "joint speed limit"),
+    "URS305": ("warning", "joint acceleration limit"),
+    "URS306": ("error", "TCP speed limit"),
+    "URS307": ("warning", "near a singularity"),
+    "URS308": ("error", "collision"),
+    "URS309": ("warning", "overlapping blends (move skipped)"),
+    "URS310": ("warning", "blend radius larger than half a segment"),
+    "URS311": ("warning", "threads still running at program end"),
+    "URS312": ("info", "stopped at the time limit"),
+}
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One problem, at the statement that caused it. ``time`` is robot time in s."""
+
+    code: str
+    severity: str
+    message: str
+    span: Span = NO_SPAN
+    time: float | None = None
+    hint: str | None = None
+
+    @classmethod
+    def of(cls, code: str, message: str, span: Span = NO_SPAN, time: float | None = None,
+           hint: str | None = None) -> Finding:
+        return cls(code, RULES[code][0], message, span, time, hint)
+
+    def diagnostic(self) -> Diagnostic:
+        return Diagnostic.at(self.span, self.message, code=self.code, severity=self.severity,
+                             hint=self.hint)
+
+    def to_dict(self) -> dict:
+        result = self.diagnostic().to_dict()
+        result["time"] = None if self.time is None else round(self.time, 6)
+        return result
