@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["rotation_angle", "slerp_rotations", "arc_points", "arc_length"]
+__all__ = ["rotation_angle", "rotation_matrix", "slerp_rotations", "arc_points", "arc_length"]
 
 
 def _log(rotation: np.ndarray) -> np.ndarray:
@@ -41,6 +41,11 @@ def _exp_many(vectors: np.ndarray) -> np.ndarray:
     result = np.eye(3) + sin * cross + (1.0 - cos) * (cross @ cross)
     result[angles <= 1e-12] = np.eye(3)
     return result
+
+
+def rotation_matrix(vector: np.ndarray) -> np.ndarray:
+    """Rotation matrix (3x3) of a rotation vector (axis · angle, rad)."""
+    return _exp_many(np.asarray(vector, dtype=float).reshape(1, 3))[0]
 
 
 def rotation_angle(r0: np.ndarray, r1: np.ndarray) -> float:

@@ -37,17 +37,27 @@ import numpy as np
 from ..script.nodes import Span
 from .profiles import Trapezoid
 
-__all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel"]
+__all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel", "JOINT_SPACE"]
+
+BLENDABLE_INTO = frozenset({"movej", "movel", "movep", "movec"})
+"""Moves the previous move may blend into (servoj and speedj start from rest)."""
+
+JOINT_SPACE = frozenset({"movej", "servoj", "speedj"})
+"""Moves that interpolate in joint space (the others follow a TCP path)."""
 
 
 class KinematicModel(Protocol):
-    """What the planner needs of a robot model (see :mod:`urdsl.motion.adapter`)."""
+    """What the planner needs of a robot model (:class:`urdsl.kinematics.Robot` is one).
 
-    def fk(self, q: np.ndarray) -> np.ndarray: ...  # (6,) rad → (4, 4) TCP in Base, m
+    ``tcp`` is the TCP as a pose (m, rotation vector) in the flange frame; None = flange.
+    """
 
-    def ik(self, pose: np.ndarray, q_near: np.ndarray) -> np.ndarray: ...  # raises
+    def fk(self, q: np.ndarray, tcp=None) -> np.ndarray: ...  # (6,) rad → (4, 4) in Base, m
 
-    def ik_many(self, poses: np.ndarray, q_near: np.ndarray) -> np.ndarray: ...  # (N,6), NaN
+    def ik(self, pose: np.ndarray, q_near: np.ndarray, tcp=None) -> np.ndarray: ...  # raises
+
+    def ik_many(self, poses: np.ndarray, q_near: np.ndarray, tcp=None) -> np.ndarray:
+        ...  # (N, 6), rows of NaN where a pose is out of reach
 
 
 @dataclass
@@ -80,6 +90,7 @@ class Segment:
     params: dict = field(default_factory=dict)
     via: np.ndarray | None = None
     blend_with_next: float = 0.0
+    tcp: np.ndarray | None = None
 
     @property
     def duration(self) -> float:
@@ -111,17 +122,22 @@ class Segment:
         if self.profile.distance == 0.0:
             return np.repeat(self.q_end[None], len(local), axis=0)
         fraction = self.profile.position(local) / self.profile.distance
-        if self.kind == "movej":
-            return self.q_start + fraction[:, None] * (self.q_end - self.q_start)
-        return kinematics.ik_many(self.path_poses(fraction), self.q_start)
+        linear = self.q_start + fraction[:, None] * (self.q_end - self.q_start)
+        if self.kind in JOINT_SPACE:
+            return linear
+        # Each sample's IK solution is the one closest to the joint-space interpolation
+        # between the two ends, which keeps the arm on the branch of its end points; a
+        # branch flip shows as a jump between samples (the verifier's URS302).
+        return kinematics.ik_many(self.path_poses(fraction), linear, tcp=self.tcp)
 
 
 class MotionPlanner:
     """Plans the moves of one program on one robot model, in robot time.
 
-    ``start_joints`` (rad) is where the arm rests at time 0. Every motion method returns the
-    robot time (s) at which the commanding script thread may go on: the end of the move, or
-    the start of its blend when it has a blend radius.
+    ``start_joints`` (rad) is where the arm rests at time 0; ``tcp`` (a pose in the flange
+    frame, m and rad) is the active TCP, changed by ``set_tcp``. Every motion method returns
+    the robot time (s) at which the commanding script thread may go on: the end of the move,
+    or the start of its blend when it has a blend radius.
     """
 
     def __init__(self, kinematics: KinematicModel, start_joints, step_time: float = 0.002
@@ -129,6 +145,9 @@ class MotionPlanner:
         self.kinematics = kinematics
         self.q_start = np.asarray(start_joints, dtype=float).copy()
         self.step_time = step_time
+        self.tcp: np.ndarray | None = None
+        self.payload_mass = 0.0  # kg
+        self.payload_cog = np.zeros(3)  # m, in the flange frame
         self.segments: list[Segment] = []
         self.warnings: list[MotionWarning] = []
         self.skipped: list[Segment] = []
@@ -144,54 +163,144 @@ class MotionPlanner:
         """Joints at the end of everything planned so far."""
         return self._q.copy()
 
-    def joints_at(self, time: float) -> np.ndarray:
-        """Planned joint positions at robot time ``time`` (s)."""
-        from .trace import joints_at
+    @property
+    def free_at(self) -> float:
+        """Robot time (s) at which the arm is at rest after everything planned so far."""
+        if self._pending is not None:
+            return self._pending.end
+        return self._free_at
 
-        return joints_at(self, np.array([time]))[0]
+    def joints_at(self, time: float) -> np.ndarray:
+        """Planned joint positions (rad) at robot time ``time`` (s).
+
+        Every move starts where the one before it ends (``q_start`` = previous ``q_end``), so
+        the position is the start of the earliest move still running plus what every running
+        move has done so far; only the last few moves need looking at.
+        """
+        active: list[Segment] = []
+        for segment in reversed(self.segments):
+            if segment.start > time:
+                continue
+            if segment.end <= time:
+                if not active:
+                    return segment.q_end.copy()
+                break
+            active.append(segment)
+        if not active:
+            return self.q_start.copy()
+        position = active[-1].q_start.copy()
+        stamp = np.array([time])
+        for segment in active:
+            moved = segment.joints(stamp, self.kinematics)[0] - segment.q_start
+            if not np.isnan(moved).any():
+                position += moved
+        return position
 
     def tcp_at(self, time: float) -> np.ndarray:
-        return self.kinematics.fk(self.joints_at(time))
+        """TCP (4x4, m) of the active TCP at robot time ``time`` (s)."""
+        return self.kinematics.fk(self.joints_at(time), tcp=self.tcp)
+
+    def fk(self, q: np.ndarray) -> np.ndarray:
+        return self.kinematics.fk(q, tcp=self.tcp)
+
+    def ik(self, pose: np.ndarray, q_near: np.ndarray | None = None) -> np.ndarray:
+        """Joints (rad) for a TCP pose (4x4) with the active TCP, closest to ``q_near``
+        (default: where the planned motion ends). Raises the model's KinematicsError."""
+        near = self._q if q_near is None else q_near
+        return self.kinematics.ik(pose, near, tcp=self.tcp)
 
     # ---- moves -----------------------------------------------------------------------------
 
     def movej(self, q: np.ndarray, a: float, v: float, t: float, r: float, span: Span,
               now: float) -> float:
+        """Joint-space move to ``q`` (rad): ``a`` rad/s², ``v`` rad/s, ``t`` s, ``r`` m."""
         q = np.asarray(q, dtype=float)
         q_from = self._q
         delta = np.abs(q - q_from)
-        lead = int(np.argmax(delta / max(v, 1e-12)))  # equal a, v for all joints
+        lead = int(np.argmax(delta))  # equal a, v for all joints: the longest way leads
         profile = Trapezoid.plan(float(delta[lead]), v, a, t)
-        pose_from, pose_to = self.kinematics.fk(q_from), self.kinematics.fk(q)
-        return self._add(Segment("movej", now, profile, q_from.copy(), q, pose_from, pose_to,
-                                 r, span, {"a": a, "v": v, "t": t, "lead": lead}), now)
+        return self._add(self._segment("movej", profile, q_from, q, r, span,
+                                       {"a": a, "v": v, "t": t, "lead": lead}), now)
 
     def movel(self, pose: np.ndarray, a: float, v: float, t: float, r: float, span: Span,
               now: float, kind: str = "movel") -> float:
+        """Straight TCP line to ``pose`` (4x4): ``a`` m/s², ``v`` m/s, ``t`` s, ``r`` m."""
         from .geometry import rotation_angle
 
         q_from = self._q
-        pose_from = self.kinematics.fk(q_from)
+        pose_from = self.fk(q_from)
         length = float(np.linalg.norm(pose[:3, 3] - pose_from[:3, 3]))
         if length < 1e-9:  # rotation only: time it on the angle
             length = rotation_angle(pose_from[:3, :3], pose[:3, :3])
         profile = Trapezoid.plan(length, v, a, t)
-        q_to = self.kinematics.ik(pose, q_from)
-        return self._add(Segment(kind, now, profile, q_from.copy(), q_to, pose_from, pose, r,
-                                 span, {"a": a, "v": v, "t": t}), now)
+        q_to = self.ik(pose, q_from)
+        return self._add(self._segment(kind, profile, q_from, q_to, r, span,
+                                       {"a": a, "v": v, "t": t}, pose_from, pose), now)
 
     def movec(self, via: np.ndarray, pose: np.ndarray, a: float, v: float, r: float,
               mode: int, span: Span, now: float) -> float:
+        """Circular arc from the current TCP through ``via``'s position to ``pose``."""
         from .geometry import arc_length
 
         q_from = self._q
-        pose_from = self.kinematics.fk(q_from)
+        pose_from = self.fk(q_from)
         length = arc_length(pose_from[:3, 3], via[:3, 3], pose[:3, 3])
         profile = Trapezoid.plan(length, v, a)
-        q_to = self.kinematics.ik(pose, q_from)
-        segment = Segment("movec", now, profile, q_from.copy(), q_to, pose_from, pose, r, span,
-                          {"a": a, "v": v, "mode": mode}, via=via[:3, 3].copy())
+        q_to = self.ik(pose, q_from)
+        segment = self._segment("movec", profile, q_from, q_to, r, span,
+                                {"a": a, "v": v, "mode": mode}, pose_from, pose)
+        segment.via = via[:3, 3].copy()
         return self._add(segment, now)
+
+    def servoj(self, q: np.ndarray, t: float, span: Span, now: float) -> float:
+        """Reach ``q`` (rad) in ``t`` s at constant joint speed (servoj ignores a and v)."""
+        q = np.asarray(q, dtype=float)
+        q_from = self._q
+        distance = float(np.max(np.abs(q - q_from)))
+        t = max(t, self.step_time)
+        profile = Trapezoid(distance, 0.0, distance / t, 0.0, t)
+        return self._add(self._segment("servoj", profile, q_from, q, 0.0, span, {"t": t}),
+                         now)
+
+    def speedj(self, qd: np.ndarray, a: float, t: float, span: Span, now: float) -> float:
+        """Accelerate with ``a`` rad/s² (leading axis) to joint speeds ``qd`` (rad/s), keep
+        them until ``t`` s, then decelerate to rest (the stop a following ``stopj`` or the
+        end of the program commands). Returns when the cruise ends."""
+        qd = np.asarray(qd, dtype=float)
+        lead = float(np.max(np.abs(qd)))
+        q_from = self._q
+        if lead == 0.0:
+            return self.stop(now)
+        t = t if t > 0 else lead / a
+        profile = Trapezoid.plan(lead * t, lead, a)
+        q_to = q_from + qd / lead * profile.distance
+        segment = self._segment("speedj", profile, q_from, q_to, 0.0, span,
+                                {"a": a, "t": t, "qd": qd.tolist()})
+        self._add(segment, now)
+        return segment.start + profile.duration - profile.t_acc
+
+    def speedl(self, xd: np.ndarray, a: float, t: float, span: Span, now: float) -> float:
+        """Tool speed ``xd`` (m/s, rad/s in Base) like :meth:`speedj`, as a straight line."""
+        from .geometry import rotation_matrix
+
+        xd = np.asarray(xd, dtype=float)
+        linear = float(np.linalg.norm(xd[:3]))
+        angular = float(np.linalg.norm(xd[3:]))
+        if linear == 0.0 and angular == 0.0:
+            return self.stop(now)
+        speed = linear if linear > 0 else angular
+        t = t if t > 0 else speed / a
+        pose_from = self.fk(self._q)
+        pose = pose_from.copy()
+        pose[:3, 3] += xd[:3] * t
+        pose[:3, :3] = rotation_matrix(xd[3:] * t) @ pose_from[:3, :3]
+        end = self.movel(pose, a, speed, 0.0, 0.0, span, now, kind="speedl")
+        return end - min(speed / a, end - now)
+
+    def stop(self, now: float) -> float:
+        """``stopj``/``stopl``: no blend into what follows; returns when the arm is at rest."""
+        self.stop_blending(now)
+        return max(now, self._free_at)
 
     def stop_blending(self, now: float) -> None:
         """The script did something that waits (sleep, a stop): a pending blend ends in a
@@ -204,6 +313,17 @@ class MotionPlanner:
         """The program ended: the last move runs to its end."""
         self.stop_blending(now)
         self.end_time = max([now] + [s.end for s in self.segments])
+
+    def _segment(self, kind: str, profile: Trapezoid, q_from: np.ndarray, q_to: np.ndarray,
+                 r: float, span: Span, params: dict, pose_from: np.ndarray | None = None,
+                 pose_to: np.ndarray | None = None) -> Segment:
+        if pose_from is None:
+            pose_from = self.fk(q_from)
+        if pose_to is None:
+            pose_to = self.fk(q_to)
+        tcp = None if self.tcp is None else self.tcp.copy()
+        return Segment(kind, 0.0, profile, q_from.copy(), np.asarray(q_to, dtype=float).copy(),
+                       pose_from, pose_to, r, span, params, tcp=tcp)
 
     # ---- planning --------------------------------------------------------------------------
 
@@ -222,6 +342,9 @@ class MotionPlanner:
                     segment.span, now))
                 self.skipped.append(segment)
                 return now
+        if previous is not None and segment.kind not in BLENDABLE_INTO:
+            self.stop_blending(now)
+            previous = None
         if previous is not None:
             tail = _time_for_last(previous, min(previous.radius, _tcp_length(previous)))
             head = segment.profile.time_at(_path_fraction_for(segment, previous.radius)

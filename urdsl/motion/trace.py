@@ -22,7 +22,9 @@ class Trace:
 
     ``times`` (N,) in s; ``q`` (N, 6) in rad; ``qd`` (N, 6) rad/s and ``qdd`` (N, 6) rad/s²
     by finite differences; ``segment`` (N,) the index into ``segments`` of the move active at
-    each sample (-1 at rest before the first move); ``dt`` the sampling step in s.
+    each sample (-1 at rest before the first move); ``dt`` the sampling step in s;
+    ``unreachable`` (N,) marks samples of a TCP path that inverse kinematics could not reach
+    (their joints repeat the last reachable sample).
     """
 
     times: np.ndarray
@@ -32,25 +34,30 @@ class Trace:
     segment: np.ndarray
     dt: float
     segments: list
+    unreachable: np.ndarray
 
     @property
     def duration(self) -> float:
         return float(self.times[-1]) if len(self.times) else 0.0
 
 
-def _displacements(planner, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Joint positions (N, 6) at sorted ``times`` and the active segment per time."""
+def _displacements(planner, times: np.ndarray):
+    """Joint positions (N, 6) at sorted ``times``, the active segment per time, and which
+    samples were out of reach."""
     count = len(times)
     steps = np.zeros((count + 1, 6))
     window = np.zeros((count, 6))
     active = np.full(count, -1, dtype=np.int64)
+    unreachable = np.zeros(count, dtype=bool)
     for index, segment in enumerate(planner.segments):
         first = int(np.searchsorted(times, segment.start, side="left"))
         last = int(np.searchsorted(times, segment.end, side="left"))
         full = segment.q_end - segment.q_start
         if last > first:
             inside = segment.joints(times[first:last], planner.kinematics) - segment.q_start
-            if np.isnan(inside).any():
+            gaps = np.isnan(inside).any(axis=1)
+            if gaps.any():
+                unreachable[first:last] |= gaps
                 inside = _fill_gaps(inside)
             window[first:last] += inside
             active[first:last] = index
@@ -58,7 +65,7 @@ def _displacements(planner, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     positions = planner.q_start + np.cumsum(steps[:-1], axis=0) + window
     # samples after a segment's start but before the next one keep the latest index
     np.maximum.accumulate(active, out=active)
-    return positions, active
+    return positions, active, unreachable
 
 
 def _fill_gaps(values: np.ndarray) -> np.ndarray:
@@ -76,7 +83,7 @@ def joints_at(planner, times: np.ndarray) -> np.ndarray:
     """Planned joint positions (N, 6) at robot times ``times`` (any order)."""
     times = np.asarray(times, dtype=float)
     order = np.argsort(times)
-    positions, _ = _displacements(planner, times[order])
+    positions, _, _ = _displacements(planner, times[order])
     result = np.empty_like(positions)
     result[order] = positions
     return result
@@ -88,7 +95,7 @@ def sample(planner, dt: float | None = None) -> Trace:
     end = max(planner.end_time, max((s.end for s in planner.segments), default=0.0))
     count = int(np.floor(end / dt + 1e-9)) + 1
     times = np.arange(count) * dt
-    q, active = _displacements(planner, times)
+    q, active, unreachable = _displacements(planner, times)
     qd = np.gradient(q, dt, axis=0) if count > 1 else np.zeros_like(q)
     qdd = np.gradient(qd, dt, axis=0) if count > 1 else np.zeros_like(q)
-    return Trace(times, q, qd, qdd, active, dt, planner.segments)
+    return Trace(times, q, qd, qdd, active, dt, planner.segments, unreachable)

@@ -4,12 +4,15 @@ placed at the statement that commanded the move."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..motion.trace import Trace
 from .findings import Finding
 
-__all__ = ["joint_limits", "joint_speeds", "joint_accelerations", "blend_radii"]
+__all__ = ["joint_limits", "joint_speeds", "joint_accelerations", "blend_radii",
+           "path_continuity", "tcp_speed", "singularities", "collisions", "Continuity"]
 
 JOINTS = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
 
@@ -49,14 +52,21 @@ def joint_limits(trace: Trace, lower: np.ndarray, upper: np.ndarray) -> list[Fin
     return findings
 
 
-def joint_speeds(trace: Trace, limits: np.ndarray) -> list[Finding]:
-    """URS304: joint speeds above the model's limits (rad/s)."""
+def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = None
+                 ) -> list[Finding]:
+    """URS304: joint speeds above the model's limits (rad/s); samples in ``exclude`` (jumps
+    already reported by :func:`path_continuity`) are left out."""
     over = np.abs(trace.qd) > limits * (1 + 1e-6)
+    if exclude is not None:
+        over &= ~exclude[:, None]
     findings = []
     for segment, sample in _per_segment(trace, over):
         ratio = np.abs(trace.qd[sample]) / limits
         joint = int(np.argmax(ratio))
-        peak = float(np.max(np.abs(trace.qd[trace.segment == segment, joint])))
+        inside = trace.segment == segment
+        if exclude is not None:
+            inside &= ~exclude
+        peak = float(np.max(np.abs(trace.qd[inside, joint])))
         findings.append(Finding.of(
             "URS304",
             f"{JOINTS[joint]} joint turns at {peak:.2f} rad/s, over its limit of "
@@ -66,9 +76,12 @@ def joint_speeds(trace: Trace, limits: np.ndarray) -> list[Finding]:
     return findings
 
 
-def joint_accelerations(trace: Trace, limits: np.ndarray) -> list[Finding]:
-    """URS305: joint accelerations above the limits (rad/s²)."""
+def joint_accelerations(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = None
+                        ) -> list[Finding]:
+    """URS305: joint accelerations above the user's limits (rad/s²; UR publishes none)."""
     over = np.abs(trace.qdd) > limits * (1 + 1e-6)
+    if exclude is not None:
+        over &= ~exclude[:, None]
     findings = []
     for segment, sample in _per_segment(trace, over):
         joint = int(np.argmax(np.abs(trace.qdd[sample]) / limits))
@@ -96,4 +109,163 @@ def blend_radii(segments) -> list[Finding]:
                 f"blend radius {before.radius:g} m is more than half of a neighbouring "
                 f"segment ({shortest:.4g} m): the blend may be cut short",
                 before.span, before.end, "use at most half the shorter segment"))
+    return findings
+
+
+@dataclass
+class Continuity:
+    """What :func:`path_continuity` found: its findings, and the samples (N,) around jumps
+    and unreachable stretches, which other checks leave out."""
+
+    findings: list[Finding]
+    samples: np.ndarray
+
+
+JUMP_MIN = 0.25
+"""Smallest joint step (rad) between two samples that counts as a jump of the IK branch: at
+the fastest joint speed of any UR (π rad/s) a joint moves 0.006 rad in a 2 ms step and
+0.025 rad in an 8 ms step; a change of branch moves a joint by about π."""
+
+
+def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
+    """URS302: a TCP path (movel/movep/movec) that leaves the workspace between reachable
+    ends, or whose joints jump because inverse kinematics must change its branch."""
+    count = len(trace.times)
+    flagged = np.zeros(count, dtype=bool)
+    findings = []
+    threshold = np.maximum(JUMP_MIN, 10.0 * speed_limits * trace.dt)
+    steps = np.abs(np.diff(trace.q, axis=0)) if count > 1 else np.zeros((0, 6))
+    jumps = np.zeros(count, dtype=bool)
+    jumps[1:] = (steps > threshold).any(axis=1)
+    reported: set[int] = set()
+    for segment, sample in _per_segment(trace, trace.unreachable):
+        reported.add(segment)
+        move = trace.segments[segment]
+        inside = np.flatnonzero(trace.unreachable & (trace.segment == segment))
+        fraction = (trace.times[inside] - move.start) / max(move.duration, 1e-12)
+        findings.append(Finding.of(
+            "URS302",
+            f"the {move.kind} path leaves the robot's workspace between "
+            f"{100 * fraction.min():.0f}% and {100 * fraction.max():.0f}% of the way "
+            f"(t={trace.times[sample]:.3f} s), although both ends are reachable",
+            _span(trace, segment), float(trace.times[sample]),
+            "go round the unreachable region with a waypoint, or use movej"))
+    for segment, sample in _per_segment(trace, jumps):
+        if segment in reported or segment < 0:
+            continue
+        move = trace.segments[segment]
+        joint = int(np.argmax(steps[sample - 1] / threshold))
+        findings.append(Finding.of(
+            "URS302",
+            f"the {move.kind} path needs a change of IK solution: the {JOINTS[joint]} joint "
+            f"jumps by {np.degrees(steps[sample - 1, joint]):.0f}° at "
+            f"t={trace.times[sample]:.3f} s, which the robot cannot do on a straight line",
+            _span(trace, segment), float(trace.times[sample]),
+            "split the move, or reach the end with movej"))
+    bad = jumps | trace.unreachable
+    for shift in (-2, -1, 1, 2):  # central differences spread a jump to the neighbours
+        flagged |= np.roll(bad, shift)
+    flagged |= bad
+    return Continuity(findings, flagged)
+
+
+def _tcp_positions(trace: Trace, robot, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """TCP positions (M, 3) in m for every ``stride``-th sample, with the sample indices;
+    each sample uses the TCP that was active for its move."""
+    index = np.arange(0, len(trace.times), stride)
+    positions = np.empty((len(index), 3))
+    tcps = [None if s.tcp is None else tuple(s.tcp) for s in trace.segments]
+    segment_of = trace.segment[index]
+    tcp_of = np.array([hash(tcps[i]) if i >= 0 else hash(None) for i in segment_of])
+    for key in np.unique(tcp_of):
+        rows = tcp_of == key
+        first = segment_of[rows][0]
+        tcp = None if first < 0 or tcps[first] is None else np.array(tcps[first])
+        positions[rows] = robot.fk_many(trace.q[index[rows]], tcp=tcp)[:, :3, 3]
+    return positions, index
+
+
+def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
+    """URS306: the TCP moves faster than the user's limit (m/s), e.g. 0.25 m/s in a
+    collaborative cell."""
+    positions, _ = _tcp_positions(trace, robot)
+    speed = np.linalg.norm(np.gradient(positions, trace.dt, axis=0), axis=1) \
+        if len(positions) > 1 else np.zeros(len(positions))
+    findings = []
+    for segment, sample in _per_segment(trace, speed > limit * (1 + 1e-6)):
+        peak = float(np.max(speed[trace.segment == segment]))
+        findings.append(Finding.of(
+            "URS306", f"the TCP moves at {peak:.3f} m/s, over the cell's limit of {limit:g} m/s",
+            _span(trace, segment), float(trace.times[sample]),
+            "lower v (movej's v is a joint speed: lower it or use movel with v in m/s)"))
+    return findings
+
+
+SINGULARITY_MARGINS = {"shoulder": 0.03, "elbow": 0.03, "wrist": 0.03}
+"""Default distances to a singularity below which URS307 warns, in the units of
+:meth:`urdsl.kinematics.Robot.singularity` (see there)."""
+
+
+def singularities(trace: Trace, robot, margin: float | None = None,
+                  step: float = 0.01) -> list[Finding]:
+    """URS307: the arm comes close to a shoulder, elbow or wrist singularity, checked every
+    ``step`` s of robot time (also inside blends); ``margin`` replaces the defaults."""
+    stride = max(1, int(round(step / trace.dt)))
+    index = np.arange(0, len(trace.times), stride)
+    if len(index) == 0:
+        return []
+    measures = robot.singularity(trace.q[index])
+    findings = []
+    for kind, default in SINGULARITY_MARGINS.items():
+        limit = default if margin is None else margin
+        close = np.zeros(len(trace.times), dtype=bool)
+        close[index] = np.abs(np.asarray(measures[kind])) < limit
+        close &= trace.segment >= 0
+        for segment, sample in _per_segment(trace, close):
+            move = trace.segments[segment]
+            findings.append(Finding.of(
+                "URS307",
+                f"{kind} singularity: the {move.kind} passes within "
+                f"{abs(float(measures[kind][sample // stride])):.3g} of it at "
+                f"t={trace.times[sample]:.3f} s (joint speeds grow without bound there)",
+                _span(trace, segment), float(trace.times[sample]),
+                _SINGULARITY_HINTS[kind]))
+    return findings
+
+
+_SINGULARITY_HINTS = {
+    "shoulder": "keep the wrist away from the base's vertical axis",
+    "elbow": "do not stretch the arm fully (stay inside the reach)",
+    "wrist": "avoid wrist 2 near 0° or 180° (wrist 1 and wrist 3 axes aligned): tilt the tool",
+}
+
+
+def collisions(trace: Trace, robot, cell, step: float = 0.02,
+               self_collision: bool = True) -> list[Finding]:
+    """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders) or itself,
+    checked every ``step`` s of robot time while it moves."""
+    from ..kinematics.collision import CollisionModel
+
+    if cell is None and not self_collision:
+        return []
+    model = CollisionModel(robot, self_collision=self_collision)
+    if cell is not None:
+        model.load_cell(cell)
+    stride = max(1, int(round(step / trace.dt)))
+    index = np.arange(0, len(trace.times), stride)
+    index = index[trace.segment[index] >= 0]
+    if len(index) == 0:
+        return []
+    result = model.check(trace.q[index])
+    hit = np.zeros(len(trace.times), dtype=bool)
+    hit[index] = result.colliding
+    position = {int(sample): i for i, sample in enumerate(index)}
+    findings = []
+    for segment, sample in _per_segment(trace, hit):
+        pair = result.pairs[position[sample]]
+        what = " and ".join(pair) if pair else "an obstacle"
+        findings.append(Finding.of(
+            "URS308", f"collision: {what} at t={trace.times[sample]:.3f} s",
+            _span(trace, segment), float(trace.times[sample]),
+            "move around the obstacle with an extra waypoint"))
     return findings

@@ -1,0 +1,360 @@
+"""Builtins that move the arm or read its state, and URScript pose maths.
+
+Motion calls go to the interpreter's robot, a :class:`urdsl.motion.planner.MotionPlanner`:
+it plans the move in robot time and says when the script may go on (the end of the move,
+or the start of its blend), and the calling thread waits until then. Pose maths comes from
+:mod:`urdsl.kinematics.pose`, inverse kinematics from the planner's robot model.
+
+Units are the controller's: joints in rad, positions in m, speeds in rad/s or m/s,
+accelerations in rad/s² or m/s², times in s, blend radii in m.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..kinematics import KinematicsError
+from ..kinematics import pose as posemath
+from .builtins import implements
+from .values import ListValue, PoseValue, is_number, type_name
+
+__all__: list[str] = []
+
+
+# ---- argument conversion ---------------------------------------------------------------------
+
+
+def _arm(rt, node):
+    if rt.robot is None:
+        raise rt.error("unsupported", "this program runs without a robot: motion and robot "
+                       "state are not available", node)
+    return rt.robot
+
+
+def _numbers(rt, node, value: Any, count: int, what: str) -> np.ndarray:
+    if type(value) is PoseValue or (type(value) is ListValue
+                                     and all(is_number(v) for v in value)):
+        if len(value) != count:
+            raise rt.error("type", f"{what} needs {count} numbers, got {len(value)}", node,
+                           "a joint vector has 6 angles in rad: [base, shoulder, elbow, "
+                           "wrist1, wrist2, wrist3]" if count == 6 else None)
+        array = np.array([float(v) for v in value])
+        if not np.isfinite(array).all():
+            raise rt.error("arithmetic", f"{what} contains a value that is not finite", node)
+        return array
+    raise rt.error("type", f"{what} must be a list of {count} numbers, not a "
+                   f"{type_name(value)}", node)
+
+
+def _number(rt, node, value: Any, what: str, minimum: float | None = 0.0) -> float:
+    if not is_number(value):
+        raise rt.error("type", f"{what} must be a number, not a {type_name(value)}", node)
+    number = float(value)
+    if not math.isfinite(number) or (minimum is not None and number < minimum):
+        raise rt.error("arithmetic", f"{what} must be a finite number >= {minimum:g}, "
+                       f"got {number:g}", node)
+    return number
+
+
+def _pose(rt, node, value: Any, what: str) -> np.ndarray:
+    """A pose argument as a 6-vector; must be a pose (p[...])."""
+    if type(value) is not PoseValue:
+        raise rt.error("type", f"{what} must be a pose p[x, y, z, rx, ry, rz], not a "
+                       f"{type_name(value)}", node)
+    return np.array(value, dtype=float)
+
+
+def _matrix(rt, node, value: Any, what: str) -> np.ndarray:
+    """A Cartesian target as a 4x4 matrix: a pose, or joints turned into a pose by FK (the
+    controller accepts joint vectors as targets of movel/movep/movec)."""
+    arm = _arm(rt, node)
+    if type(value) is PoseValue:
+        return posemath.to_matrix(np.array(value, dtype=float))
+    return arm.fk(_numbers(rt, node, value, 6, what))
+
+
+def _joints_target(rt, node, value: Any) -> np.ndarray:
+    """The joints of a movej target: a joint vector, or a pose solved by IK closest to where
+    the arm is going."""
+    arm = _arm(rt, node)
+    if type(value) is PoseValue:
+        return _solve(rt, node, arm, posemath.to_matrix(np.array(value, dtype=float)), None)
+    return _numbers(rt, node, value, 6, "the joint target")
+
+
+def _solve(rt, node, arm, matrix: np.ndarray, near: np.ndarray | None) -> np.ndarray:
+    try:
+        return arm.ik(matrix, near)
+    except KinematicsError as error:
+        raise rt.error("ik", f"inverse kinematics failed: {error}", node,
+                       "the pose is out of reach of this robot with the active TCP") from None
+
+
+def _to_pose(matrix: np.ndarray) -> PoseValue:
+    return PoseValue(posemath.from_matrix(matrix))
+
+
+def _vector(values) -> ListValue:
+    return ListValue([float(v) for v in values])
+
+
+def _plan(rt, node, plan) -> None:
+    """Run a planning call, turning the model's errors into runtime errors, and wait until
+    the script may go on."""
+    try:
+        resume = plan()
+    except KinematicsError as error:
+        raise rt.error("ik", f"inverse kinematics failed: {error}", node,
+                       "the pose is out of reach of this robot with the active TCP") from None
+    except ValueError as error:
+        raise rt.error("arithmetic", str(error), node) from None
+    rt.wait_until(resume)
+
+
+# ---- moves -----------------------------------------------------------------------------------
+
+
+@implements("movej")
+def _movej(rt, node, q, a=1.4, v=1.05, t=0, r=0):
+    arm = _arm(rt, node)
+    target = _joints_target(rt, node, q)
+    a, v = _number(rt, node, a, "a"), _number(rt, node, v, "v")
+    t, r = _number(rt, node, t, "t"), _number(rt, node, r, "r")
+    _plan(rt, node, lambda: arm.movej(target, a, v, t, r, node.span, rt.time))
+
+
+def _linear(kind: str):
+    def move(rt, node, pose, a=1.2, v=0.25, t=0, r=0):
+        arm = _arm(rt, node)
+        target = _matrix(rt, node, pose, "the target")
+        a, v = _number(rt, node, a, "a"), _number(rt, node, v, "v")
+        t, r = _number(rt, node, t, "t"), _number(rt, node, r, "r")
+        _plan(rt, node, lambda: arm.movel(target, a, v, t, r, node.span, rt.time, kind=kind))
+
+    return move
+
+
+implements("movel")(_linear("movel"))
+implements("movep", "servoc")(_linear("movep"))
+
+
+@implements("movec")
+def _movec(rt, node, pose_via, pose_to, a=1.2, v=0.25, r=0, mode=0):
+    arm = _arm(rt, node)
+    via = _matrix(rt, node, pose_via, "pose_via")
+    target = _matrix(rt, node, pose_to, "pose_to")
+    a, v, r = _number(rt, node, a, "a"), _number(rt, node, v, "v"), _number(rt, node, r, "r")
+    if type(mode) is not int or mode not in (0, 1):
+        raise rt.error("type", f"movec mode must be 0 (unconstrained) or 1 (fixed), not {mode}",
+                       node)
+    _plan(rt, node, lambda: arm.movec(via, target, a, v, r, mode, node.span, rt.time))
+
+
+@implements("servoj")
+def _servoj(rt, node, q, a=None, v=None, t=None, lookahead_time=0.1, gain=300):
+    arm = _arm(rt, node)
+    target = _numbers(rt, node, q, 6, "the joint target")
+    step = rt.config.step_time
+    t = step if t is None else _number(rt, node, t, "t")
+    lookahead = _number(rt, node, lookahead_time, "lookahead_time")
+    if not 0.03 <= lookahead <= 0.2:
+        raise rt.error("arithmetic", f"servoj lookahead_time must be in [0.03, 0.2] s, got "
+                       f"{lookahead:g}", node)
+    if not 100 <= _number(rt, node, gain, "gain") <= 2000:
+        raise rt.error("arithmetic", f"servoj gain must be in [100, 2000], got {gain}", node)
+    _plan(rt, node, lambda: arm.servoj(target, t, node.span, rt.time))
+
+
+@implements("speedj")
+def _speedj(rt, node, qd, a, t=0):
+    arm = _arm(rt, node)
+    speeds = _numbers(rt, node, qd, 6, "the joint speeds")
+    a, t = _number(rt, node, a, "a", 1e-9), _number(rt, node, t, "t")
+    _plan(rt, node, lambda: arm.speedj(speeds, a, t, node.span, rt.time))
+
+
+@implements("speedl")
+def _speedl(rt, node, xd, a, t=0, aRot="a"):  # noqa: N803 - the catalog's parameter name
+    arm = _arm(rt, node)
+    speeds = _numbers(rt, node, xd, 6, "the tool speed")
+    a, t = _number(rt, node, a, "a", 1e-9), _number(rt, node, t, "t")
+    _plan(rt, node, lambda: arm.speedl(speeds, a, t, node.span, rt.time))
+
+
+@implements("stopj", "stopl")
+def _stop(rt, node, a, aRot="a"):  # noqa: N803
+    arm = _arm(rt, node)
+    _number(rt, node, a, "a", 1e-9)
+    rt.wait_until(arm.stop(rt.time))
+
+
+# ---- robot state -----------------------------------------------------------------------------
+
+
+@implements("get_actual_joint_positions", "get_target_joint_positions")
+def _joints(rt, node):
+    return _vector(_arm(rt, node).joints_at(rt.time))
+
+
+@implements("get_actual_tcp_pose", "get_target_tcp_pose")
+def _tcp_pose(rt, node):
+    return _to_pose(_arm(rt, node).tcp_at(rt.time))
+
+
+@implements("get_actual_joint_speeds", "get_target_joint_speeds")
+def _joint_speeds(rt, node):
+    arm = _arm(rt, node)
+    step = rt.config.step_time
+    before = arm.joints_at(max(rt.time - step, 0.0))
+    return _vector((arm.joints_at(rt.time) - before) / step if rt.time > 0 else np.zeros(6))
+
+
+@implements("get_actual_tcp_speed", "get_target_tcp_speed")
+def _tcp_speed(rt, node):
+    arm = _arm(rt, node)
+    step = rt.config.step_time
+    if rt.time <= 0:
+        return _vector(np.zeros(6))
+    before, after = arm.tcp_at(rt.time - step), arm.tcp_at(rt.time)
+    linear = (after[:3, 3] - before[:3, 3]) / step
+    angular = posemath.from_matrix(np.vstack([np.hstack([after[:3, :3] @ before[:3, :3].T,
+                                                         np.zeros((3, 1))]),
+                                              [0, 0, 0, 1]]))[3:] / step
+    return _vector(np.concatenate([linear, angular]))
+
+
+@implements("get_forward_kin")
+def _forward_kin(rt, node, q="current_joint_positions", tcp="active_tcp"):
+    arm = _arm(rt, node)
+    joints = arm.joints_at(rt.time) if isinstance(q, str) else _numbers(rt, node, q, 6, "q")
+    offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
+    return _to_pose(arm.kinematics.fk(joints, tcp=offset))
+
+
+def _inverse(rt, node, x, qnear, maxPositionError, maxOrientationError, tcp):  # noqa: N803
+    arm = _arm(rt, node)
+    target = posemath.to_matrix(_pose(rt, node, x, "x"))
+    near = arm.joints_at(rt.time) if qnear is None else _numbers(rt, node, qnear, 6, "qnear")
+    offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
+    _number(rt, node, maxPositionError, "maxPositionError")
+    _number(rt, node, maxOrientationError, "maxOrientationError")
+    return arm.kinematics.ik(target, near, tcp=offset)
+
+
+@implements("get_inverse_kin")
+def _inverse_kin(rt, node, x, qnear=None, maxPositionError=1e-10,  # noqa: N803
+                 maxOrientationError=1e-10, tcp="active_tcp"):
+    try:
+        return _vector(_inverse(rt, node, x, qnear, maxPositionError, maxOrientationError, tcp))
+    except KinematicsError as error:
+        raise rt.error("ik", f"get_inverse_kin found no solution: {error}", node,
+                       "test with get_inverse_kin_has_solution() first") from None
+
+
+@implements("get_inverse_kin_has_solution")
+def _has_solution(rt, node, pose, qnear=None, maxPositionError=1e-10,  # noqa: N803
+                  maxOrientationError=1e-10, tcp="active_tcp"):
+    try:
+        _inverse(rt, node, pose, qnear, maxPositionError, maxOrientationError, tcp)
+    except KinematicsError:
+        return False
+    return True
+
+
+@implements("set_tcp")
+def _set_tcp(rt, node, pose):
+    arm = _arm(rt, node)
+    arm.tcp = _pose(rt, node, pose, "the TCP")
+
+
+@implements("get_tcp_offset")
+def _get_tcp_offset(rt, node):
+    arm = _arm(rt, node)
+    return PoseValue(np.zeros(6) if arm.tcp is None else arm.tcp)
+
+
+@implements("set_payload")
+def _set_payload(rt, node, m, cog=None):
+    arm = _arm(rt, node)
+    arm.payload_mass = _number(rt, node, m, "the payload mass (kg)")
+    if cog is not None:
+        arm.payload_cog = _numbers(rt, node, cog, 3, "the centre of gravity (m)")
+
+
+@implements("set_payload_mass")
+def _set_payload_mass(rt, node, m):
+    _arm(rt, node).payload_mass = _number(rt, node, m, "the payload mass (kg)")
+
+
+@implements("set_payload_cog")
+def _set_payload_cog(rt, node, cog):
+    _arm(rt, node).payload_cog = _numbers(rt, node, cog, 3, "the centre of gravity (m)")
+
+
+@implements("is_within_safety_limits")
+def _within_limits(rt, node, pose):
+    arm = _arm(rt, node)
+    try:
+        q = arm.ik(posemath.to_matrix(_pose(rt, node, pose, "pose")), arm.joints_at(rt.time))
+    except KinematicsError:
+        return False
+    model = arm.kinematics
+    return bool(np.all(q >= model.q_min) and np.all(q <= model.q_max))
+
+
+# ---- pose maths ------------------------------------------------------------------------------
+
+
+@implements("pose_trans")
+def _pose_trans(rt, node, p_from, p_from_to):
+    return PoseValue(posemath.pose_trans(_pose(rt, node, p_from, "p_from"),
+                                         _pose(rt, node, p_from_to, "p_from_to")))
+
+
+@implements("pose_add")
+def _pose_add(rt, node, p_1, p_2):
+    return PoseValue(posemath.pose_add(_pose(rt, node, p_1, "p_1"), _pose(rt, node, p_2, "p_2")))
+
+
+@implements("pose_sub")
+def _pose_sub(rt, node, p_to, p_from):
+    return PoseValue(posemath.pose_sub(_pose(rt, node, p_to, "p_to"),
+                                       _pose(rt, node, p_from, "p_from")))
+
+
+@implements("pose_inv")
+def _pose_inv(rt, node, p_from):
+    return PoseValue(posemath.pose_inv(_pose(rt, node, p_from, "p_from")))
+
+
+@implements("pose_dist")
+def _pose_dist(rt, node, p_from, p_to):
+    return float(posemath.pose_dist(_pose(rt, node, p_from, "p_from"),
+                                    _pose(rt, node, p_to, "p_to")))
+
+
+@implements("point_dist")
+def _point_dist(rt, node, p_from, p_to):
+    a, b = _pose(rt, node, p_from, "p_from"), _pose(rt, node, p_to, "p_to")
+    return float(np.linalg.norm(a[:3] - b[:3]))
+
+
+@implements("interpolate_pose")
+def _interpolate_pose(rt, node, p_from, p_to, alpha):
+    return PoseValue(posemath.interpolate_pose(_pose(rt, node, p_from, "p_from"),
+                                               _pose(rt, node, p_to, "p_to"),
+                                               _number(rt, node, alpha, "alpha", None)))
+
+
+@implements("rotvec2rpy")
+def _rotvec2rpy(rt, node, rotation_vector):
+    vector = _numbers(rt, node, rotation_vector, 3, "the rotation vector")
+    return _vector(posemath.rotvec2rpy(vector))
+
+
+@implements("rpy2rotvec")
+def _rpy2rotvec(rt, node, rpy_vector):
+    return _vector(posemath.rpy2rotvec(_numbers(rt, node, rpy_vector, 3, "the RPY vector")))

@@ -1,0 +1,160 @@
+"""``urdsl check``: run programs offline on a simulated robot and report what would go wrong."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from .findings import RULES
+
+__all__ = ["add_commands", "cmd_check", "parse_vector"]
+
+_DESCRIPTION = """\
+Run each program on a simulated robot, offline, and report every problem the real robot
+would stop for, at the line that causes it: unreachable poses (URS301), straight-line moves
+that leave the workspace or flip the IK solution (URS302), joint limits (URS303), joint
+speeds (URS304), the cell's TCP speed limit (URS306), singularities (URS307), collisions with
+the cell or the arm itself (URS308), Overlapping Blends (URS309), runtime errors (URS2xx).
+Also prints every move with its duration and the cycle time.
+
+Exit status: 0 no errors (warnings allowed), 1 errors found, 2 usage errors.
+"""
+
+_EPILOG = """\
+examples:
+  urdsl check pick.script --robot ur5e
+  urdsl check programs/palletizing.py --robot ur10e --cell cell.toml
+  urdsl check pick.script --start-joints-deg 0,-90,90,-90,-90,0 --tcp 0,0,0.15,0,0,0
+  urdsl check pick.script --tcp-speed-limit 0.25 --json > report.json
+  urdsl check pick.script --plot pick.png
+
+rules:
+""" + "\n".join(f"  {code}  {severity:<8} {text}" for code, (severity, text) in RULES.items())
+
+
+def parse_vector(text: str, count: int, what: str, degrees: bool = False) -> tuple:
+    """``"0,-1.57,0,..."`` → a tuple of ``count`` floats (converted from degrees if asked)."""
+    try:
+        values = tuple(float(v) for v in text.replace(" ", "").strip("[]p").split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{what} must be {count} comma-separated numbers, "
+                                         f"got {text!r}") from None
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(f"{what} must be {count} finite numbers, got "
+                                         f"{len(values)}: {text!r}")
+    return tuple(math.radians(v) for v in values) if degrees else values
+
+
+def add_commands(commands) -> None:
+    p = commands.add_parser(
+        "check", help="run programs offline on a simulated robot and report problems",
+        description=_DESCRIPTION, epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("files", nargs="+", metavar="FILE",
+                   help="a URScript file (.script) or a DSL program (.py)")
+    p.add_argument("--robot", default="ur5e", metavar="MODEL",
+                   help="robot model: ur3, ur5, ur10, ur3e, ur5e, ur10e, ur16e, ur20, ur30, "
+                   "ur7e, ur12e, ur15, ur18, ur8long (default: ur5e)")
+    start = p.add_mutually_exclusive_group()
+    start.add_argument("--start-joints", metavar="Q", type=lambda t: parse_vector(
+        t, 6, "--start-joints"), help="joint positions in rad where the arm starts, "
+        "comma-separated (default: 0,-pi/2,pi/2,-pi/2,-pi/2,0)")
+    start.add_argument("--start-joints-deg", metavar="Q", type=lambda t: parse_vector(
+        t, 6, "--start-joints-deg", degrees=True), help="the same in degrees")
+    p.add_argument("--tcp", metavar="POSE", type=lambda t: parse_vector(t, 6, "--tcp"),
+                   help="TCP offset from the flange: x,y,z in m and a rotation vector in rad "
+                   "(default: the flange; a script's set_tcp() changes it)")
+    p.add_argument("--cell", metavar="TOML",
+                   help="cell description with the floor, boxes and cylinders to avoid")
+    p.add_argument("--tcp-speed-limit", type=float, metavar="M_PER_S",
+                   help="maximum TCP speed in m/s, e.g. 0.25 for a collaborative cell")
+    p.add_argument("--joint-acceleration-limit", type=float, metavar="RAD_PER_S2",
+                   help="maximum joint acceleration in rad/s² (UR publishes none; off "
+                   "by default)")
+    p.add_argument("--singularity-margin", type=float, metavar="D",
+                   help="warn closer than this to a singularity (default 0.03: metres for "
+                   "shoulder, sine of the joint angle for elbow and wrist)")
+    p.add_argument("--no-self-collision", action="store_true",
+                   help="do not check the arm against itself")
+    p.add_argument("--max-time", type=float, default=3600.0, metavar="S",
+                   help="stop a program that runs longer than this robot time (default 3600)")
+    p.add_argument("--json", action="store_true",
+                   help="print the report as one JSON document on stdout (one per file, in "
+                   "a list when several files are given)")
+    p.add_argument("--plot", metavar="PNG",
+                   help="write a plot of joint positions, speeds and the TCP path")
+    p.add_argument("--all-moves", action="store_true",
+                   help="list every move in the text report (default: the first 20)")
+    p.set_defaults(run=cmd_check)
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
+    from ..kinematics import MODELS
+    from .run import DEFAULT_START, CheckOptions, check_text
+
+    robot = args.robot.lower()
+    if robot not in MODELS:
+        raise UsageError(f"unknown robot model {args.robot!r}; known: {', '.join(MODELS)}")
+    if args.plot and len(args.files) > 1:
+        raise UsageError("--plot takes one file at a time")
+    options = CheckOptions(
+        robot=robot,
+        start_joints=args.start_joints or args.start_joints_deg or DEFAULT_START,
+        tcp=args.tcp, cell=args.cell, tcp_speed_limit=args.tcp_speed_limit,
+        joint_acceleration_limit=args.joint_acceleration_limit,
+        singularity_margin=args.singularity_margin, max_time=args.max_time,
+        self_collision=not args.no_self_collision)
+    if args.cell:
+        _check_cell(args.cell)
+    reports = []
+    for name in args.files:
+        if name.endswith(".py"):
+            report = _check_program(name, options)
+        else:
+            source = read_input(name)
+            report = check_text(source.text, source.name, options=options)
+        reports.append(report)
+        if not args.json:
+            _print(report, args.all_moves)
+    if args.json:
+        import json
+
+        documents = [r.to_dict() for r in reports]
+        json.dump(documents[0] if len(documents) == 1 else documents, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    if args.plot:
+        reports[0].plot(args.plot)
+        print(f"plot written to {args.plot}", file=sys.stderr)
+    return EXIT_PROBLEMS if any(r.has_errors for r in reports) else EXIT_OK
+
+
+def _check_cell(path: str) -> None:
+    from ..cli import UsageError
+    from ..kinematics import MODELS, KinematicsError, Robot
+    from ..kinematics.collision import CollisionModel
+
+    try:
+        CollisionModel(Robot.model(next(iter(MODELS)))).load_cell(path)
+    except OSError as error:
+        raise UsageError(f"cannot read the cell {path}: {error.strerror}") from None
+    except (KinematicsError, ValueError) as error:
+        raise UsageError(f"bad cell description {path}: {error}") from None
+
+
+def _check_program(name: str, options):
+    from ..cli import UsageError
+    from .run import check_file
+
+    try:
+        return check_file(name, options)
+    except OSError as error:
+        raise UsageError(f"cannot read {name}: {error.strerror}") from None
+
+
+def _print(report, all_moves: bool) -> None:
+    from rich.console import Console
+
+    console = Console(highlight=False, soft_wrap=True)
+    report.print_rich(console, max_moves=len(report.moves) if all_moves else 20)

@@ -1,0 +1,137 @@
+"""The verifier's report: findings, executed moves, cycle time; as text, JSON and a plot.
+
+JSON shape (``urdsl check --json``), one document::
+
+    {"file": "pick.script", "robot": "ur5e", "ok": false, "cycle_time": 4.182,
+     "summary": {"error": 1, "warning": 0, "info": 0},
+     "findings": [{"code": "URS303", "severity": "error", "message": "...",
+                   "file": "pick.script", "line": 7, "column": 1, "hint": "...",
+                   "time": 2.31}],
+     "moves": [{"kind": "movej", "line": 3, "column": 1, "start": 0.0,
+                "duration": 2.094}],
+     "events": [{"time": 0.0, "kind": "textmsg", "message": "hello", "line": 2}]}
+
+Times in s of robot time.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..script.nodes import Span
+from .findings import Finding
+
+__all__ = ["Report", "Move"]
+
+
+@dataclass(frozen=True)
+class Move:
+    """One executed move: its kind, the statement, start time and duration (s)."""
+
+    kind: str
+    span: Span
+    start: float
+    duration: float
+    lead_joint: int | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind, "line": self.span.line, "column": self.span.column,
+                "start": round(self.start, 6), "duration": round(self.duration, 6)}
+
+
+@dataclass
+class Report:
+    """Everything ``urdsl check`` found out about one program."""
+
+    file: str
+    robot: str
+    findings: list[Finding] = field(default_factory=list)
+    moves: list[Move] = field(default_factory=list)
+    events: list = field(default_factory=list)
+    cycle_time: float = 0.0
+    trace: Any = field(default=None, repr=False)
+
+    def sort(self) -> None:
+        """Order findings by position in the file, then by time."""
+        self.findings.sort(key=lambda f: (f.span.line, f.span.column, f.time or 0.0, f.code))
+
+    def count(self, severity: str) -> int:
+        return sum(1 for f in self.findings if f.severity == severity)
+
+    @property
+    def has_errors(self) -> bool:
+        return self.count("error") > 0
+
+    def codes(self) -> list[str]:
+        return [f.code for f in self.findings]
+
+    # ---- outputs ---------------------------------------------------------------------------
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "file": self.file,
+            "robot": self.robot,
+            "ok": not self.has_errors,
+            "cycle_time": round(self.cycle_time, 6),
+            "summary": {s: self.count(s) for s in ("error", "warning", "info")},
+            "findings": [f.to_dict() for f in self.findings],
+            "moves": [m.to_dict() for m in self.moves],
+            "events": [{"time": round(e.time, 6), "kind": e.kind, "message": e.message,
+                        "line": e.span.line} for e in self.events],
+        }
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2)
+
+    def render_text(self, moves: bool = True, max_moves: int = 20) -> str:
+        """Plain-text report: each finding with its source line, then the moves and the
+        cycle time."""
+        lines = [f.diagnostic().render() for f in self.findings]
+        if moves and self.moves:
+            lines.append(f"moves ({len(self.moves)}):")
+            for move in self.moves[:max_moves]:
+                lines.append(f"  line {move.span.line:>4}  {move.kind:<6} "
+                             f"start {move.start:8.3f} s  duration {move.duration:7.3f} s")
+            if len(self.moves) > max_moves:
+                lines.append(f"  ... {len(self.moves) - max_moves} more")
+        lines.append(self.summary())
+        return "\n".join(lines) + "\n"
+
+    def summary(self) -> str:
+        verdict = "FAILED" if self.has_errors else "ok"
+        return (f"{self.file}: {verdict} on {self.robot}: {self.count('error')} error(s), "
+                f"{self.count('warning')} warning(s), {self.count('info')} info; "
+                f"{len(self.moves)} move(s), cycle time {self.cycle_time:.3f} s")
+
+    def print_rich(self, console, moves: bool = True, max_moves: int = 20) -> None:
+        """The report on a rich console: coloured findings, a table of moves."""
+        from rich.table import Table
+        from rich.text import Text
+
+        colours = {"error": "bold red", "warning": "yellow", "info": "cyan"}
+        for finding in self.findings:
+            rendered = finding.diagnostic().render().split("\n")
+            console.print(Text(rendered[0], style=colours.get(finding.severity, "")))
+            for rest in rendered[1:]:
+                console.print(Text(rest))
+        if moves and self.moves:
+            table = Table(title=f"moves ({len(self.moves)})", show_edge=False)
+            for column in ("line", "move", "start s", "duration s"):
+                table.add_column(column, justify="right" if column != "move" else "left")
+            for move in self.moves[:max_moves]:
+                table.add_row(str(move.span.line), move.kind, f"{move.start:.3f}",
+                              f"{move.duration:.3f}")
+            if len(self.moves) > max_moves:
+                table.add_row("…", f"{len(self.moves) - max_moves} more", "", "")
+            console.print(table)
+        style = "bold red" if self.has_errors else "bold green"
+        console.print(Text(self.summary(), style=style))
+
+    def plot(self, path, robot_model=None) -> None:
+        """Joint positions and speeds against the limits, and the TCP path (PNG, SVG or PDF
+        by the file's suffix)."""
+        from .plot import plot_report
+
+        plot_report(self, path, robot_model)

@@ -1,0 +1,170 @@
+"""Check a program: run it on a simulated robot, sample the trajectory, apply every check.
+
+The steps, each reported as findings at the statement that caused them:
+
+1. parse (syntax errors are URS001 findings; nothing runs);
+2. run the program through :class:`urdsl.runtime.Interpreter` with a
+   :class:`urdsl.motion.MotionPlanner` as its robot, in robot time — runtime errors (URS2xx,
+   an unreachable target as URS301) stop it as they would stop the controller;
+3. sample the planned trajectory at the controller rate (:func:`urdsl.motion.trace.sample`);
+4. run the checks of :mod:`urdsl.verify.checks` over the samples.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..motion.planner import MotionPlanner
+from ..motion.trace import sample
+from ..runtime import Environment, Interpreter, RuntimeConfig
+from ..script.diagnostics import ScriptSyntaxError
+from ..script.parser import parse
+from . import checks
+from .findings import Finding
+from .report import Move, Report
+
+__all__ = ["CheckOptions", "check_text", "check_tree", "check_file", "DEFAULT_START"]
+
+DEFAULT_START = (0.0, -1.5707963267948966, 1.5707963267948966, -1.5707963267948966,
+                 -1.5707963267948966, 0.0)
+"""Where the simulated arm rests before the program (rad): upper arm up, forearm
+horizontal, tool pointing down — a pose every model reaches away from singularities."""
+
+
+@dataclass
+class CheckOptions:
+    """What to check against.
+
+    ``robot``: model name (``urdsl.kinematics.MODELS``); ``start_joints`` (rad);
+    ``tcp``: TCP pose in the flange frame (m, rad) active from the start; ``cell``: path of a
+    cell TOML (obstacles, see :mod:`urdsl.kinematics.collision`); ``tcp_speed_limit`` (m/s);
+    ``joint_acceleration_limit`` (rad/s², one value or six); ``q_min``/``q_max``: user joint
+    limits (rad) replacing the model's; ``singularity_margin``: see
+    :func:`urdsl.verify.checks.singularities`; ``max_time``: robot time (s) after which a
+    program that runs on is stopped; ``sample_time``: trace step in s (default: the
+    controller's, 0.002 e-Series / 0.008 CB3); ``collision_step``: robot time (s) between
+    collision samples.
+    """
+
+    robot: str = "ur5e"
+    start_joints: tuple[float, ...] = DEFAULT_START
+    tcp: tuple[float, ...] | None = None
+    cell: str | Path | None = None
+    tcp_speed_limit: float | None = None
+    joint_acceleration_limit: float | tuple[float, ...] | None = None
+    q_min: tuple[float, ...] | None = None
+    q_max: tuple[float, ...] | None = None
+    singularity_margin: float | None = None
+    max_time: float = 3600.0
+    sample_time: float | None = None
+    collision_step: float = 0.02
+    self_collision: bool = True
+    environment: Environment | None = field(default=None, repr=False)
+
+
+def check_text(text: str, filename: str = "<script>", *, robot: str = "ur5e",
+               options: CheckOptions | None = None) -> Report:
+    """Check URScript ``text``; ``filename`` names it in messages."""
+    options = options or CheckOptions(robot=robot)
+    try:
+        module = parse(text, filename=filename)
+    except ScriptSyntaxError as error:
+        report = Report(filename, options.robot)
+        report.findings.append(Finding(error.diagnostic.code or "URS001", "error",
+                                       error.diagnostic.message, error.diagnostic.span,
+                                       None, error.diagnostic.hint))
+        return report
+    return check_tree(module, filename, options)
+
+
+def check_file(path: str | Path, options: CheckOptions | None = None) -> Report:
+    """Check a ``.script`` file, or a DSL program file (``.py``) after compiling it."""
+    path = Path(path)
+    options = options or CheckOptions()
+    if path.suffix == ".py":
+        from ..dsl.command import load_program
+
+        program = load_program(path)
+        return check_tree(program.tree(), str(path), options)
+    return check_text(path.read_text(encoding="utf-8"), str(path), options=options)
+
+
+def _robot_model(name: str):
+    from ..kinematics import Robot
+
+    return Robot.model(name)
+
+
+def check_tree(module, filename: str, options: CheckOptions) -> Report:
+    """Run and check a parsed program (:class:`urdsl.script.nodes.Module`)."""
+    robot = _robot_model(options.robot)
+    cb3 = getattr(robot.spec, "generation", "") == "cb3"
+    step = 0.008 if cb3 else 0.002
+    planner = MotionPlanner(robot, options.start_joints, step_time=step)
+    if options.tcp is not None:
+        planner.tcp = np.asarray(options.tcp, dtype=float)
+    config = RuntimeConfig(step_time=step, max_time=options.max_time)
+    interpreter = Interpreter(module, robot=planner, environment=options.environment,
+                              config=config)
+    result = interpreter.run()
+
+    report = Report(filename, options.robot)
+    report.events = result.events
+    if result.error is not None:
+        report.findings.append(_runtime_finding(result.error))
+    for warning in planner.warnings:
+        report.findings.append(Finding.of("URS309", warning.message, warning.span,
+                                          warning.time))
+    if result.threads_left_running:
+        names = ", ".join(result.threads_left_running)
+        report.findings.append(Finding.of(
+            "URS311", f"the program ended while thread(s) {names} still ran; the controller "
+            "stops them", module.span, result.time, "join or kill threads before the end"))
+    if result.stopped_at_max_time:
+        report.findings.append(Finding.of(
+            "URS312", f"the program still ran after {options.max_time:g} s of robot time and "
+            "was stopped there (a cell program that loops forever?)", module.span,
+            options.max_time, "use --max-time to check longer"))
+
+    trace = sample(planner, options.sample_time or step)
+    report.trace = trace
+    report.cycle_time = float(max(result.time, trace.duration))
+    report.moves = [Move(s.kind, s.span, s.start, s.duration, s.params.get("lead"))
+                    for s in planner.segments]
+    report.findings.extend(_trace_findings(trace, planner, robot, options))
+    report.sort()
+    return report
+
+
+def _runtime_finding(error) -> Finding:
+    diagnostic = error.diagnostic
+    if error.kind == "ik":
+        return Finding.of("URS301", diagnostic.message, diagnostic.span, error.time,
+                          diagnostic.hint)
+    return Finding(diagnostic.code, "error", diagnostic.message, diagnostic.span, error.time,
+                   diagnostic.hint)
+
+
+def _trace_findings(trace, planner, robot, options: CheckOptions) -> list[Finding]:
+    findings: list[Finding] = []
+    if len(trace.times) == 0 or not planner.segments:
+        return findings
+    jumps = checks.path_continuity(trace, robot.qd_max)
+    findings += jumps.findings
+    q_min = np.asarray(options.q_min if options.q_min is not None else robot.q_min)
+    q_max = np.asarray(options.q_max if options.q_max is not None else robot.q_max)
+    findings += checks.joint_limits(trace, q_min, q_max)
+    findings += checks.joint_speeds(trace, np.asarray(robot.qd_max), exclude=jumps.samples)
+    if options.joint_acceleration_limit is not None:
+        limits = np.broadcast_to(np.asarray(options.joint_acceleration_limit, float), (6,))
+        findings += checks.joint_accelerations(trace, limits, exclude=jumps.samples)
+    findings += checks.blend_radii(planner.segments)
+    if options.tcp_speed_limit is not None:
+        findings += checks.tcp_speed(trace, robot, options.tcp_speed_limit)
+    findings += checks.singularities(trace, robot, options.singularity_margin)
+    findings += checks.collisions(trace, robot, options.cell, options.collision_step,
+                                  options.self_collision)
+    return findings
