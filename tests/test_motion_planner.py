@@ -1,0 +1,177 @@
+"""Motion planning and timing, on a gantry robot whose joints are the TCP pose itself
+(x, y, z in m, then a rotation vector): the planner's timing rules are then visible in
+closed form, without the kinematics of an arm."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from urdsl.motion.geometry import rotation_matrix
+from urdsl.motion.planner import MotionPlanner
+from urdsl.motion.profiles import Trapezoid
+from urdsl.motion.trace import sample
+from urdsl.script.nodes import NO_SPAN
+
+
+class OutOfReach(Exception):
+    pass
+
+
+class Gantry:
+    """q = (x, y, z, rx, ry, rz); reach: |x|, |y|, |z| <= 1 m."""
+
+    def fk(self, q, tcp=None):
+        matrix = np.eye(4)
+        matrix[:3, :3] = rotation_matrix(q[3:])
+        matrix[:3, 3] = q[:3]
+        return matrix
+
+    def ik(self, pose, q_near, tcp=None):
+        from urdsl.motion.geometry import _log
+
+        if np.any(np.abs(pose[:3, 3]) > 1.0):
+            raise OutOfReach(pose[:3, 3])
+        return np.concatenate([pose[:3, 3], _log(pose[:3, :3])])
+
+    def ik_many(self, poses, q_near, tcp=None):
+        result = np.array([self.ik(p, None) if np.all(np.abs(p[:3, 3]) <= 1.0)
+                           else np.full(6, np.nan) for p in poses])
+        return result.reshape(len(poses), 6)
+
+
+def pose(x, y, z):
+    matrix = np.eye(4)
+    matrix[:3, 3] = (x, y, z)
+    return matrix
+
+
+def closed_form(distance, v, a):
+    if distance >= v * v / a:
+        return distance / v + v / a
+    return 2 * math.sqrt(distance / a)
+
+
+def planner(step=0.002):
+    return MotionPlanner(Gantry(), np.zeros(6), step_time=step)
+
+
+@pytest.mark.parametrize("distance,v,a", [(0.5, 0.25, 1.2), (0.01, 0.25, 1.2), (0.3, 1.0, 0.5)])
+def test_movel_takes_the_closed_form_trapezoid_time(distance, v, a):
+    arm = planner()
+    end = arm.movel(pose(distance, 0, 0), a, v, 0, 0, NO_SPAN, 0.0)
+    arm.finish(end)
+    assert end == pytest.approx(closed_form(distance, v, a), rel=1e-12)
+    trace = sample(arm)
+    assert trace.duration == pytest.approx(end, abs=arm.step_time)
+    assert np.abs(trace.qd[:, 0]).max() == pytest.approx(min(v, math.sqrt(a * distance)),
+                                                         rel=0.02)
+
+
+def test_movej_is_timed_by_the_leading_axis():
+    arm = planner()
+    target = np.array([0.1, -0.4, 0.2, 0.0, 0.0, 0.0])
+    end = arm.movej(target, 1.4, 1.05, 0, 0, NO_SPAN, 0.0)
+    assert end == pytest.approx(closed_form(0.4, 1.05, 1.4))
+    arm.finish(end)
+    trace = sample(arm)
+    # all joints start and stop together: the others move proportionally slower
+    ratio = trace.qd[:, 0] / np.where(trace.qd[:, 1] != 0, trace.qd[:, 1], np.nan)
+    assert np.nanmax(np.abs(ratio + 0.25)) < 1e-6
+    assert np.allclose(trace.q[-1], target)
+
+
+def test_time_has_priority_over_speed_and_acceleration():
+    arm = planner()
+    assert arm.movej(np.array([0.2, 0, 0, 0, 0, 0]), 1.4, 1.05, 3.0, 0, NO_SPAN, 0.0) == \
+        pytest.approx(3.0)
+    assert arm.movel(pose(0.0, 0, 0), 1.2, 0.25, 2.0, 0, NO_SPAN, 3.0) == pytest.approx(5.0)
+
+
+def test_a_blend_shortens_the_cycle_and_keeps_the_motion_smooth():
+    stopped, blended = planner(), planner()
+    for arm, radius in ((stopped, 0.0), (blended, 0.05)):
+        now = arm.movel(pose(0.3, 0, 0), 1.2, 0.25, 0, radius, NO_SPAN, 0.0)
+        now = arm.movel(pose(0.3, 0.3, 0), 1.2, 0.25, 0, 0, NO_SPAN, now)
+        arm.finish(now)
+    assert blended.end_time < stopped.end_time - 0.1
+    trace = sample(blended)
+    speed = np.linalg.norm(trace.qd[:, :3], axis=1)
+    middle = (trace.times > 0.5) & (trace.times < blended.end_time - 0.5)
+    assert speed[middle].min() > 0.1  # the TCP never stops at the waypoint
+    corner = np.linalg.norm(trace.q[:, :3] - [0.3, 0, 0], axis=1)
+    assert 0.0 < corner.min() < 0.05  # it passes inside the blend sphere, not through it
+    assert np.abs(np.diff(trace.q, axis=0)).max() < 0.25 * blended.step_time * 2
+
+
+def test_overlapping_blend_spheres_skip_the_move_with_a_warning():
+    arm = planner()
+    now = arm.movel(pose(0.2, 0, 0), 1.2, 0.25, 0, 0.05, NO_SPAN, 0.0)
+    now = arm.movel(pose(0.2, 0.06, 0), 1.2, 0.25, 0, 0.05, NO_SPAN, now)  # 0.05 + 0.05 > 0.06
+    arm.finish(now)
+    assert len(arm.segments) == 1 and len(arm.skipped) == 1
+    assert "Overlapping Blends" in arm.warnings[0].message
+
+
+def test_the_start_point_counts_as_radius_zero():
+    arm = planner()
+    arm.movel(pose(0.04, 0, 0), 1.2, 0.25, 0, 0.05, NO_SPAN, 0.0)
+    assert arm.skipped and not arm.segments
+
+
+def test_blends_that_just_fit_are_kept():
+    arm = planner()
+    now = arm.movel(pose(0.2, 0, 0), 1.2, 0.25, 0, 0.03, NO_SPAN, 0.0)
+    now = arm.movel(pose(0.2, 0.07, 0), 1.2, 0.25, 0, 0.03, NO_SPAN, now)
+    now = arm.movel(pose(0.0, 0.07, 0), 1.2, 0.25, 0, 0.0, NO_SPAN, now)
+    arm.finish(now)
+    assert not arm.skipped and len(arm.segments) == 3
+
+
+def test_servoj_moves_at_constant_speed_for_its_time():
+    arm = planner()
+    now = 0.0
+    for k in range(1, 101):
+        now = arm.servoj(np.array([0.001 * k, 0, 0, 0, 0, 0]), 0.002, NO_SPAN, now)
+    arm.finish(now)
+    assert now == pytest.approx(0.2)
+    trace = sample(arm)
+    assert np.allclose(trace.qd[2:-2, 0], 0.5, atol=1e-6)
+
+
+def test_speedj_cruises_for_t_then_stops():
+    arm = planner()
+    resume = arm.speedj(np.array([0.2, 0, 0, 0, 0, 0]), 0.5, 1.0, NO_SPAN, 0.0)
+    assert resume == pytest.approx(1.0)
+    arm.finish(arm.stop(resume))
+    assert arm.end_time == pytest.approx(1.0 + 0.2 / 0.5)
+    assert arm.target_joints[0] == pytest.approx(0.2 * 1.0)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.tuples(st.floats(-0.8, 0.8), st.floats(-0.8, 0.8), st.floats(0, 0.01)),
+                min_size=1, max_size=6),
+       st.floats(0, 1))
+def test_joints_at_agrees_with_the_sampled_trace(waypoints, where):
+    arm = planner()
+    now = 0.0
+    for x, y, radius in waypoints:
+        now = arm.movel(pose(x, y, 0.0), 1.2, 0.25, 0, radius, NO_SPAN, now)
+    arm.finish(now)
+    trace = sample(arm)
+    index = int(where * (len(trace.times) - 1))
+    assert np.allclose(arm.joints_at(float(trace.times[index])), trace.q[index], atol=1e-9)
+
+
+def test_trapezoid_profile_is_consistent():
+    profile = Trapezoid.plan(0.5, 0.25, 1.2)
+    times = np.linspace(0, profile.duration, 1001)
+    positions = profile.position(times)
+    assert positions[0] == 0 and positions[-1] == pytest.approx(0.5)
+    assert np.all(np.diff(positions) >= -1e-15)
+    for s in (0.0, 0.01, 0.25, 0.49, 0.5):
+        assert profile.position(profile.time_at(s)) == pytest.approx(s, abs=1e-12)
