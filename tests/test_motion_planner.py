@@ -23,7 +23,16 @@ class OutOfReach(Exception):
 
 
 class Gantry:
-    """q = (x, y, z, rx, ry, rz); reach: |x|, |y|, |z| <= 1 m."""
+    """q = (x, y, z, rx, ry, rz); reach: a 1 m box, with ``hole`` outside a column of 0.1 m
+    around the z axis (like a UR's base)."""
+
+    def __init__(self, hole: bool = False) -> None:
+        self.hole = hole
+
+    def reachable(self, position) -> bool:
+        position = np.asarray(position)
+        outside = not self.hole or np.hypot(*position[:2]) >= 0.1
+        return bool(np.all(np.abs(position) <= 1.0) and outside)
 
     def fk(self, q, tcp=None):
         matrix = np.eye(4)
@@ -34,13 +43,13 @@ class Gantry:
     def ik(self, pose, q_near, tcp=None):
         from urdsl.motion.geometry import _log
 
-        if np.any(np.abs(pose[:3, 3]) > 1.0):
+        if not self.reachable(pose[:3, 3]):
             raise OutOfReach(pose[:3, 3])
         return np.concatenate([pose[:3, 3], _log(pose[:3, :3])])
 
     def ik_many(self, poses, q_near, tcp=None):
-        result = np.array([self.ik(p, None) if np.all(np.abs(p[:3, 3]) <= 1.0)
-                           else np.full(6, np.nan) for p in poses])
+        result = np.array([self.ik(p, None) if self.reachable(p[:3, 3]) else np.full(6, np.nan)
+                           for p in poses])
         return result.reshape(len(poses), 6)
 
 
@@ -56,8 +65,8 @@ def closed_form(distance, v, a):
     return 2 * math.sqrt(distance / a)
 
 
-def planner(step=0.002):
-    return MotionPlanner(Gantry(), np.zeros(6), step_time=step)
+def planner(step=0.002, start=(0, 0, 0, 0, 0, 0), hole=False):
+    return MotionPlanner(Gantry(hole), np.array(start, dtype=float), step_time=step)
 
 
 @pytest.mark.parametrize("distance,v,a", [(0.5, 0.25, 1.2), (0.01, 0.25, 1.2), (0.3, 1.0, 0.5)])
@@ -175,3 +184,16 @@ def test_trapezoid_profile_is_consistent():
     assert np.all(np.diff(positions) >= -1e-15)
     for s in (0.0, 0.01, 0.25, 0.49, 0.5):
         assert profile.position(profile.time_at(s)) == pytest.approx(s, abs=1e-12)
+
+
+def test_samples_out_of_reach_are_marked_and_the_trace_stays_finite():
+    arm = planner(start=(-0.5, 0.02, 0, 0, 0, 0), hole=True)
+    arm.finish(arm.movel(pose(0.5, 0.02, 0), 1.2, 0.25, 0, 0, NO_SPAN, 0.0))
+    trace = sample(arm)
+    assert np.isfinite(trace.q).all()
+    inside = trace.unreachable.nonzero()[0]
+    assert len(inside) > 0
+    x = 0.02
+    crossing = np.abs(trace.q[inside[0] - 1, 0])
+    assert crossing == pytest.approx(np.sqrt(0.1 ** 2 - x ** 2), abs=0.01)
+    assert np.allclose(trace.q[-1, :3], (0.5, 0.02, 0))

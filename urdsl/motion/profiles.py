@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Trapezoid"]
+__all__ = ["Trapezoid", "positions"]
 
 
 @dataclass(frozen=True)
@@ -77,15 +77,8 @@ class Trapezoid:
 
     def position(self, t: np.ndarray | float) -> np.ndarray:
         """Distance covered at times ``t`` (s from the start), clipped to [0, duration]."""
-        t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
-        a, ta, tf = self.accel, self.t_acc, self.t_flat
-        if self.distance == 0.0:
-            return np.zeros_like(t)
-        rising = 0.5 * a * t * t
-        cruising = 0.5 * a * ta * ta + self.peak * (t - ta)
-        rest = self.duration - t
-        falling = self.distance - 0.5 * a * rest * rest
-        return np.where(t < ta, rising, np.where(t < ta + tf, cruising, falling))
+        t = np.asarray(t, dtype=float)
+        return positions(t, self.distance, self.accel, self.peak, self.t_acc, self.t_flat)
 
     def speed(self, t: np.ndarray | float) -> np.ndarray:
         """Speed at times ``t`` (units/s)."""
@@ -112,3 +105,17 @@ class Trapezoid:
             return ta + (s - d_acc) / self.peak
         rest = self.distance - s
         return self.duration - math.sqrt(2.0 * rest / a)
+
+
+def positions(t, distance, accel, peak, t_acc, t_flat) -> np.ndarray:
+    """Distance covered at times ``t`` (s since each profile's start) for many profiles at
+    once: every argument is a scalar or an array broadcasting with ``t``; times are clipped
+    to [0, duration]. A profile of zero distance stays at 0."""
+    duration = 2.0 * t_acc + t_flat
+    t = np.clip(t, 0.0, duration)
+    rising = 0.5 * accel * t * t
+    cruising = 0.5 * accel * t_acc * t_acc + peak * (t - t_acc)
+    rest = duration - t
+    falling = distance - 0.5 * accel * rest * rest
+    result = np.where(t < t_acc, rising, np.where(t < t_acc + t_flat, cruising, falling))
+    return np.where(distance == 0.0, 0.0, result)

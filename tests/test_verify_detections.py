@@ -1,0 +1,209 @@
+"""Each problem the verifier knows, detected at the right line, in a small program of its own.
+
+Programs start with a movej to known joints and build their poses from the pose reached
+there, so they hold for the model under test without hand-computed coordinates.
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+
+import pytest
+
+from urdsl.verify.run import CheckOptions, check_text
+
+READY = "movej([0, -1.9, 1.9, -1.57, -1.57, 0])"  # tool down, in front of the robot
+
+
+def check(body: str, robot: str = "ur5e", **options):
+    text = textwrap.dedent(body).lstrip("\n")
+    return check_text(text, "test.script", options=CheckOptions(robot=robot, **options))
+
+
+def only(report, code):
+    found = [f for f in report.findings if f.code == code]
+    assert found, f"expected {code}, got:\n{report.render_text()}"
+    return found
+
+
+def test_a_clean_program_has_no_findings_and_a_cycle_time():
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]), r=0.02)
+        movel(pose_add(home, p[0.1, 0.1, 0, 0, 0, 0]), r=0.02)
+        movel(home)
+        """)
+    assert [f for f in report.findings if f.severity != "info"] == [], report.render_text()
+    assert len(report.moves) == 4
+    assert report.cycle_time == pytest.approx(report.moves[-1].start
+                                              + report.moves[-1].duration, abs=0.01)
+
+
+def test_overlapping_blends_skip_the_move_with_a_warning():
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]), r=0.05)
+        movel(pose_add(home, p[0.1, 0.06, 0, 0, 0, 0]), r=0.05)
+        movel(home)
+        """)
+    (finding,) = only(report, "URS309")
+    assert finding.severity == "warning" and finding.span.line == 4
+    assert "Overlapping Blends" in finding.message
+    assert not report.has_errors
+    assert [m.span.line for m in report.moves] == [1, 3, 5]
+
+
+def test_unreachable_pose():
+    report = check(f"""
+        {READY}
+        textmsg("going far")
+        movel(p[1.5, 0.2, 0.3, 0, 3.1416, 0])
+        """)
+    (finding,) = only(report, "URS301")
+    assert finding.severity == "error" and (finding.span.line, finding.span.column) == (3, 1)
+    assert report.has_errors
+
+
+def test_movel_through_an_unreachable_region_between_reachable_ends():
+    # The straight line from one side of the base to the other passes the base's axis,
+    # where no UR can put its wrist (the shoulder offset keeps it away).
+    report = check("""
+        movej(get_inverse_kin(p[0.35, -0.2, 0.3, 0, 3.1416, 0]))
+        movel(p[-0.35, 0.2, 0.3, 0, 3.1416, 0])
+        """)
+    found = only(report, "URS302")
+    assert found[0].span.line == 2
+    assert "URS301" not in report.codes()
+
+
+def test_joint_position_limit():
+    report = check(f"""
+        {READY}
+        movej([0, -1.9, 1.9, -1.57, -1.57, 6.5])
+        """)
+    (finding,) = only(report, "URS303")
+    assert finding.span.line == 2 and "wrist 3" in finding.message
+
+
+def test_joint_speed_over_the_model_limit():
+    report = check(f"""
+        {READY}
+        movej([3, -1.9, 1.9, -1.57, -1.57, 0], a=20, v=5)
+        """)
+    (finding,) = only(report, "URS304")
+    assert finding.span.line == 2 and "base" in finding.message
+
+
+def test_wrist_singularity_during_a_movel():
+    report = check("""
+        movej([0.3, -1.6, 1.6, -1.57, 0.25, 0])
+        a = get_actual_tcp_pose()
+        movej([0.3, -1.6, 1.6, -1.57, -0.25, 0])
+        b = get_actual_tcp_pose()
+        movej([0.3, -1.6, 1.6, -1.57, 0.25, 0])
+        movel(b)
+        """)
+    found = [f for f in report.findings if f.code in ("URS307", "URS302")]
+    assert found and found[0].span.line == 6, report.render_text()
+    assert any(f.code == "URS307" and "wrist" in f.message for f in report.findings)
+
+
+def test_collision_with_the_floor(tmp_path):
+    cell = tmp_path / "cell.toml"
+    cell.write_text("[floor]\nz = 0.0\n")
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        movel(pose_add(home, p[0, 0, -0.2, 0, 0, 0]))
+        movel(pose_add(home, p[0, 0, -1.0, 0, 0, 0]))
+        """, cell=str(cell))
+    (finding,) = only(report, "URS308")
+    assert finding.span.line == 4 and finding.severity == "error"
+
+
+def test_undefined_variable_at_runtime():
+    report = check(f"""
+        {READY}
+        movel(target)
+        """)
+    (finding,) = only(report, "URS201")
+    assert (finding.span.line, finding.span.column) == (2, 7)
+
+
+def test_index_out_of_range():
+    report = check("""
+        q = [0, -1.9, 1.9, -1.57, -1.57, 0]
+        movej(q)
+        x = q[6]
+        """)
+    (finding,) = only(report, "URS202")
+    assert finding.span.line == 3
+
+
+def test_a_thread_busy_looping_without_sync():
+    report = check(f"""
+        thread watch():
+          while True:
+            x = 1
+          end
+        end
+        {READY}
+        t = run watch()
+        sleep(1)
+        """)
+    (finding,) = only(report, "URS207")
+    assert finding.span.line == 2
+
+
+def test_threads_left_running_and_time_limit():
+    report = check(f"""
+        thread beat():
+          while True:
+            sleep(0.5)
+          end
+        end
+        {READY}
+        t = run beat()
+        """)
+    assert "URS311" in report.codes()
+    forever = check("""
+        while True:
+          sleep(1)
+        end
+        """, max_time=20)
+    assert "URS312" in forever.codes() and not forever.has_errors
+
+
+def test_tcp_speed_limit():
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        movel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), v=0.5)
+        movel(home, v=0.2)
+        """, tcp_speed_limit=0.25)
+    (finding,) = only(report, "URS306")
+    assert finding.span.line == 3
+
+
+@pytest.mark.parametrize("distance,v,a", [(0.2, 0.25, 1.2), (0.02, 0.25, 1.2)])
+def test_single_movel_lasts_the_closed_form_time(distance, v, a):
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        movel(pose_add(home, p[{distance}, 0, 0, 0, 0, 0]), a={a}, v={v})
+        """)
+    expected = distance / v + v / a if distance >= v * v / a else 2 * math.sqrt(distance / a)
+    assert report.moves[1].duration == pytest.approx(expected, rel=1e-9)
+
+
+def test_single_movej_lasts_the_closed_form_time_of_the_leading_axis():
+    report = check("""
+        movej([0, -1.9, 1.9, -1.57, -1.57, 0])
+        movej([1.0, -1.5, 1.9, -1.57, -1.57, 0], a=1.4, v=1.05)
+        """, start_joints=(0, -1.9, 1.9, -1.57, -1.57, 0))
+    expected = 1.0 / 1.05 + 1.05 / 1.4
+    assert report.moves[1].duration == pytest.approx(expected, rel=1e-9)
+    assert report.cycle_time == pytest.approx(expected, abs=0.003)
