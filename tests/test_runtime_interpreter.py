@@ -206,3 +206,21 @@ def test_unsupported_builtin_is_an_event_by_default():
     result = run("modbus_set_output_signal(\"x\", True, False)\n")
     assert result.error is None
     assert any(e.kind == "unsupported" for e in result.events)
+
+
+def test_pace_sees_robot_time_advance_and_can_stop_the_program():
+    seen: list[float] = []
+    holder: dict = {}
+
+    def pace(when: float) -> None:
+        seen.append(when)
+        if when >= 2.0:
+            holder["rt"].request_stop()
+
+    text = "i = 0\nwhile True:\n  i = i + 1\n  sleep(0.5)\nend\n"
+    rt = Interpreter(parse(text, "t.script"), config=RuntimeConfig(pace=pace))
+    holder["rt"] = rt
+    result = rt.run()
+    assert result.stopped and result.error is None
+    assert seen == [0.5, 1.0, 1.5, 2.0]
+    assert result.globals["i"] == 4 and result.time == 1.5

@@ -59,6 +59,10 @@ class RuntimeConfig:
     runaway_limit: int = 200_000
     max_time: float = 3600.0
     max_call_depth: int = 200
+    pace: Callable[[float], None] | None = None
+    """Called with the robot time (s) the program is about to advance to, before it does:
+    the virtual controller sleeps there to run in real time. ``None`` (the verifier): robot
+    time jumps from event to event."""
 
 
 @dataclass(frozen=True)
@@ -81,6 +85,7 @@ class RunResult:
     events: list[Event] = field(default_factory=list)
     error: ScriptRuntimeError | None = None
     stopped_at_max_time: bool = False
+    stopped: bool = False
     threads_left_running: list[str] = field(default_factory=list)
     globals: dict[str, Any] = field(default_factory=dict)
 
@@ -154,6 +159,7 @@ class Interpreter:
         self.current: Thread | None = None
         self.critical: Thread | None = None
         self.halted = False
+        self.stop_requested = False
         self._threads: list[Thread] = []
         self._order = 0
         self._scheduler: greenlet.greenlet | None = None
@@ -200,6 +206,11 @@ class Interpreter:
             if thread.wake > self.config.max_time:
                 result.stopped_at_max_time = True
                 self.time = self.config.max_time
+                break
+            if thread.wake > self.time and self.config.pace is not None:
+                self.config.pace(thread.wake)
+            if self.stop_requested:
+                result.stopped = True
                 break
             self.time = max(self.time, thread.wake)
             self.current = thread
@@ -250,6 +261,11 @@ class Interpreter:
             joiner.wake = self.time
         for child in thread.children:
             self._kill(child)
+
+    def request_stop(self) -> None:
+        """Stop the program at its next step in time (a dashboard ``stop``, a new program
+        replacing it); safe to call from the ``pace`` callback or another thread."""
+        self.stop_requested = True
 
     # ---- what builtins and statements call -------------------------------------------------
 
