@@ -183,7 +183,7 @@ def test_tcp_speed_limit():
         home = get_actual_tcp_pose()
         movel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), v=0.5)
         movel(home, v=0.2)
-        """, tcp_speed_limit=0.25)
+        """, tcp_speed_limit=0.25, start_joints=(0, -1.9, 1.9, -1.57, -1.57, 0))
     (finding,) = only(report, "URS306")
     assert finding.span.line == 3
 

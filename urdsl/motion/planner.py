@@ -269,8 +269,8 @@ class MotionPlanner:
         qd = np.asarray(qd, dtype=float)
         lead = float(np.max(np.abs(qd)))
         q_from = self._q
-        if lead == 0.0:
-            return self.stop(now)
+        if lead == 0.0:  # a zero speed command still lasts its t
+            return max(self.stop(now), now + t)
         t = t if t > 0 else lead / a
         profile = Trapezoid.plan(lead * t, lead, a)
         q_to = q_from + qd / lead * profile.distance
@@ -287,7 +287,7 @@ class MotionPlanner:
         linear = float(np.linalg.norm(xd[:3]))
         angular = float(np.linalg.norm(xd[3:]))
         if linear == 0.0 and angular == 0.0:
-            return self.stop(now)
+            return max(self.stop(now), now + t)
         speed = linear if linear > 0 else angular
         t = t if t > 0 else speed / a
         pose_from = self.fk(self._q)

@@ -104,8 +104,8 @@ class BuiltinTable:
             raise rt.error("unsupported", f"{row.name}() is not simulated by urdsl", node)
         rt.event("unsupported", f"{row.name}() is not simulated; it did nothing here", node.span)
         kind = row.returns[0] if row.returns else "None"
-        if kind == "Array":
-            return ListValue([])
+        if kind == "Array":  # nearly all of them return a 6-vector (joints, wrench, speeds)
+            return ListValue([0.0] * 6)
         if kind == "Pose":
             return PoseValue([0.0] * 6)
         return _NEUTRAL.get(kind)
@@ -346,6 +346,28 @@ def _make_list(rt, node, length, initial_value, capacity=None):
     if capacity < length:
         raise rt.error("index", "make_list: capacity is smaller than length", node)
     return ListValue([initial_value] * length, capacity)
+
+
+@implements("inv")
+def _inv(rt, node, m):
+    rows = _matrix_rows(rt, node, m, "inv")
+    if len(rows) != len(rows[0]):
+        raise rt.error("type", f"inv() needs a square matrix, got {len(rows)}x{len(rows[0])}",
+                       node)
+    import numpy as np
+
+    matrix = np.array(rows, dtype=float)
+    if abs(np.linalg.det(matrix)) < 1e-300 or np.linalg.cond(matrix) > 1e15:
+        raise rt.error("arithmetic", "inv() of a singular matrix", node)
+    return ListValue([ListValue(list(map(float, row))) for row in np.linalg.inv(matrix)])
+
+
+def _matrix_rows(rt, node, m, name: str) -> list[list[float]]:
+    if (type(m) is not ListValue or not m or not all(type(r) is ListValue for r in m)
+            or len({len(r) for r in m}) != 1 or not all(is_number(v) for r in m for v in r)):
+        raise rt.error("type", f"{name}() needs a matrix of numbers, not a {type_name(m)}",
+                       node)
+    return [[float(v) for v in row] for row in m]
 
 
 @implements("transpose")

@@ -56,7 +56,7 @@ class RuntimeConfig:
     """
 
     step_time: float = 0.002
-    runaway_limit: int = 200_000
+    runaway_limit: int = 50_000
     max_time: float = 3600.0
     max_call_depth: int = 200
     pace: Callable[[float], None] | None = None

@@ -358,3 +358,16 @@ def _rotvec2rpy(rt, node, rotation_vector):
 @implements("rpy2rotvec")
 def _rpy2rotvec(rt, node, rpy_vector):
     return _vector(posemath.rpy2rotvec(_numbers(rt, node, rpy_vector, 3, "the RPY vector")))
+
+
+@implements("wrench_trans")
+def _wrench_trans(rt, node, T_from_to, w_from):  # noqa: N803 - the catalog's parameter name
+    """Move a wrench [Fx, Fy, Fz, Mx, My, Mz] (N, N·m) into the frame ``T_from_to`` (the
+    new frame's pose in the old one): ``f' = Rᵀf``, ``m' = Rᵀ(m − p × f)`` [U: the manual
+    gives no formula; this is the rigid-body transformation of a wrench]."""
+    matrix = posemath.to_matrix(_pose(rt, node, T_from_to, "T_from_to"))
+    wrench = _numbers(rt, node, w_from, 6, "w_from")
+    rotation, offset = matrix[:3, :3], matrix[:3, 3]
+    force = rotation.T @ wrench[:3]
+    moment = rotation.T @ (wrench[3:] - np.cross(offset, wrench[:3]))
+    return _vector(np.concatenate([force, moment]))

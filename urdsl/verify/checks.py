@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..motion.planner import JOINT_SPACE
 from ..motion.trace import Trace
 from .findings import Finding
 
@@ -71,9 +72,15 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
             "URS304",
             f"{JOINTS[joint]} joint turns at {peak:.2f} rad/s, over its limit of "
             f"{limits[joint]:.2f} rad/s",
-            _span(trace, segment), float(trace.times[sample]),
-            "lower v (rad/s for movej, m/s for movel) or lengthen t"))
+            _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment)))
     return findings
+
+
+def _speed_hint(trace: Trace, segment: int) -> str:
+    kind = trace.segments[segment].kind if segment >= 0 else ""
+    if kind in JOINT_SPACE:
+        return f"lower v (rad/s of the leading joint) or lengthen t of this {kind}"
+    return f"lower v (m/s of the TCP) of this {kind}, or move further from singularities"
 
 
 def joint_accelerations(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = None
@@ -196,8 +203,7 @@ def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
         peak = float(np.max(speed[trace.segment == segment]))
         findings.append(Finding.of(
             "URS306", f"the TCP moves at {peak:.3f} m/s, over the cell's limit of {limit:g} m/s",
-            _span(trace, segment), float(trace.times[sample]),
-            "lower v (movej's v is a joint speed: lower it or use movel with v in m/s)"))
+            _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment)))
     return findings
 
 
@@ -215,12 +221,16 @@ def singularities(trace: Trace, robot, margin: float | None = None,
     if len(index) == 0:
         return []
     measures = robot.singularity(trace.q[index])
+    # Joint moves pass singular configurations harmlessly; on a TCP path (and in blends into
+    # one) the joint speeds needed near them grow without bound.
+    kinds = np.array([s.kind not in JOINT_SPACE for s in trace.segments] + [False])
+    cartesian = kinds[trace.segment]
     findings = []
     for kind, default in SINGULARITY_MARGINS.items():
         limit = default if margin is None else margin
         close = np.zeros(len(trace.times), dtype=bool)
         close[index] = np.abs(np.asarray(measures[kind])) < limit
-        close &= trace.segment >= 0
+        close &= cartesian
         for segment, sample in _per_segment(trace, close):
             move = trace.segments[segment]
             findings.append(Finding.of(

@@ -21,6 +21,7 @@ from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
 from ..runtime import Environment, Interpreter, RuntimeConfig
 from ..script.diagnostics import ScriptSyntaxError
+from ..script.nodes import NO_SPAN
 from ..script.parser import parse
 from . import checks
 from .findings import Finding
@@ -74,7 +75,7 @@ def check_text(text: str, filename: str = "<script>", *, robot: str = "ur5e",
     except ScriptSyntaxError as error:
         report = Report(filename, options.robot)
         report.findings.append(Finding(error.diagnostic.code or "URS001", "error",
-                                       error.diagnostic.message, error.diagnostic.span,
+                                       error.diagnostic.message, error.span or NO_SPAN,
                                        None, error.diagnostic.hint))
         return report
     return check_tree(module, filename, options)
@@ -142,9 +143,9 @@ def check_tree(module, filename: str, options: CheckOptions) -> Report:
 def _runtime_finding(error) -> Finding:
     diagnostic = error.diagnostic
     if error.kind == "ik":
-        return Finding.of("URS301", diagnostic.message, diagnostic.span, error.time,
+        return Finding.of("URS301", diagnostic.message, error.span, error.time,
                           diagnostic.hint)
-    return Finding(diagnostic.code, "error", diagnostic.message, diagnostic.span, error.time,
+    return Finding(diagnostic.code, "error", diagnostic.message, error.span, error.time,
                    diagnostic.hint)
 
 
