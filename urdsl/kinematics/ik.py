@@ -45,12 +45,15 @@ def wrap(q: np.ndarray) -> np.ndarray:
 
 
 def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float, d6: float,
-             q6_hint: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+             q6_hint: np.ndarray | None = None,
+             reach_tolerance: float = REACH_TOLERANCE) -> tuple[np.ndarray, np.ndarray]:
     """All analytic solutions for flange poses ``T`` (N, 4, 4).
 
     Returns ``(solutions, miss)``: joint vectors (N, 8, 6) wrapped to (−π, π] with NaN rows
     for branches that do not exist, and (N, 8) distances out of reach [m] (0 where solved).
-    ``q6_hint`` (N,) is used for θ6 at the wrist singularity.
+    ``q6_hint`` (N,) is used for θ6 at the wrist singularity. Branches out of reach by less
+    than ``reach_tolerance`` [m] are still solved (on the boundary; their miss is reported),
+    which lets a calibrated arm refine them.
     """
     T = np.asarray(T, dtype=float)
     n = T.shape[0]
@@ -122,7 +125,7 @@ def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: floa
     miss = np.maximum(np.broadcast_to(miss_shoulder[:, None, None, None], shape),
                       np.broadcast_to(miss_elbow[..., None], shape)).reshape(n, 8)
     solutions = wrap(solutions)
-    solutions[miss > REACH_TOLERANCE] = np.nan
+    solutions[miss > max(reach_tolerance, REACH_TOLERANCE)] = np.nan
     return solutions, np.where(miss > REACH_TOLERANCE, miss, 0.0)
 
 
