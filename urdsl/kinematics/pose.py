@@ -145,15 +145,18 @@ def rpy_to_matrix(rpy) -> np.ndarray:
 def matrix_to_rpy(rotation) -> np.ndarray:
     """(roll, pitch, yaw) [rad] of rotation matrices, pitch in [−π/2, π/2].
 
-    At gimbal lock (pitch = ±π/2) only roll ∓ yaw is defined; roll is then returned as 0.
+    ``yaw = atan2(R10, R00)``; roll and pitch are then read from ``M = Rz(−yaw)·R =
+    Ry(pitch)·Rx(roll)``, which keeps the three angles consistent near gimbal lock
+    (pitch = ±π/2, where only roll ∓ yaw is defined; exactly there yaw is returned as 0).
     """
     m = np.asarray(rotation, dtype=float)
-    cos_pitch = np.hypot(m[..., 0, 0], m[..., 1, 0])
-    pitch = np.arctan2(-m[..., 2, 0], cos_pitch)
-    locked = cos_pitch < 1e-12
-    yaw = np.where(locked, np.arctan2(-m[..., 0, 1], m[..., 1, 1]),
-                   np.arctan2(m[..., 1, 0], m[..., 0, 0]))
-    roll = np.where(locked, 0.0, np.arctan2(m[..., 2, 1], m[..., 2, 2]))
+    yaw = np.arctan2(m[..., 1, 0], m[..., 0, 0])
+    cy, sy = np.cos(yaw), np.sin(yaw)
+    m00 = cy * m[..., 0, 0] + sy * m[..., 1, 0]
+    m11 = cy * m[..., 1, 1] - sy * m[..., 0, 1]
+    m12 = cy * m[..., 1, 2] - sy * m[..., 0, 2]
+    pitch = np.arctan2(-m[..., 2, 0], m00)
+    roll = np.arctan2(-m12, m11)
     return np.stack([roll, pitch, yaw], axis=-1)
 
 
