@@ -9,8 +9,10 @@ closed-form solutions per flange pose ``T = [x6 y6 z6 p]`` (the same structure a
    ``r, φ`` the polar coordinates of ``p5`` in the xy plane (needs ``r ≥ |d4|``);
 2. ``z6·n1 = cos θ5`` and ``|(x6·n1, y6·n1)| = |sin θ5|`` give ``θ5 = ±atan2(|…|, z6·n1)``
    (accurate near θ5 = 0, unlike an arccos; it always exists once θ1 does);
-3. ``x6·n1 = s5·c6`` and ``y6·n1 = −s5·s6`` give θ6 (free when ``s5 = 0``, the wrist
-   singularity: then it is taken from a hint, 0 by default);
+3. ``x6·n1 = s5·c6`` and ``y6·n1 = −s5·s6`` give θ6. At the wrist singularity (``s5 = 0``)
+   only ``θ234 + cos θ5·θ6`` is determined: θ6 is taken from a hint (0 by default), moved
+   just enough to keep the wrist-1 point within the arm's reach (see
+   :func:`_wrist_singular_split`);
 4. ``w = s6·x6 + c6·y6 = (−c1·S, −s1·S, C)`` gives ``θ234 = atan2(S, C)``;
 5. the wrist-1 point ``p4 = p5 − d5·(c1·S, s1·S, −C)`` in the arm plane,
    ``(u, v) = (c1·p4x + s1·p4y, p4z − d1)``, is reached by the planar two-link arm a2, a3:
@@ -41,7 +43,8 @@ WRIST_SINGULAR = 1e-12
 
 def wrap(q: np.ndarray) -> np.ndarray:
     """Angles wrapped to (−π, π] [rad]."""
-    return np.pi - np.mod(np.pi - q, 2.0 * np.pi)
+    out = np.pi - np.mod(np.pi - q, 2.0 * np.pi)
+    return np.where(out <= -np.pi, out + 2.0 * np.pi, out)  # mod may round up to 2π
 
 
 def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float, d6: float,
@@ -95,6 +98,12 @@ def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: floa
     big_s = -(c1b * wx + s1b * wy)
     big_c = wz
     theta234 = np.arctan2(big_s, big_c)
+    if np.any(singular):
+        theta234, theta6 = _wrist_singular_split(theta234, theta6, singular, np.cos(theta5),
+                                                  c1b * p5[:, 0, None, None]
+                                                  + s1b * p5[:, 1, None, None],
+                                                  p5[:, 2, None, None] - d1, a2, a3, d5)
+        big_s, big_c = np.sin(theta234), np.cos(theta234)
 
     # 5. planar two-link arm, two θ3 per (θ1, θ5): shape (N, 2, 2, 2)
     p4x = p5[:, 0, None, None] - d5 * c1b * big_s
@@ -129,6 +138,33 @@ def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: floa
     return solutions, np.where(miss > REACH_TOLERANCE, miss, 0.0)
 
 
+def _wrist_singular_split(theta234, theta6, singular, c5, u5, v5, a2, a3, d5):
+    """At the wrist singularity (sin θ5 = 0) only ``θ234 + cos θ5·θ6`` is fixed by the
+    orientation, while θ234 alone places the wrist-1 point on a circle of radius d5 around
+    the wrist centre ``(u5, v5)`` in the arm plane. Keep θ6 from the hint when that point is
+    reachable by the two-link arm; otherwise move θ234 (and θ6 with it) the least amount that
+    brings the point onto the reachable annulus.
+
+    With ``|c| = |(u5, v5)|`` and ``ψ = atan2(−u5, v5)`` the wrist-1 distance is
+    ``L² = |c|² + d5² + 2·d5·|c|·cos(θ234 − ψ)``.
+    """
+    centre = np.hypot(u5, v5)
+    psi = np.arctan2(-u5, v5)
+    outer, inner = abs(a2) + abs(a3), abs(abs(a2) - abs(a3))
+    denominator = 2.0 * d5 * np.maximum(centre, 1e-300)
+    k_out = (outer ** 2 - centre ** 2 - d5 ** 2) / denominator
+    k_in = (inner ** 2 - centre ** 2 - d5 ** 2) / denominator
+    low = np.arccos(np.clip(k_out, -1.0, 1.0))    # |θ234 − ψ| ≥ low keeps L ≤ outer
+    high = np.arccos(np.clip(k_in, -1.0, 1.0))    # |θ234 − ψ| ≤ high keeps L ≥ inner
+    delta = wrap(theta234 - psi)
+    side = np.where(delta < 0.0, -1.0, 1.0)
+    clamped = psi + side * np.clip(np.abs(delta), low, np.maximum(high, low))
+    adjust = singular & (centre > 1e-12) & (low <= high)
+    new234 = np.where(adjust, clamped, theta234)
+    new6 = np.where(adjust, theta6 - c5 * (new234 - theta234), theta6)
+    return new234, new6
+
+
 def choose_nearest(solutions: np.ndarray, q_near: np.ndarray, q_min: np.ndarray,
                    q_max: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The controller's choice among ``solutions`` (N, K, 6): the one closest to ``q_near``
@@ -140,8 +176,8 @@ def choose_nearest(solutions: np.ndarray, q_near: np.ndarray, q_min: np.ndarray,
     near = q_near[:, None, :]
     shifted = near + wrap(solutions - near)
     two_pi = 2.0 * np.pi
-    shifted = np.where(shifted > q_max, shifted - two_pi, shifted)
-    shifted = np.where(shifted < q_min, shifted + two_pi, shifted)
+    shifted = shifted - two_pi * np.ceil(np.maximum(shifted - q_max, 0.0) / two_pi)
+    shifted = shifted + two_pi * np.ceil(np.maximum(q_min - shifted, 0.0) / two_pi)
     fits = np.all((shifted >= q_min) & (shifted <= q_max), axis=2)
     cost = np.sum((shifted - near) ** 2, axis=2)
     cost = np.where(fits & np.isfinite(cost), cost, np.inf)
