@@ -581,3 +581,7 @@ def _socket_set_var(rt, node, name, value, socket_name="socket_0"):
 def _rpc_factory(rt, node, type, url):  # noqa: A002
     rt.event("rpc", f"rpc_factory({type!r}, {url!r}): calls are recorded, not made", node.span)
     return _RemoteHandle(str(type), str(url))
+
+
+# Motion, robot state and pose maths register themselves from their own module.
+from . import motion_builtins  # noqa: E402,F401

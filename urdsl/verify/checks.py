@@ -207,15 +207,20 @@ def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
     return findings
 
 
-SINGULARITY_MARGINS = {"shoulder": 0.03, "elbow": 0.03, "wrist": 0.03}
-"""Default distances to a singularity below which URS307 warns, in the units of
-:meth:`urdsl.kinematics.Robot.singularity` (see there)."""
+SINGULARITY_MARGINS = {"shoulder": 0.05, "elbow": 0.02, "wrist": 0.05}
+"""Distances to a singularity below which URS307 warns, in the units of
+:meth:`urdsl.kinematics.Robot.singularity`: the wrist centre 5 cm from the vertical plane
+through the base axis (shoulder), the arm 2 cm from fully stretched or folded (elbow), the
+wrist-1 and wrist-3 axes 0.05 rad (2.9°) from parallel (wrist)."""
+
+_UNITS = {"shoulder": "m", "elbow": "m", "wrist": "rad"}
 
 
-def singularities(trace: Trace, robot, margin: float | None = None,
+def singularities(trace: Trace, robot, scale: float | None = None,
                   step: float = 0.01) -> list[Finding]:
-    """URS307: the arm comes close to a shoulder, elbow or wrist singularity, checked every
-    ``step`` s of robot time (also inside blends); ``margin`` replaces the defaults."""
+    """URS307: on a TCP path (also inside blends) the arm comes closer to a shoulder, elbow or
+    wrist singularity than :data:`SINGULARITY_MARGINS` times ``scale`` (default 1), checked
+    every ``step`` s of robot time."""
     stride = max(1, int(round(step / trace.dt)))
     index = np.arange(0, len(trace.times), stride)
     if len(index) == 0:
@@ -227,7 +232,7 @@ def singularities(trace: Trace, robot, margin: float | None = None,
     cartesian = kinds[trace.segment]
     findings = []
     for kind, default in SINGULARITY_MARGINS.items():
-        limit = default if margin is None else margin
+        limit = default * (1.0 if scale is None else scale)
         close = np.zeros(len(trace.times), dtype=bool)
         close[index] = np.abs(np.asarray(measures[kind])) < limit
         close &= cartesian
@@ -236,7 +241,7 @@ def singularities(trace: Trace, robot, margin: float | None = None,
             findings.append(Finding.of(
                 "URS307",
                 f"{kind} singularity: the {move.kind} passes within "
-                f"{abs(float(measures[kind][sample // stride])):.3g} of it at "
+                f"{abs(float(measures[kind][sample // stride])):.3g} {_UNITS[kind]} of it at "
                 f"t={trace.times[sample]:.3f} s (joint speeds grow without bound there)",
                 _span(trace, segment), float(trace.times[sample]),
                 _SINGULARITY_HINTS[kind]))

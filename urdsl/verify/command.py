@@ -72,9 +72,9 @@ def add_commands(commands) -> None:
     p.add_argument("--joint-acceleration-limit", type=float, metavar="RAD_PER_S2",
                    help="maximum joint acceleration in rad/s² (UR publishes none; off "
                    "by default)")
-    p.add_argument("--singularity-margin", type=float, metavar="D",
-                   help="warn closer than this to a singularity (default 0.03: metres for "
-                   "shoulder, sine of the joint angle for elbow and wrist)")
+    p.add_argument("--singularity-scale", type=float, metavar="F",
+                   help="scale the distances at which URS307 warns (default 1: shoulder "
+                   "0.05 m, elbow 0.02 m, wrist 0.05 rad); 0 turns the warning off")
     p.add_argument("--no-self-collision", action="store_true",
                    help="do not check the arm against itself")
     p.add_argument("--max-time", type=float, default=3600.0, metavar="S",
@@ -104,7 +104,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         start_joints=args.start_joints or args.start_joints_deg or DEFAULT_START,
         tcp=args.tcp, cell=args.cell, tcp_speed_limit=args.tcp_speed_limit,
         joint_acceleration_limit=args.joint_acceleration_limit,
-        singularity_margin=args.singularity_margin, max_time=args.max_time,
+        singularity_scale=args.singularity_scale, max_time=args.max_time,
         self_collision=not args.no_self_collision)
     if args.cell:
         _check_cell(args.cell)

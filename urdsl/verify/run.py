@@ -43,7 +43,7 @@ class CheckOptions:
     ``tcp``: TCP pose in the flange frame (m, rad) active from the start; ``cell``: path of a
     cell TOML (obstacles, see :mod:`urdsl.kinematics.collision`); ``tcp_speed_limit`` (m/s);
     ``joint_acceleration_limit`` (rad/s², one value or six); ``q_min``/``q_max``: user joint
-    limits (rad) replacing the model's; ``singularity_margin``: see
+    limits (rad) replacing the model's; ``singularity_scale``: see
     :func:`urdsl.verify.checks.singularities`; ``max_time``: robot time (s) after which a
     program that runs on is stopped; ``sample_time``: trace step in s (default: the
     controller's, 0.002 e-Series / 0.008 CB3); ``collision_step``: robot time (s) between
@@ -58,7 +58,7 @@ class CheckOptions:
     joint_acceleration_limit: float | tuple[float, ...] | None = None
     q_min: tuple[float, ...] | None = None
     q_max: tuple[float, ...] | None = None
-    singularity_margin: float | None = None
+    singularity_scale: float | None = None
     max_time: float = 3600.0
     sample_time: float | None = None
     collision_step: float = 0.02
@@ -165,7 +165,7 @@ def _trace_findings(trace, planner, robot, options: CheckOptions) -> list[Findin
     findings += checks.blend_radii(planner.segments)
     if options.tcp_speed_limit is not None:
         findings += checks.tcp_speed(trace, robot, options.tcp_speed_limit)
-    findings += checks.singularities(trace, robot, options.singularity_margin)
+    findings += checks.singularities(trace, robot, options.singularity_scale)
     findings += checks.collisions(trace, robot, options.cell, options.collision_step,
                                   options.self_collision)
     return findings
