@@ -102,12 +102,15 @@ class BuiltinTable:
         rt = self.rt
         if rt.env.unsupported == "error":
             raise rt.error("unsupported", f"{row.name}() is not simulated by urdsl", node)
-        rt.event("unsupported", f"{row.name}() is not simulated; it did nothing here", node.span)
+        rt.event_once("unsupported", f"{row.name}() is not simulated; it did nothing here",
+                      node.span)
         kind = row.returns[0] if row.returns else "None"
         if kind == "Array":  # nearly all of them return a 6-vector (joints, wrench, speeds)
             return ListValue([0.0] * 6)
         if kind == "Pose":
             return PoseValue([0.0] * 6)
+        if kind == "Matrix":  # the 6x6 ones: mass matrix, Jacobians
+            return ListValue([ListValue([0.0] * 6) for _ in range(6)])
         return _NEUTRAL.get(kind)
 
     def call_method(self, receiver: Any, method: str, args: list, named: dict,

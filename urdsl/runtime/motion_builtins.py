@@ -371,3 +371,71 @@ def _wrench_trans(rt, node, T_from_to, w_from):  # noqa: N803 - the catalog's pa
     force = rotation.T @ wrench[:3]
     moment = rotation.T @ (wrench[3:] - np.cross(offset, wrench[:3]))
     return _vector(np.concatenate([force, moment]))
+
+
+@implements("get_actual_tool_flange_pose")
+def _flange_pose(rt, node):
+    arm = _arm(rt, node)
+    return _to_pose(arm.kinematics.fk(arm.joints_at(rt.time)))
+
+
+@implements("get_target_waypoint")
+def _target_waypoint(rt, node):
+    """Where the current (or last) move goes: the end of everything planned so far."""
+    arm = _arm(rt, node)
+    return _to_pose(arm.fk(arm.target_joints))
+
+
+@implements("is_steady")
+def _is_steady(rt, node):
+    return bool(rt.time >= _arm(rt, node).free_at)
+
+
+@implements("get_jacobian")
+def _get_jacobian(rt, node, q="current_joint_positions", tcp="active_tcp"):
+    """The 6x6 geometric Jacobian at the TCP, rows (v m/s, ω rad/s) in Base axes, columns
+    per joint speed (rad/s) [U: row order and reference point as in UR's 5.22 examples]."""
+    arm = _arm(rt, node)
+    joints = arm.joints_at(rt.time) if isinstance(q, str) else _numbers(rt, node, q, 6, "q")
+    offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
+    return _matrix_value(_tcp_jacobian(arm, joints, offset))
+
+
+def _tcp_jacobian(arm, joints: np.ndarray, offset) -> np.ndarray:
+    jacobian = np.array(arm.kinematics.jacobian(joints), dtype=float)
+    if offset is not None:  # move the reference point from the flange to the TCP
+        flange = arm.kinematics.fk(joints)
+        lever = flange[:3, :3] @ np.asarray(offset, dtype=float)[:3]
+        jacobian[:3] -= np.cross(lever, jacobian[3:].T).T
+    return jacobian
+
+
+def _matrix_value(matrix: np.ndarray) -> ListValue:
+    return ListValue([ListValue([float(v) for v in row]) for row in matrix])
+
+
+@implements("get_jacobian_time_derivative")
+def _get_jacobian_dot(rt, node, q="current_joint_positions", qd="current_joint_speeds",
+                      tcp="active_tcp"):
+    """dJ/dt at joints ``q`` moving with ``qd`` (rad/s), by a central difference along qd."""
+    arm = _arm(rt, node)
+    joints = arm.joints_at(rt.time) if isinstance(q, str) else _numbers(rt, node, q, 6, "q")
+    if isinstance(qd, str):
+        speeds = np.array(_joint_speeds(rt, node), dtype=float)
+    else:
+        speeds = _numbers(rt, node, qd, 6, "qd")
+    offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
+    step = 1e-6
+    ahead = _tcp_jacobian(arm, joints + step * speeds, offset)
+    behind = _tcp_jacobian(arm, joints - step * speeds, offset)
+    return _matrix_value((ahead - behind) / (2 * step))
+
+
+@implements("direct_torque")
+def _direct_torque(rt, node, torques, friction_comp=True):
+    """Torque control is not simulated (urdsl has no dynamics): the arm holds still, and the
+    call lasts one controller step, as on the robot, so that control loops advance time."""
+    _numbers(rt, node, torques, 6, "torques")
+    rt.event_once("unsupported", "direct_torque() is not simulated: the arm holds still",
+                  node.span)
+    rt.wait(rt.config.step_time)
