@@ -259,10 +259,10 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
                self_collision: bool = True) -> list[Finding]:
     """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders) or itself,
     checked every ``step`` s of robot time while it moves."""
-    from ..kinematics.collision import CollisionModel
-
     if cell is None and not self_collision:
         return []
+    from ..kinematics.collision import CollisionModel
+
     model = CollisionModel(robot, self_collision=self_collision)
     if cell is not None:
         model.load_cell(cell)
