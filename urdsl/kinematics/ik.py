@@ -37,6 +37,8 @@ __all__ = ["solve_ur", "wrap", "choose_nearest", "refine"]
 
 #: Poses out of reach by less than this [m] are treated as on the boundary (rounding).
 REACH_TOLERANCE = 1e-9
+#: Joint values beyond a limit by at most this [rad] (rounding) count as on the limit.
+LIMIT_TOLERANCE = 1e-9
 #: |sin θ5| below this counts as the wrist singularity (θ6 then comes from the hint).
 WRIST_SINGULAR = 1e-12
 
@@ -98,11 +100,18 @@ def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: floa
     big_s = -(c1b * wx + s1b * wy)
     big_c = wz
     theta234 = np.arctan2(big_s, big_c)
-    if np.any(singular):
-        theta234, theta6 = _wrist_singular_split(theta234, theta6, singular, np.cos(theta5),
-                                                  c1b * p5[:, 0, None, None]
-                                                  + s1b * p5[:, 1, None, None],
-                                                  p5[:, 2, None, None] - d1, a2, a3, d5)
+    near_singular = np.abs(s5) < 1e-6
+    if np.any(near_singular):
+        split234, split6 = _wrist_singular_split(theta234, theta6, near_singular,
+                                                 np.cos(theta5),
+                                                 c1b * p5[:, 0, None, None]
+                                                 + s1b * p5[:, 1, None, None],
+                                                 p5[:, 2, None, None] - d1, a2, a3, d5)
+        # near (not at) the singularity, moving θ234 turns the tool by |s5|·Δθ234: accept
+        # the move only while that stays at rounding level
+        accept = singular | (np.abs(s5) * np.abs(split234 - theta234) <= 1e-11)
+        theta234 = np.where(accept, split234, theta234)
+        theta6 = np.where(accept, split6, theta6)
         big_s, big_c = np.sin(theta234), np.cos(theta234)
 
     # 5. planar two-link arm, two θ3 per (θ1, θ5): shape (N, 2, 2, 2)
@@ -160,9 +169,8 @@ def _wrist_singular_split(theta234, theta6, singular, c5, u5, v5, a2, a3, d5):
     side = np.where(delta < 0.0, -1.0, 1.0)
     clamped = psi + side * np.clip(np.abs(delta), low, np.maximum(high, low))
     adjust = singular & (centre > 1e-12) & (low <= high)
-    new234 = np.where(adjust, clamped, theta234)
-    new6 = np.where(adjust, theta6 - c5 * (new234 - theta234), theta6)
-    return new234, new6
+    move = np.where(adjust, wrap(clamped - theta234), 0.0)
+    return theta234 + move, theta6 - c5 * move
 
 
 def choose_nearest(solutions: np.ndarray, q_near: np.ndarray, q_min: np.ndarray,
@@ -176,9 +184,12 @@ def choose_nearest(solutions: np.ndarray, q_near: np.ndarray, q_min: np.ndarray,
     near = q_near[:, None, :]
     shifted = near + wrap(solutions - near)
     two_pi = 2.0 * np.pi
-    shifted = shifted - two_pi * np.ceil(np.maximum(shifted - q_max, 0.0) / two_pi)
-    shifted = shifted + two_pi * np.ceil(np.maximum(q_min - shifted, 0.0) / two_pi)
-    fits = np.all((shifted >= q_min) & (shifted <= q_max), axis=2)
+    # a value beyond a limit by rounding only (≤ LIMIT_TOLERANCE) is put on the limit
+    upper, lower = q_max + LIMIT_TOLERANCE, q_min - LIMIT_TOLERANCE
+    shifted = shifted - two_pi * np.ceil(np.maximum(shifted - upper, 0.0) / two_pi)
+    shifted = shifted + two_pi * np.ceil(np.maximum(lower - shifted, 0.0) / two_pi)
+    fits = np.all((shifted >= lower) & (shifted <= upper), axis=2)
+    shifted = np.clip(shifted, q_min, q_max)
     cost = np.sum((shifted - near) ** 2, axis=2)
     cost = np.where(fits & np.isfinite(cost), cost, np.inf)
     best = np.argmin(cost, axis=1)

@@ -377,6 +377,7 @@ class Robot:
         flange = origins[:, 6]
         jacobian = np.concatenate(
             [np.cross(axes[:, :6], flange[:, None] - origins[:, :6]), axes[:, :6]], axis=2)
-        manipulability = np.abs(np.linalg.det(jacobian))
+        with np.errstate(divide="ignore", invalid="ignore"):  # LU of an exactly singular J
+            manipulability = np.abs(np.linalg.det(jacobian))
         return {"shoulder": shoulder, "elbow": elbow, "wrist": wrist_angle,
                 "manipulability": manipulability}
