@@ -90,3 +90,20 @@ def test_usage_errors_exit_2(files, capsys, argv, message):
 def test_a_missing_file_exits_2(tmp_path, capsys):
     assert main(["check", str(tmp_path / "nope.script")]) == 2
     assert "cannot read" in capsys.readouterr().err
+
+
+def test_a_bad_cell_file_is_a_usage_error(files, tmp_path, capsys):
+    cell = tmp_path / "cell.toml"
+    cell.write_text("[[box]]\nsize = [1, 1]\n")
+    assert main(["check", str(files / "good.script"), "--cell", str(cell)]) == 2
+    assert "bad cell description" in capsys.readouterr().err
+
+
+def test_a_cell_with_a_table_in_reach_finds_the_collision(files, tmp_path, capsys):
+    cell = tmp_path / "cell.toml"
+    cell.write_text('[[box]]\nname = "fixture"\nsize = [0.3, 0.3, 0.3]\n'
+                    'pose = [-0.3, -0.08, 0.35, 0, 0, 0]\n')
+    assert main(["check", str(files / "good.script"), "--cell", str(cell), "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert any(f["code"] == "URS308" and "fixture" in f["message"]
+               for f in report["findings"])

@@ -113,7 +113,7 @@ def test_wrist_singularity_during_a_movel():
 
 def test_collision_with_the_floor(tmp_path):
     cell = tmp_path / "cell.toml"
-    cell.write_text("[floor]\nz = 0.0\n")
+    cell.write_text("[floor]\nheight = 0.0\n")
     report = check(f"""
         {READY}
         home = get_actual_tcp_pose()

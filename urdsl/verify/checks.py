@@ -257,30 +257,38 @@ _SINGULARITY_HINTS = {
 
 def collisions(trace: Trace, robot, cell, step: float = 0.02,
                self_collision: bool = True) -> list[Finding]:
-    """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders) or itself,
-    checked every ``step`` s of robot time while it moves."""
+    """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders, planes) or itself,
+    checked every ``step`` s of robot time while it moves. ``cell`` is a path of a cell TOML
+    or a ready :class:`urdsl.kinematics.collision.CollisionModel` (None: no obstacles)."""
     if cell is None and not self_collision:
         return []
     from ..kinematics.collision import CollisionModel
 
-    model = CollisionModel(robot, self_collision=self_collision)
-    if cell is not None:
-        model.load_cell(cell)
+    if isinstance(cell, CollisionModel):
+        model = cell
+    else:
+        model = CollisionModel(robot)
+        if cell is not None:
+            model.load_cell(cell)
     stride = max(1, int(round(step / trace.dt)))
     index = np.arange(0, len(trace.times), stride)
     index = index[trace.segment[index] >= 0]
     if len(index) == 0:
         return []
-    result = model.check(trace.q[index])
+    tcp = trace.segments[-1].tcp if trace.segments else None
+    result = model.check(trace.q[index], tcp=tcp)
     hit = np.zeros(len(trace.times), dtype=bool)
     hit[index] = result.colliding
     position = {int(sample): i for i, sample in enumerate(index)}
     findings = []
     for segment, sample in _per_segment(trace, hit):
-        pair = result.pairs[position[sample]]
-        what = " and ".join(pair) if pair else "an obstacle"
+        where = position[sample]
+        pairs = result.pairs.get(where) or [result.closest[where]]
+        what = ", ".join(" and ".join(pair) for pair in pairs[:3])
+        depth = -float(result.distance[where])
         findings.append(Finding.of(
-            "URS308", f"collision: {what} at t={trace.times[sample]:.3f} s",
+            "URS308", f"collision: {what} (overlap {depth * 1000:.0f} mm) at "
+            f"t={trace.times[sample]:.3f} s",
             _span(trace, segment), float(trace.times[sample]),
             "move around the obstacle with an extra waypoint"))
     return findings

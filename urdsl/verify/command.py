@@ -107,7 +107,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         singularity_scale=args.singularity_scale, max_time=args.max_time,
         self_collision=not args.no_self_collision)
     if args.cell:
-        _check_cell(args.cell)
+        options.cell = _load_cell(robot, args.cell)
     reports = []
     for name in args.files:
         if name.endswith(".py"):
@@ -130,17 +130,18 @@ def cmd_check(args: argparse.Namespace) -> int:
     return EXIT_PROBLEMS if any(r.has_errors for r in reports) else EXIT_OK
 
 
-def _check_cell(path: str) -> None:
+def _load_cell(robot: str, path: str):
+    """The collision model of ``robot`` with the cell's obstacles, or a usage error."""
     from ..cli import UsageError
-    from ..kinematics import MODELS, KinematicsError, Robot
+    from ..kinematics import KinematicsError, Robot
     from ..kinematics.collision import CollisionModel
 
+    model = CollisionModel(Robot.model(robot))
     try:
-        CollisionModel(Robot.model(next(iter(MODELS)))).load_cell(path)
-    except OSError as error:
-        raise UsageError(f"cannot read the cell {path}: {error.strerror}") from None
-    except (KinematicsError, ValueError) as error:
-        raise UsageError(f"bad cell description {path}: {error}") from None
+        model.load_cell(path)
+    except KinematicsError as error:
+        raise UsageError(f"bad cell description: {error}") from None
+    return model
 
 
 def _check_program(name: str, options):
