@@ -107,3 +107,12 @@ def test_a_cell_with_a_table_in_reach_finds_the_collision(files, tmp_path, capsy
     report = json.loads(capsys.readouterr().out)
     assert any(f["code"] == "URS308" and "fixture" in f["message"]
                for f in report["findings"])
+
+
+def test_user_joint_limits(files, capsys):
+    assert main(["check", str(files / "good.script"), "--json", "--no-self-collision",
+                 "--q-max", "6.28,6.28,6.28,6.28,6.28,-0.5"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert {f["code"] for f in report["findings"]} == {"URS303"}  # one per move
+    assert [f["line"] for f in report["findings"]] == [1, 3, 4]
+    assert "wrist 3" in report["findings"][0]["message"]

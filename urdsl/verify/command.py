@@ -65,6 +65,10 @@ def add_commands(commands) -> None:
     p.add_argument("--tcp", metavar="POSE", type=lambda t: parse_vector(t, 6, "--tcp"),
                    help="TCP offset from the flange: x,y,z in m and a rotation vector in rad "
                    "(default: the flange; a script's set_tcp() changes it)")
+    p.add_argument("--q-min", metavar="Q", type=lambda t: parse_vector(t, 6, "--q-min"),
+                   help="lower joint limits in rad set for the cell (default: the model's)")
+    p.add_argument("--q-max", metavar="Q", type=lambda t: parse_vector(t, 6, "--q-max"),
+                   help="upper joint limits in rad set for the cell (default: the model's)")
     p.add_argument("--cell", metavar="TOML",
                    help="cell description with the floor, boxes and cylinders to avoid")
     p.add_argument("--tcp-speed-limit", type=float, metavar="M_PER_S",
@@ -102,7 +106,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     options = CheckOptions(
         robot=robot,
         start_joints=args.start_joints or args.start_joints_deg or DEFAULT_START,
-        tcp=args.tcp, cell=args.cell, tcp_speed_limit=args.tcp_speed_limit,
+        tcp=args.tcp, cell=args.cell, q_min=args.q_min, q_max=args.q_max,
+        tcp_speed_limit=args.tcp_speed_limit,
         joint_acceleration_limit=args.joint_acceleration_limit,
         singularity_scale=args.singularity_scale, max_time=args.max_time,
         self_collision=not args.no_self_collision)
