@@ -178,7 +178,8 @@ class Interpreter:
         try:
             self._schedule(main, result)
         except ScriptRuntimeError as error:
-            error.time = self.time
+            if error.time is None:
+                error.time = self.time
             result.error = error
         finally:
             for thread in self._threads:

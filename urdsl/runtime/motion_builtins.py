@@ -19,6 +19,7 @@ import numpy as np
 from ..kinematics import KinematicsError
 from ..kinematics import pose as posemath
 from .builtins import implements
+from .errors import ScriptRuntimeError
 from .values import ListValue, PoseValue, is_number, type_name
 
 __all__: list[str] = []
@@ -27,11 +28,33 @@ __all__: list[str] = []
 # ---- argument conversion ---------------------------------------------------------------------
 
 
-def _arm(rt, node):
+def _arm(rt, node, resolve: bool = True):
+    """The interpreter's robot, with every move planned so far solved (a target out of reach
+    found now stops the program at that move's line). Straight-line moves pass
+    ``resolve=False``: their targets are solved later, in batches."""
     if rt.robot is None:
         raise rt.error("unsupported", "this program runs without a robot: motion and robot "
                        "state are not available", node)
+    if not resolve:
+        return rt.robot
+    try:
+        rt.robot.resolve()
+    except KinematicsError as error:
+        raise _ik_error(rt, node, error) from None
     return rt.robot
+
+
+def _ik_error(rt, node, error: KinematicsError):
+    """The runtime error for a failed inverse kinematics: at the move whose target failed
+    (when the planner found it later, in a batch), else at ``node``."""
+    span = getattr(error, "span", None)
+    if span is None:
+        return rt.error("ik", f"inverse kinematics failed: {error}", node, _IK_HINT)
+    return ScriptRuntimeError("ik", f"inverse kinematics failed: {error}", span, _IK_HINT,
+                              getattr(error, "time", rt.time))
+
+
+_IK_HINT = "the pose is out of reach of this robot with the active TCP"
 
 
 def _numbers(rt, node, value: Any, count: int, what: str) -> np.ndarray:
@@ -70,7 +93,7 @@ def _pose(rt, node, value: Any, what: str) -> np.ndarray:
 def _matrix(rt, node, value: Any, what: str) -> np.ndarray:
     """A Cartesian target as a 4x4 matrix: a pose, or joints turned into a pose by FK (the
     controller accepts joint vectors as targets of movel/movep/movec)."""
-    arm = _arm(rt, node)
+    arm = _arm(rt, node, resolve=False)
     if type(value) is PoseValue:
         return posemath.to_matrix(np.array(value, dtype=float))
     return arm.fk(_numbers(rt, node, value, 6, what))
@@ -89,8 +112,7 @@ def _solve(rt, node, arm, matrix: np.ndarray, near: np.ndarray | None) -> np.nda
     try:
         return arm.ik(matrix, near)
     except KinematicsError as error:
-        raise rt.error("ik", f"inverse kinematics failed: {error}", node,
-                       "the pose is out of reach of this robot with the active TCP") from None
+        raise _ik_error(rt, node, error) from None
 
 
 def _to_pose(matrix: np.ndarray) -> PoseValue:
@@ -107,8 +129,7 @@ def _plan(rt, node, plan) -> None:
     try:
         resume = plan()
     except KinematicsError as error:
-        raise rt.error("ik", f"inverse kinematics failed: {error}", node,
-                       "the pose is out of reach of this robot with the active TCP") from None
+        raise _ik_error(rt, node, error) from None
     except ValueError as error:
         raise rt.error("arithmetic", str(error), node) from None
     rt.wait_until(resume)
@@ -128,7 +149,7 @@ def _movej(rt, node, q, a=1.4, v=1.05, t=0, r=0):
 
 def _linear(kind: str):
     def move(rt, node, pose, a=1.2, v=0.25, t=0, r=0):
-        arm = _arm(rt, node)
+        arm = _arm(rt, node, resolve=False)
         target = _matrix(rt, node, pose, "the target")
         a, v = _number(rt, node, a, "a"), _number(rt, node, v, "v")
         t, r = _number(rt, node, t, "t"), _number(rt, node, r, "r")
@@ -143,7 +164,7 @@ implements("movep", "servoc")(_linear("movep"))
 
 @implements("movec")
 def _movec(rt, node, pose_via, pose_to, a=1.2, v=0.25, r=0, mode=0):
-    arm = _arm(rt, node)
+    arm = _arm(rt, node, resolve=False)
     via = _matrix(rt, node, pose_via, "pose_via")
     target = _matrix(rt, node, pose_to, "pose_to")
     a, v, r = _number(rt, node, a, "a"), _number(rt, node, v, "v"), _number(rt, node, r, "r")

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
-from ..runtime import Environment, Interpreter, RuntimeConfig
+from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
 from ..script.diagnostics import ScriptSyntaxError
 from ..script.nodes import NO_SPAN
 from ..script.parser import parse
@@ -104,7 +104,7 @@ def check_tree(module, filename: str, options: CheckOptions) -> Report:
     robot = _robot_model(options.robot)
     cb3 = getattr(robot.spec, "generation", "") == "cb3"
     step = 0.008 if cb3 else 0.002
-    planner = MotionPlanner(robot, options.start_joints, step_time=step)
+    planner = MotionPlanner(robot, options.start_joints, step_time=step, lazy_ik=True)
     if options.tcp is not None:
         planner.tcp = np.asarray(options.tcp, dtype=float)
     config = RuntimeConfig(step_time=step, max_time=options.max_time)
@@ -114,6 +114,19 @@ def check_tree(module, filename: str, options: CheckOptions) -> Report:
 
     report = Report(filename, options.robot)
     report.events = result.events
+    if result.error is None and planner.failure is not None:
+        # found when the last moves were solved, after the script had run on: the robot
+        # stops at that move, so nothing after it happens
+        failure = planner.failure
+        result.error = ScriptRuntimeError("ik", f"inverse kinematics failed: {failure}",
+                                          failure.span, "the pose is out of reach of this "
+                                          "robot with the active TCP", failure.time)
+    if result.error is not None and result.error.kind == "ik":
+        # a target solved in a batch may fail after the script ran on: the robot stops at
+        # the move, so nothing after its start happens
+        result.time = min(result.time, result.error.time)
+        planner.end_time = max([result.time] + [s.end for s in planner.segments])
+        report.events = [e for e in result.events if e.time <= result.error.time]
     if result.error is not None:
         report.findings.append(_runtime_finding(result.error))
     for warning in planner.warnings:
