@@ -207,7 +207,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-_COMMAND_MODULES: list[str] = ["urdsl.verify.command"]
+_COMMAND_MODULES: list[str] = [
+    "urdsl.kinematics.cli",
+    "urdsl.verify.command",
+]
 """Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""
 
 
