@@ -1,0 +1,102 @@
+"""Forward kinematics of a standard-DH chain, vectorised over many joint vectors.
+
+Two evaluations of the same product ``T_1·…·T_6`` with ``T_i = Rz(θ_i)·Tz(d_i)·Tx(a_i)·Rx(α_i)``:
+
+* :func:`fk_ur` — closed form for the nominal UR structure (α = π/2, 0, 0, π/2, −π/2, 0 and
+  a1 = a4 = a5 = a6 = d2 = d3 = 0). With ``c1 = cos θ1``, ``C = cos(θ2+θ3+θ4)``,
+  ``S = sin(θ2+θ3+θ4)``, ``u = a2·c2 + a3·c23``, ``v = a2·s2 + a3·s23``::
+
+      z5 = (c1·S, s1·S, −C)                                  (wrist-2 axis)
+      x5 = (c1·C·c5 + s1·s5, s1·C·c5 − c1·s5, S·c5)
+      y5 = (−c1·S, −s1·S, C)
+      z6 = (−c1·C·s5 + s1·c5, −s1·C·s5 − c1·c5, −S·s5)       (tool Z, out of the flange)
+      x6 = x5·c6 + y5·s6,   y6 = −x5·s6 + y5·c6
+      p  = (c1·u + s1·d4, s1·u − c1·d4, d1 + v) + d5·z5 + d6·z6
+
+  Only element-wise array arithmetic: this is what makes batched FK fast.
+* :func:`dh_frames` — the general chain (any θ offsets, a, d, α, e.g. a calibrated robot),
+  returning every intermediate frame, by batched 4x4 products.
+
+Joint angles in rad, lengths in m; results are (N, 4, 4) transforms of DH frame 6 (the tool
+flange, ROS ``tool0``) in the controller's Base frame.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["fk_ur", "dh_frames", "dh_transforms"]
+
+
+def fk_ur(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
+          d6: float) -> np.ndarray:
+    """Flange poses (N, 4, 4) for joint vectors ``q`` (N, 6) of a nominal UR arm."""
+    q = np.asarray(q, dtype=float)
+    c = np.cos(q)
+    s = np.sin(q)
+    c1, s1, c2, s2, c5, s5, c6, s6 = (c[:, 0], s[:, 0], c[:, 1], s[:, 1], c[:, 4], s[:, 4],
+                                      c[:, 5], s[:, 5])
+    q23 = q[:, 1] + q[:, 2]
+    q234 = q23 + q[:, 3]
+    c23, s23 = np.cos(q23), np.sin(q23)
+    cc, ss = np.cos(q234), np.sin(q234)
+    u = a2 * c2 + a3 * c23
+    v = a2 * s2 + a3 * s23
+
+    c1c = c1 * cc
+    s1c = s1 * cc
+    x5x, x5y, x5z = c1c * c5 + s1 * s5, s1c * c5 - c1 * s5, ss * c5
+    y5x, y5y, y5z = -c1 * ss, -s1 * ss, cc
+    out = np.empty((q.shape[0], 4, 4))
+    out[:, 0, 0] = x5x * c6 + y5x * s6
+    out[:, 1, 0] = x5y * c6 + y5y * s6
+    out[:, 2, 0] = x5z * c6 + y5z * s6
+    out[:, 0, 1] = y5x * c6 - x5x * s6
+    out[:, 1, 1] = y5y * c6 - x5y * s6
+    out[:, 2, 1] = y5z * c6 - x5z * s6
+    z6x = s1 * c5 - c1c * s5
+    z6y = -c1 * c5 - s1c * s5
+    z6z = -ss * s5
+    out[:, 0, 2] = z6x
+    out[:, 1, 2] = z6y
+    out[:, 2, 2] = z6z
+    out[:, 0, 3] = c1 * u + s1 * d4 + d5 * c1 * ss + d6 * z6x
+    out[:, 1, 3] = s1 * u - c1 * d4 + d5 * s1 * ss + d6 * z6y
+    out[:, 2, 3] = d1 + v - d5 * cc + d6 * z6z
+    out[:, 3, :3] = 0.0
+    out[:, 3, 3] = 1.0
+    return out
+
+
+def dh_transforms(q: np.ndarray, theta_offset: np.ndarray, a: np.ndarray, d: np.ndarray,
+                  alpha: np.ndarray) -> np.ndarray:
+    """The link transforms ``T_i`` (N, 6, 4, 4) for joint vectors ``q`` (N, 6)."""
+    theta = np.asarray(q, dtype=float) + theta_offset
+    ct, st = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    out = np.zeros(theta.shape + (4, 4))
+    out[..., 0, 0] = ct
+    out[..., 0, 1] = -st * ca
+    out[..., 0, 2] = st * sa
+    out[..., 0, 3] = a * ct
+    out[..., 1, 0] = st
+    out[..., 1, 1] = ct * ca
+    out[..., 1, 2] = -ct * sa
+    out[..., 1, 3] = a * st
+    out[..., 2, 1] = sa
+    out[..., 2, 2] = ca
+    out[..., 2, 3] = d
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def dh_frames(q: np.ndarray, theta_offset: np.ndarray, a: np.ndarray, d: np.ndarray,
+              alpha: np.ndarray) -> np.ndarray:
+    """Frames 0…6 (N, 7, 4, 4) of the chain in the Base frame (frame 0 is the identity,
+    frame 6 the flange) for joint vectors ``q`` (N, 6)."""
+    links = dh_transforms(q, theta_offset, a, d, alpha)
+    frames = np.empty((links.shape[0], 7, 4, 4))
+    frames[:, 0] = np.eye(4)
+    for i in range(6):
+        frames[:, i + 1] = frames[:, i] @ links[:, i]
+    return frames

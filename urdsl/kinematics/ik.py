@@ -1,0 +1,197 @@
+"""Analytic inverse kinematics of the UR arm, vectorised over many poses.
+
+The UR geometry (joints 2, 3, 4 parallel, wrist axes 5 ⟂ 4 and 6 ⟂ 5) gives up to eight
+closed-form solutions per flange pose ``T = [x6 y6 z6 p]`` (the same structure as the FK in
+:mod:`.dh`; ``n1 = (s1, −c1, 0)`` is the shoulder axis):
+
+1. wrist centre ``p5 = p − d6·z6``; its distance to the base axis satisfies
+   ``p5·n1 = d4``, so ``θ1 = φ + asin(d4/r)`` or ``φ + π − asin(d4/r)`` with
+   ``r, φ`` the polar coordinates of ``p5`` in the xy plane (needs ``r ≥ |d4|``);
+2. ``z6·n1 = cos θ5`` and ``|(x6·n1, y6·n1)| = |sin θ5|`` give ``θ5 = ±atan2(|…|, z6·n1)``
+   (accurate near θ5 = 0, unlike an arccos; it always exists once θ1 does);
+3. ``x6·n1 = s5·c6`` and ``y6·n1 = −s5·s6`` give θ6 (free when ``s5 = 0``, the wrist
+   singularity: then it is taken from a hint, 0 by default);
+4. ``w = s6·x6 + c6·y6 = (−c1·S, −s1·S, C)`` gives ``θ234 = atan2(S, C)``;
+5. the wrist-1 point ``p4 = p5 − d5·(c1·S, s1·S, −C)`` in the arm plane,
+   ``(u, v) = (c1·p4x + s1·p4y, p4z − d1)``, is reached by the planar two-link arm a2, a3:
+   ``cos θ3 = (u² + v² − a2² − a3²)/(2·a2·a3)``, ``θ3 = ±acos(…)``,
+   ``θ2 = atan2(v, u) − atan2(a3·s3, a2 + a3·c3)``, ``θ4 = θ234 − θ2 − θ3``.
+
+Solution ``k`` (0…7) takes shoulder branch ``k // 4``, wrist branch ``(k // 2) % 2`` and elbow
+branch ``k % 2``. A branch that does not exist gives NaN. Its *miss* is how far (m) the pose is
+out of reach for it: ``|d4| − r`` (wrist centre inside the shoulder cylinder) or the
+distance of the wrist-1 point
+outside the annulus ``||a2| − |a3|| ≤ √(u² + v²) ≤ |a2| + |a3|`` — the largest of these.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import pose as _pose
+from .dh import dh_frames
+
+__all__ = ["solve_ur", "wrap", "choose_nearest", "refine"]
+
+#: Poses out of reach by less than this [m] are treated as on the boundary (rounding).
+REACH_TOLERANCE = 1e-9
+#: |sin θ5| below this counts as the wrist singularity (θ6 then comes from the hint).
+WRIST_SINGULAR = 1e-12
+
+
+def wrap(q: np.ndarray) -> np.ndarray:
+    """Angles wrapped to (−π, π] [rad]."""
+    return np.pi - np.mod(np.pi - q, 2.0 * np.pi)
+
+
+def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float, d6: float,
+             q6_hint: np.ndarray | None = None,
+             reach_tolerance: float = REACH_TOLERANCE) -> tuple[np.ndarray, np.ndarray]:
+    """All analytic solutions for flange poses ``T`` (N, 4, 4).
+
+    Returns ``(solutions, miss)``: joint vectors (N, 8, 6) wrapped to (−π, π] with NaN rows
+    for branches that do not exist, and (N, 8) distances out of reach [m] (0 where solved).
+    ``q6_hint`` (N,) is used for θ6 at the wrist singularity. Branches out of reach by less
+    than ``reach_tolerance`` [m] are still solved (on the boundary; their miss is reported),
+    which lets a calibrated arm refine them.
+    """
+    T = np.asarray(T, dtype=float)
+    n = T.shape[0]
+    x6, y6, z6, p = T[:, :3, 0], T[:, :3, 1], T[:, :3, 2], T[:, :3, 3]
+    p5 = p - d6 * z6
+
+    # 1. shoulder: two θ1 per pose, shape (N, 2)
+    r = np.hypot(p5[:, 0], p5[:, 1])
+    phi = np.arctan2(p5[:, 1], p5[:, 0])
+    miss_shoulder = np.maximum(abs(d4) - r, 0.0)
+    ratio = np.clip(d4 / np.maximum(r, 1e-300), -1.0, 1.0)
+    ratio = np.where(r > 0.0, ratio, np.sign(d4))
+    offset = np.arcsin(ratio)
+    theta1 = np.stack([phi + offset, phi + np.pi - offset], axis=1)
+    c1, s1 = np.cos(theta1), np.sin(theta1)
+
+    # 2. wrist 2: two θ5 per θ1, shape (N, 2, 2); cos θ5 = z6·n1, |sin θ5| = |(x6·n1, y6·n1)|
+    z6n = z6[:, 0, None] * s1 - z6[:, 1, None] * c1
+    x6n = x6[:, 0, None] * s1 - x6[:, 1, None] * c1
+    y6n = y6[:, 0, None] * s1 - y6[:, 1, None] * c1
+    t5 = np.arctan2(np.hypot(x6n, y6n), z6n)
+    theta5 = np.stack([t5, -t5], axis=2)
+    s5 = np.sin(theta5)
+
+    # 3. wrist 3
+    sign5 = np.where(theta5 < 0.0, -1.0, 1.0)
+    theta6 = np.arctan2(-y6n[:, :, None] * sign5, x6n[:, :, None] * sign5)
+    singular = np.abs(s5) < WRIST_SINGULAR
+    if np.any(singular):
+        hint = np.zeros(n) if q6_hint is None else np.asarray(q6_hint, dtype=float)
+        theta6 = np.where(singular, hint[:, None, None], theta6)
+    c6, s6 = np.cos(theta6), np.sin(theta6)
+
+    # 4. θ2 + θ3 + θ4
+    c1b, s1b = c1[:, :, None], s1[:, :, None]
+    wx = x6[:, 0, None, None] * s6 + y6[:, 0, None, None] * c6
+    wy = x6[:, 1, None, None] * s6 + y6[:, 1, None, None] * c6
+    wz = x6[:, 2, None, None] * s6 + y6[:, 2, None, None] * c6
+    big_s = -(c1b * wx + s1b * wy)
+    big_c = wz
+    theta234 = np.arctan2(big_s, big_c)
+
+    # 5. planar two-link arm, two θ3 per (θ1, θ5): shape (N, 2, 2, 2)
+    p4x = p5[:, 0, None, None] - d5 * c1b * big_s
+    p4y = p5[:, 1, None, None] - d5 * s1b * big_s
+    p4z = p5[:, 2, None, None] + d5 * big_c
+    u = c1b * p4x + s1b * p4y
+    v = p4z - d1
+    length = np.hypot(u, v)
+    outer, inner = abs(a2) + abs(a3), abs(abs(a2) - abs(a3))
+    miss_elbow = np.maximum(np.maximum(length - outer, inner - length), 0.0)
+    c3 = np.clip((u * u + v * v - a2 * a2 - a3 * a3) / (2.0 * a2 * a3), -1.0, 1.0)
+    t3 = np.arccos(c3)
+    theta3 = np.stack([t3, -t3], axis=3)
+    s3 = np.sin(theta3)
+    theta2 = (np.arctan2(v, u)[..., None]
+              - np.arctan2(a3 * s3, a2 + a3 * c3[..., None]))
+    theta4 = theta234[..., None] - theta2 - theta3
+
+    shape = (n, 2, 2, 2)
+    solutions = np.stack([
+        np.broadcast_to(theta1[:, :, None, None], shape),
+        theta2,
+        theta3,
+        theta4,
+        np.broadcast_to(theta5[:, :, :, None], shape),
+        np.broadcast_to(theta6[..., None], shape),
+    ], axis=-1).reshape(n, 8, 6)
+    miss = np.maximum(np.broadcast_to(miss_shoulder[:, None, None, None], shape),
+                      np.broadcast_to(miss_elbow[..., None], shape)).reshape(n, 8)
+    solutions = wrap(solutions)
+    solutions[miss > max(reach_tolerance, REACH_TOLERANCE)] = np.nan
+    return solutions, np.where(miss > REACH_TOLERANCE, miss, 0.0)
+
+
+def choose_nearest(solutions: np.ndarray, q_near: np.ndarray, q_min: np.ndarray,
+                   q_max: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The controller's choice among ``solutions`` (N, K, 6): the one closest to ``q_near``
+    (N, 6) in the sum of squared joint differences [rad²], each joint first moved by a
+    multiple of 2π to the value nearest ``q_near`` that lies within ``[q_min, q_max]``.
+
+    Returns ``(q, found)``: (N, 6) with NaN rows where no solution fits the limits, (N,) bool.
+    """
+    near = q_near[:, None, :]
+    shifted = near + wrap(solutions - near)
+    two_pi = 2.0 * np.pi
+    shifted = np.where(shifted > q_max, shifted - two_pi, shifted)
+    shifted = np.where(shifted < q_min, shifted + two_pi, shifted)
+    fits = np.all((shifted >= q_min) & (shifted <= q_max), axis=2)
+    cost = np.sum((shifted - near) ** 2, axis=2)
+    cost = np.where(fits & np.isfinite(cost), cost, np.inf)
+    best = np.argmin(cost, axis=1)
+    rows = np.arange(solutions.shape[0])
+    chosen = shifted[rows, best]
+    found = np.isfinite(cost[rows, best])
+    chosen[~found] = np.nan
+    return chosen, found
+
+
+def refine(q: np.ndarray, target: np.ndarray, theta_offset: np.ndarray, a: np.ndarray,
+           d: np.ndarray, alpha: np.ndarray, iterations: int = 20,
+           tolerance: float = 1e-14) -> tuple[np.ndarray, np.ndarray]:
+    """Newton steps on the general DH chain from guesses ``q`` (M, 6) to flange poses
+    ``target`` (M, 4, 4): ``J·Δq = e`` with ``e = (p* − p, log(R*·Rᵀ))`` in the Base frame and
+    the geometric Jacobian (columns ``z_i × (p − o_i)``, ``z_i``).
+
+    Returns ``(q, error)``: refined joints and the final error norm (m and rad mixed).
+    """
+    q = np.array(q, dtype=float)
+    error_norm = np.full(q.shape[0], np.inf)
+    active = np.ones(q.shape[0], dtype=bool)
+    for _ in range(iterations):
+        if not np.any(active):
+            break
+        frames = dh_frames(q[active], theta_offset, a, d, alpha)
+        flange = frames[:, 6]
+        goal = target[active]
+        e_pos = goal[:, :3, 3] - flange[:, :3, 3]
+        e_rot = _pose.matrix_to_rotvec(goal[:, :3, :3] @ np.swapaxes(flange[:, :3, :3], 1, 2))
+        error = np.concatenate([e_pos, e_rot], axis=1)
+        norm = np.linalg.norm(error, axis=1)
+        error_norm[active] = norm
+        axes = frames[:, :6, :3, 2]
+        origins = frames[:, :6, :3, 3]
+        jacobian = np.concatenate(
+            [np.cross(axes, flange[:, None, :3, 3] - origins), axes], axis=2)
+        jacobian = np.swapaxes(jacobian, 1, 2)
+        damping = 1e-12 * np.eye(6)
+        jjt = jacobian @ np.swapaxes(jacobian, 1, 2) + damping
+        step = np.swapaxes(jacobian, 1, 2) @ np.linalg.solve(jjt, error[:, :, None])
+        index = np.flatnonzero(active)
+        q[index] += step[:, :, 0]
+        done = norm < tolerance
+        active[index[done]] = False
+    if np.any(active):
+        frames = dh_frames(q[active], theta_offset, a, d, alpha)[:, 6]
+        goal = target[active]
+        e_pos = goal[:, :3, 3] - frames[:, :3, 3]
+        e_rot = _pose.matrix_to_rotvec(goal[:, :3, :3] @ np.swapaxes(frames[:, :3, :3], 1, 2))
+        error_norm[active] = np.linalg.norm(np.concatenate([e_pos, e_rot], axis=1), axis=1)
+    return q, error_norm

@@ -1,0 +1,382 @@
+"""A UR arm: forward and inverse kinematics, joint limits and singularity measures.
+
+Frames: everything is in the controller's Base frame (ROS ``base``; ROS ``base_link`` is
+turned by π about z from it). With ``tcp=None`` the tool point is the flange (DH frame 6,
+ROS ``tool0``, Z out of the flange); a TCP is a pose ``p[x, y, z, rx, ry, rz]`` of the tool
+point in the flange frame (as ``set_tcp`` takes it) or a 4x4 matrix.
+
+Which solution the controller takes
+-----------------------------------
+``get_inverse_kin``/``movej`` to a pose pick, among the (up to eight) analytic solutions, the
+one closest to ``q_near`` in the sum of squared joint differences. Each joint may first be
+moved by a multiple of 2π to the value nearest ``q_near`` within the joint limits
+(±2π: the arm can reach every angle in two ways), so a solution at −3.1 rad becomes +3.18
+when ``q_near`` is 3.0.
+
+Calibration
+-----------
+With a :class:`~urdsl.kinematics.calibration.Calibration`, FK uses the corrected DH table. IK
+solves the nominal arm analytically, then refines each solution by Newton steps on the
+corrected chain (Pinocchio for single poses, the same iteration in NumPy for batches), so that
+``fk(ik(x)) == x`` holds for the calibrated robot.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from . import ik as _ik
+from . import pose as _pose
+from .calibration import Calibration
+from .dh import dh_frames, fk_ur
+from .errors import KinematicsError
+from .models import ModelSpec, model_spec
+from .pinmodel import URDF_MODELS, build_dh_model, load_urdf_model
+
+__all__ = ["Robot"]
+
+#: A calibrated pose counts as solved when the refined FK error is below this [m, rad].
+REFINE_TOLERANCE = 1e-12
+#: Nominal branches out of reach by less than this [m] are still refined for a calibrated arm.
+CALIBRATED_REACH_SLACK = 0.01
+
+
+def _readonly(array: np.ndarray) -> np.ndarray:
+    array = np.array(array, dtype=float)
+    array.setflags(write=False)
+    return array
+
+
+def _joints(q, name: str = "q") -> np.ndarray:
+    array = np.asarray(q, dtype=float)
+    if array.shape != (6,):
+        raise KinematicsError(f"{name} must be 6 joint angles [rad], got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise KinematicsError(f"{name} must be finite, got {array.tolist()}")
+    return array
+
+
+def _joint_batch(q, name: str = "Q") -> np.ndarray:
+    array = np.asarray(q, dtype=float)
+    if array.ndim == 1 and array.shape == (6,):
+        array = array[None]
+    if array.ndim != 2 or array.shape[1] != 6:
+        raise KinematicsError(f"{name} must have shape (N, 6), got {array.shape}")
+    return array
+
+
+def _transform(x, name: str = "pose") -> np.ndarray:
+    """A 4x4 matrix from a pose (6,) or a matrix (4, 4)."""
+    array = np.asarray(x, dtype=float)
+    if array.shape == (6,):
+        return _pose.to_matrix(array)
+    if array.shape == (4, 4):
+        return array
+    raise KinematicsError(f"{name} must be a pose (6 numbers) or a 4x4 matrix, got shape "
+                          f"{array.shape}")
+
+
+def _transform_batch(x, name: str = "poses") -> np.ndarray:
+    array = np.asarray(x, dtype=float)
+    if array.ndim == 2 and array.shape[1] == 6:
+        return _pose.to_matrix(array)
+    if array.ndim == 3 and array.shape[1:] == (4, 4):
+        return array
+    if array.shape in ((6,), (4, 4)):
+        return _transform(array, name)[None]
+    raise KinematicsError(f"{name} must have shape (N, 6) or (N, 4, 4), got {array.shape}")
+
+
+def _tcp(tcp) -> np.ndarray | None:
+    if tcp is None:
+        return None
+    matrix = _transform(tcp, "tcp")
+    if np.array_equal(matrix, np.eye(4)):
+        return None
+    return matrix
+
+
+def _inverse(matrix: np.ndarray) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3] = matrix[:3, :3].T
+    out[:3, 3] = -matrix[:3, :3].T @ matrix[:3, 3]
+    return out
+
+
+def _dedupe(solutions: np.ndarray, tolerance: float = 1e-9) -> np.ndarray:
+    kept: list[np.ndarray] = []
+    for solution in solutions:
+        if not any(np.max(np.abs(_ik.wrap(solution - other))) < tolerance for other in kept):
+            kept.append(solution)
+    return np.array(kept).reshape(-1, 6)
+
+
+class Robot:
+    """One UR arm (see the module docstring for frames and conventions).
+
+    Build it with :meth:`Robot.model`. ``spec`` is its :class:`ModelSpec`; ``q_min``,
+    ``q_max`` [rad] and ``qd_max`` [rad/s] are read-only (6,) arrays; ``pin_model`` /
+    ``pin_data`` the Pinocchio model built from the (calibrated) DH table.
+    """
+
+    def __init__(self, spec: ModelSpec, calibration: Calibration | None = None) -> None:
+        self.spec = spec
+        if calibration is not None and calibration.is_zero and calibration.model in (None,
+                                                                                    spec.name):
+            calibration = None
+        self.calibration = calibration
+        if calibration is None:
+            theta, a, d, alpha = np.zeros(6), spec.dh_a, spec.dh_d, spec.dh_alpha
+        else:
+            theta, a, d, alpha = calibration.dh(spec)
+        self._dh = tuple(_readonly(v) for v in (theta, a, d, alpha))
+        self._nominal = (spec.d1, spec.a2, spec.a3, spec.d4, spec.d5, spec.d6)
+        self.pin_model = build_dh_model(spec.name, *self._dh, spec.q_min, spec.q_max,
+                                        spec.qd_max)
+        self.pin_data = self.pin_model.createData()
+        self._flange = self.pin_model.getFrameId("tool0")
+
+    @classmethod
+    def model(cls, name: str, calibration: Calibration | None = None) -> Robot:
+        """The robot of model ``name`` (``"ur5e"``, ``"UR10"``, …), optionally calibrated.
+
+        Raises :class:`KinematicsError` for an unknown name, listing the known ones.
+        """
+        return cls(model_spec(name), calibration)
+
+    # -- data -----------------------------------------------------------------------------
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    @property
+    def q_min(self) -> np.ndarray:
+        """Lower joint position limits [rad] (−∞ for an unlimited joint)."""
+        return self.spec.q_min
+
+    @property
+    def q_max(self) -> np.ndarray:
+        """Upper joint position limits [rad] (+∞ for an unlimited joint)."""
+        return self.spec.q_max
+
+    @property
+    def qd_max(self) -> np.ndarray:
+        """Joint speed limits [rad/s]."""
+        return self.spec.qd_max
+
+    @property
+    def dh(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The DH table in use ``(theta_offset, a, d, alpha)`` (rad, m, m, rad)."""
+        return self._dh
+
+    @property
+    def calibrated(self) -> bool:
+        return self.calibration is not None
+
+    def __repr__(self) -> str:
+        return f"Robot({self.name!r}{', calibrated' if self.calibrated else ''})"
+
+    def within_limits(self, Q) -> np.ndarray:
+        """(N,) True where every joint of ``Q`` (N, 6) lies within the position limits."""
+        Q = _joint_batch(Q)
+        return np.all((Q >= self.q_min) & (Q <= self.q_max), axis=1)
+
+    def urdf_model(self) -> pin.Model:
+        """The example-robot-data URDF model (UR3, UR5, UR10 only; root ``base_link``, frames
+        ``base`` = controller Base and ``tool0`` = flange). Raises :class:`KinematicsError`
+        for the other models."""
+        if self.name not in URDF_MODELS:
+            raise KinematicsError(f"there is no URDF model of the {self.name}; example-robot-"
+                                  "data describes " + ", ".join(URDF_MODELS))
+        return load_urdf_model(self.name)
+
+    # -- forward kinematics ---------------------------------------------------------------
+
+    def fk(self, q, tcp=None) -> np.ndarray:
+        """The TCP pose (4, 4) in Base for joints ``q`` (6,) [rad] (Pinocchio)."""
+        q = _joints(q)
+        pin.forwardKinematics(self.pin_model, self.pin_data, q)
+        flange = pin.updateFramePlacement(self.pin_model, self.pin_data, self._flange)
+        matrix = flange.homogeneous
+        tcp = _tcp(tcp)
+        return matrix if tcp is None else matrix @ tcp
+
+    def fk_pose(self, q, tcp=None) -> np.ndarray:
+        """The TCP pose as ``p[x, y, z, rx, ry, rz]`` (6,) for joints ``q`` (6,)."""
+        return _pose.from_matrix(self.fk(q, tcp))
+
+    def fk_many(self, Q, tcp=None) -> np.ndarray:
+        """TCP poses (N, 4, 4) for joint vectors ``Q`` (N, 6), vectorised in NumPy (closed
+        form for a nominal arm, the DH product for a calibrated one)."""
+        Q = _joint_batch(Q)
+        if self.calibration is None:
+            out = fk_ur(Q, *self._nominal)
+        else:
+            out = dh_frames(Q, *self._dh)[:, 6]
+        tcp = _tcp(tcp)
+        return out if tcp is None else out @ tcp
+
+    def frames_many(self, Q) -> np.ndarray:
+        """DH frames 0…6 (N, 7, 4, 4) in Base for joint vectors ``Q`` (N, 6)."""
+        return dh_frames(_joint_batch(Q), *self._dh)
+
+    def jacobian(self, q) -> np.ndarray:
+        """The geometric Jacobian (6, 6) of the flange at ``q``: rows (v [m/s], ω [rad/s]) in
+        Base axes at the flange origin, columns per joint speed [rad/s] (Pinocchio)."""
+        q = _joints(q)
+        return pin.computeFrameJacobian(self.pin_model, self.pin_data, q, self._flange,
+                                        pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+
+    # -- inverse kinematics ---------------------------------------------------------------
+
+    def _flange_targets(self, T: np.ndarray, tcp) -> np.ndarray:
+        tcp = _tcp(tcp)
+        return T if tcp is None else T @ _inverse(tcp)
+
+    def _solve(self, flange: np.ndarray, q6_hint: np.ndarray | None
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """Solutions (N, 8, 6) and misses (N, 8) [m] for flange poses (N, 4, 4)."""
+        if self.calibration is None:
+            return _ik.solve_ur(flange, *self._nominal, q6_hint=q6_hint)
+        solutions, miss = _ik.solve_ur(flange, *self._nominal, q6_hint=q6_hint,
+                                       reach_tolerance=CALIBRATED_REACH_SLACK)
+        valid = ~np.isnan(solutions[..., 0])
+        refined, error = _ik.refine(solutions[valid], flange[np.nonzero(valid)[0]], *self._dh)
+        good = error < REFINE_TOLERANCE
+        out = np.full_like(solutions, np.nan)
+        index_n, index_k = np.nonzero(valid)
+        out[index_n[good], index_k[good]] = _ik.wrap(refined[good])
+        # a branch that refined is solved; one that did not keeps the nominal miss (at least
+        # a nanometre, so that it counts as missed)
+        miss = np.where(np.isnan(out[..., 0]), np.maximum(miss, 1e-9), 0.0)
+        return out, miss
+
+    def _refine_pin(self, q: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, float]:
+        """Newton steps with Pinocchio's frame Jacobian (LOCAL) and SE3 log error."""
+        goal = pin.SE3(target)
+        model, data = self.pin_model, self.pin_data
+        error = np.inf
+        for _ in range(20):
+            pin.forwardKinematics(model, data, q)
+            current = pin.updateFramePlacement(model, data, self._flange)
+            twist = pin.log6(current.actInv(goal)).vector
+            error = float(np.linalg.norm(twist))
+            if error < 1e-14:
+                break
+            jacobian = pin.computeFrameJacobian(model, data, q, self._flange,
+                                                pin.ReferenceFrame.LOCAL)
+            q = q + np.linalg.lstsq(jacobian, twist, rcond=None)[0]
+        return q, error
+
+    def ik_all(self, T, tcp=None, q6_hint: float = 0.0) -> np.ndarray:
+        """All inverse kinematics solutions (k, 6), k ≤ 8, joints wrapped to (−π, π].
+
+        ``T`` is the TCP pose (4x4 or pose 6-vector) in Base. ``q6_hint`` [rad] is used for
+        wrist 3 at the wrist singularity (θ5 = 0, where only θ4 + θ6 is determined). Returns an
+        empty (0, 6) array when the pose is out of reach (see :meth:`out_of_reach`).
+        """
+        flange = self._flange_targets(_transform(T)[None], tcp)
+        hint = np.array([q6_hint], dtype=float)
+        if self.calibration is None:
+            solutions, _ = _ik.solve_ur(flange, *self._nominal, q6_hint=hint)
+            candidates = solutions[0][~np.isnan(solutions[0, :, 0])]
+            return _dedupe(candidates)
+        solutions, _ = _ik.solve_ur(flange, *self._nominal, q6_hint=hint,
+                                    reach_tolerance=CALIBRATED_REACH_SLACK)
+        refined = []
+        for guess in solutions[0][~np.isnan(solutions[0, :, 0])]:
+            q, error = self._refine_pin(guess, flange[0])
+            if error < REFINE_TOLERANCE:
+                refined.append(_ik.wrap(q))
+        return _dedupe(np.array(refined).reshape(-1, 6))
+
+    def out_of_reach(self, T, tcp=None) -> np.ndarray:
+        """How far (m) each pose (N, 4, 4) or (N, 6) lies outside the reach, 0 when some
+        analytic branch solves it (see :mod:`urdsl.kinematics.ik` for the measure)."""
+        flange = self._flange_targets(_transform_batch(T), tcp)
+        _, miss = self._solve(flange, None)
+        return np.min(miss, axis=1)
+
+    def ik(self, T, q_near, tcp=None) -> np.ndarray:
+        """The controller's solution (6,) for TCP pose ``T``: the one closest to ``q_near``,
+        each joint possibly moved by ±2π within the limits (see the module docstring).
+
+        Raises :class:`KinematicsError` when the pose is out of reach (``distance`` = metres
+        out of reach) or no solution fits the joint limits (``distance`` = 0).
+        """
+        q_near = _joints(q_near, "q_near")
+        T = _transform(T)
+        solutions = self.ik_all(T, tcp, q6_hint=float(q_near[5]))
+        if len(solutions) == 0:
+            distance = float(self.out_of_reach(T[None], tcp)[0])
+            position = np.round(T[:3, 3], 4).tolist()
+            raise KinematicsError(
+                f"pose at {position} m is out of reach of the {self.name} by "
+                f"{distance * 1000:.1f} mm", distance=distance)
+        chosen, found = _ik.choose_nearest(solutions[None], q_near[None], self.q_min,
+                                           self.q_max)
+        if not found[0]:
+            raise KinematicsError(f"no solution for this pose lies within the joint limits of "
+                                  f"the {self.name}", distance=0.0)
+        return chosen[0]
+
+    def ik_many(self, T, q_near, tcp=None) -> np.ndarray:
+        """The controller's solutions (N, 6) for TCP poses ``T`` (N, 4, 4) or (N, 6); NaN rows
+        where a pose is out of reach or no solution fits the limits. ``q_near`` is (6,) for
+        all rows or (N, 6), one per row."""
+        flange = self._flange_targets(_transform_batch(T), tcp)
+        n = flange.shape[0]
+        near = np.asarray(q_near, dtype=float)
+        if near.shape == (6,):
+            near = np.broadcast_to(near, (n, 6))
+        elif near.shape != (n, 6):
+            raise KinematicsError(f"q_near must have shape (6,) or ({n}, 6), got {near.shape}")
+        solutions, _ = self._solve(flange, near[:, 5])
+        chosen, _ = _ik.choose_nearest(solutions, np.ascontiguousarray(near), self.q_min,
+                                       self.q_max)
+        return chosen
+
+    def ik_all_many(self, T, tcp=None) -> tuple[np.ndarray, np.ndarray]:
+        """All solutions of many poses: (N, 8, 6) with NaN rows for missing branches (see
+        :mod:`urdsl.kinematics.ik` for the branch order) and (N, 8) misses [m]."""
+        flange = self._flange_targets(_transform_batch(T), tcp)
+        return self._solve(flange, None)
+
+    # -- singularities --------------------------------------------------------------------
+
+    def singularity(self, Q) -> dict[str, np.ndarray]:
+        """Distances to the three singularities and the manipulability, each (N,):
+
+        * ``"shoulder"`` [m]: horizontal distance of the wrist centre (DH frame 5 origin)
+          from the vertical plane through the base axis parallel to the shoulder axis,
+          ``sqrt(r² − d4²)`` with ``r`` its distance to the base axis. 0: the base joint can
+          no longer move the wrist centre sideways (the two shoulder solutions merge).
+        * ``"elbow"`` [m]: how much the shoulder-to-wrist-1 distance ``L`` may still grow or
+          shrink before the arm is fully stretched or folded,
+          ``min(|a2| + |a3| − L, L − ||a2| − |a3||)``. 0: elbow singularity (θ3 = 0 or π).
+        * ``"wrist"`` [rad]: angle between the wrist-1 and wrist-3 axes, folded into
+          [0, π/2] (``|θ5|`` away from 0 or π on a nominal arm). 0: those axes are parallel.
+        * ``"manipulability"`` [m³]: ``sqrt(det(J·Jᵀ)) = |det J|`` of the 6x6 flange
+          Jacobian (rows m/s and rad/s); 0 at every singularity.
+        """
+        Q = _joint_batch(Q)
+        frames = dh_frames(Q, *self._dh)
+        origins = frames[:, :, :3, 3]
+        axes = frames[:, :, :3, 2]
+        wrist = origins[:, 5]
+        d4 = float(self._dh[2][3])
+        r2 = wrist[:, 0] ** 2 + wrist[:, 1] ** 2
+        shoulder = np.sqrt(np.maximum(r2 - d4 * d4, 0.0))
+        a2, a3 = abs(float(self._dh[1][1])), abs(float(self._dh[1][2]))
+        length = np.linalg.norm(origins[:, 3] - origins[:, 1], axis=1)
+        elbow = np.maximum(np.minimum(a2 + a3 - length, length - abs(a2 - a3)), 0.0)
+        sin_wrist = np.linalg.norm(np.cross(axes[:, 3], axes[:, 5]), axis=1)
+        wrist_angle = np.arcsin(np.clip(sin_wrist, 0.0, 1.0))
+        flange = origins[:, 6]
+        jacobian = np.concatenate(
+            [np.cross(axes[:, :6], flange[:, None] - origins[:, :6]), axes[:, :6]], axis=2)
+        manipulability = np.abs(np.linalg.det(jacobian))
+        return {"shoulder": shoulder, "elbow": elbow, "wrist": wrist_angle,
+                "manipulability": manipulability}
