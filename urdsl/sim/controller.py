@@ -114,6 +114,7 @@ class _Job:
     text: str
     name: str
     origin: str
+    module: Any = None  # the parsed program, set by the compiler thread
 
 
 @dataclass
@@ -194,6 +195,7 @@ class VirtualController:
         self._loaded: tuple[str, str] | None = None  # (name, text)
         self._last_program_name = ""
         self._jobs: queue.Queue[_Job | None] = queue.Queue()
+        self._compile: queue.Queue[_Job | None] = queue.Queue()
         self._subscribers: list[Callable[[Snapshot], None]] = []
         self._message_subscribers: list[Callable[[ControllerMessage], None]] = []
         self._message_log: list[ControllerMessage] = []
@@ -219,6 +221,7 @@ class VirtualController:
         self._started = True
         self._wall0 = time.perf_counter()
         for name, target in (("urdsl-sim-clock", self._clock),
+                             ("urdsl-sim-compiler", self._compiler),
                              ("urdsl-sim-runner", self._runner)):
             thread = threading.Thread(target=target, name=name, daemon=True)
             thread.start()
@@ -233,6 +236,7 @@ class VirtualController:
                 self._halt_program(self._program)
             self._wake.notify_all()
         self._jobs.put(None)
+        self._compile.put(None)
         for thread in self._threads:
             thread.join(timeout)
         self._threads.clear()
@@ -351,16 +355,10 @@ class VirtualController:
             self.submit_chunk(chunk.kind, chunk.text, origin)
 
     def submit_chunk(self, kind: str, text: str, origin: str) -> None:
-        """One framed program (``kind`` ``"def"``, ``"sec"`` or ``"bare"``)."""
-        if kind == "sec":
-            thread = threading.Thread(target=self._run_secondary, args=(text, origin),
-                                      name="urdsl-sim-sec", daemon=True)
-            thread.start()
-            return
-        with self._lock:
-            if self._program is not None:
-                self._halt_program(self._program)
-        self._jobs.put(_Job(kind, text, "", origin))
+        """One framed program (``kind`` ``"def"``, ``"sec"`` or ``"bare"``). It is parsed
+        first (in the compiler thread); a program with a syntax error is reported and leaves
+        the running program alone, a good one replaces it."""
+        self._compile.put(_Job(kind, text, "", origin))
 
     def stop_program(self) -> bool:
         """Stop the running program (dashboard ``stop``); False if none was running."""
@@ -427,9 +425,7 @@ class VirtualController:
             if self._loaded is None or not self._can_move():
                 return False
             name, text = self._loaded
-            if self._program is not None:
-                self._halt_program(self._program)
-            self._jobs.put(_Job("play", text, name, name))
+            self._compile.put(_Job("play", text, name, name))
             return True
 
     # ---- power and safety ----------------------------------------------------------------
@@ -509,6 +505,33 @@ class VirtualController:
                 self._wake.wait(min(wall_left, 0.05))
             program.interpreter.request_stop()
 
+    def _compiler(self) -> None:
+        from ..script.parser import parse
+
+        while not self._closing.is_set():
+            job = self._compile.get()
+            if job is None or self._closing.is_set():
+                return
+            if job.kind == "sec":
+                thread = threading.Thread(target=self._run_secondary,
+                                          args=(job.text, job.origin),
+                                          name="urdsl-sim-sec", daemon=True)
+                thread.start()
+                continue
+            try:
+                job.module = parse(job.text, filename=job.name or job.origin)
+            except ScriptSyntaxError as error:
+                self._report_error(error)
+                continue
+            except RecursionError:
+                self._publish(ControllerMessage(self.now(), "runtime_exception",
+                                                f"{job.origin}: the program nests too deeply"))
+                continue
+            with self._lock:
+                if self._program is not None:
+                    self._halt_program(self._program)
+                self._jobs.put(job)
+
     def _runner(self) -> None:
         while not self._closing.is_set():
             job = self._jobs.get()
@@ -526,15 +549,9 @@ class VirtualController:
 
     def _run_job(self, job: _Job) -> None:
         from ..runtime import Interpreter, RuntimeConfig
-        from ..script.parser import parse
 
         _wire_motion_builtins()
-        filename = job.name or job.origin
-        try:
-            module = parse(job.text, filename=filename)
-        except ScriptSyntaxError as error:
-            self._report_error(error)
-            return
+        module = job.module
         name = job.name or _program_name(module) or f"program{next(self._names)}"
         with self._lock:
             if not self._can_move():
