@@ -207,7 +207,7 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-_COMMAND_MODULES: list[str] = []
+_COMMAND_MODULES: list[str] = ["urdsl.sim.command"]
 """Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""
 
 
