@@ -463,6 +463,12 @@ class VirtualController:
             self._safety_mode = SafetyMode.NORMAL
             return True
 
+    def restart_safety(self) -> None:
+        """Dashboard ``restart safety``: leave any safety stop; the arm is powered off."""
+        with self._lock:
+            self.power_off()
+            self._safety_mode = SafetyMode.NORMAL
+
     # ---- internals: programs -------------------------------------------------------------
 
     def _can_move(self) -> bool:

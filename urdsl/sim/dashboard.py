@@ -43,7 +43,6 @@ class DashboardSession:
 
     def command(self, line: str) -> str:
         """The reply to one command line."""
-        sim = self.sim
         lower = line.lower()
         if lower.startswith("load installation "):
             return f"Loading installation: {line[18:].strip()}"
@@ -178,7 +177,7 @@ _COMMANDS = {
     "brake release": DashboardSession._brake_release,
     "unlock protective stop": DashboardSession._unlock,
     "close safety popup": lambda s: "closing safety popup",
-    "restart safety": lambda s: "Restarting safety",
+    "restart safety": lambda s: (s.sim.restart_safety(), "Restarting safety")[1],
     "close popup": lambda s: "closing popup",
     "isprogramsaved": DashboardSession._saved,
     "polyscopeversion": DashboardSession._polyscope,
