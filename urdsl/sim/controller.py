@@ -248,15 +248,17 @@ class VirtualController:
         self.close()
 
     def serve(self, host: str = "127.0.0.1", port_offset: int = 0,
-              ports: dict[str, int] | None = None):
+              ports: dict[str, int] | None = None, **options: Any):
         """Start the network interfaces (dashboard, primary, secondary, realtime, read-only
         ports, RTDE) and return the :class:`urdsl.sim.servers.SimServers` context manager.
         ``port_offset`` shifts every standard port; ``ports`` names single ports (0 = any
-        free port; the chosen ones are in ``servers.ports``)."""
+        free port; the chosen ones are in ``servers.ports``); ``send_limit``: bytes queued per
+        client before a stalled client is dropped."""
         from .servers import SimServers
 
         self.start()
-        return SimServers(self, host=host, port_offset=port_offset, ports=ports).start()
+        return SimServers(self, host=host, port_offset=port_offset, ports=ports,
+                          **options).start()
 
     # ---- time ----------------------------------------------------------------------------
 

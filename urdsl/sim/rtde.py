@@ -273,7 +273,8 @@ class RtdeSession:
             ok = self.output is not None and self.output.valid or (
                 self.output is None and bool(self.inputs))
             self.started = bool(ok)
-            self._phase = 1.0  # the first package goes out at the next step
+            # the first package goes out at the next step, then one every max/f steps
+            self._phase = 1.0 - self.frequency / self.max_frequency
             self._count = 0
             return package(kind, struct.pack(">B", self.started))
         if kind == PAUSE:

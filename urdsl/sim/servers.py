@@ -78,11 +78,11 @@ class _Client:
         self.writing = False
 
     def send(self, data: bytes) -> None:
-        """Queue ``data``; drop the client when its buffer would exceed :data:`SEND_LIMIT`."""
+        """Queue ``data``; drop the client when its buffer would exceed the limit."""
         if self.closed:
             return
         with self.lock:
-            if len(self.out) + len(data) > SEND_LIMIT:
+            if len(self.out) + len(data) > self.servers.send_limit:
                 self.dropped_for = "stalled: its send buffer is full"
                 self.closed = True
             else:
@@ -100,8 +100,9 @@ class SimServers:
     """
 
     def __init__(self, controller: Any, host: str = "127.0.0.1", port_offset: int = 0,
-                 ports: dict[str, int] | None = None) -> None:
+                 ports: dict[str, int] | None = None, send_limit: int = SEND_LIMIT) -> None:
         self.sim = controller
+        self.send_limit = send_limit
         self.host = host
         self.requested = {k: v + port_offset for k, v in STANDARD_PORTS.items()}
         for name, port in (ports or {}).items():
