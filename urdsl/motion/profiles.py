@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Trapezoid", "positions"]
+__all__ = ["Trapezoid", "positions", "speeds"]
 
 
 @dataclass(frozen=True)
@@ -119,3 +119,13 @@ def positions(t, distance, accel, peak, t_acc, t_flat) -> np.ndarray:
     falling = distance - 0.5 * accel * rest * rest
     result = np.where(t < t_acc, rising, np.where(t < t_acc + t_flat, cruising, falling))
     return np.where(distance == 0.0, 0.0, result)
+
+
+def speeds(t, distance, accel, peak, t_acc, t_flat) -> np.ndarray:
+    """Speed (units/s) at times ``t`` for many profiles at once, like :func:`positions`;
+    0 outside [0, duration]."""
+    duration = 2.0 * t_acc + t_flat
+    inside = (t >= 0.0) & (t <= duration)
+    speed = np.where(t < t_acc, accel * t,
+                     np.where(t < t_acc + t_flat, peak, accel * (duration - t)))
+    return np.where(inside & (distance > 0.0), speed, 0.0)

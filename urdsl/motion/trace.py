@@ -52,6 +52,7 @@ def _displacements(planner, times: np.ndarray):
     from .geometry import _exp_many, _log
     from .planner import JOINT_SPACE
     from .profiles import positions as profile_positions
+    from .profiles import speeds as profile_speeds
 
     count = len(times)
     segments = planner.segments
@@ -85,8 +86,24 @@ def _displacements(planner, times: np.ndarray):
         cartesian = np.array([s.kind not in JOINT_SPACE for s in segments])
         rows = np.flatnonzero(cartesian[entry_segment] & (p[:, 0] > 0))
         if len(rows):
-            moved[rows] = _cartesian(planner, segments, entry_segment[rows], fraction[rows],
-                                     q_start, moved[rows], _exp_many, _log)
+            local = rows - offsets[entry_segment[rows]]
+            seg_rows = entry_segment[rows]
+            local_t = times[entry_sample] - starts[entry_segment]
+            phase = (local_t[rows] >= p[rows, 3]).astype(np.int8) + (
+                local_t[rows] >= p[rows, 3] + p[rows, 4])
+            knots = _knots(planner, segments, seg_rows, local, lengths, times[1] - times[0]
+                           if count > 1 else 1.0, phase)
+            knot_rows = rows[knots]
+            moved[knot_rows] = _cartesian(planner, segments, entry_segment[knot_rows],
+                                          fraction[knot_rows], q_start, moved[knot_rows],
+                                          _exp_many, _log)
+            if not knots.all():
+                speed = profile_speeds(local_t[knot_rows], p[knot_rows, 0], p[knot_rows, 1],
+                                       p[knot_rows, 2], p[knot_rows, 3], p[knot_rows, 4])
+                velocity = _joint_velocities(planner, segments, entry_segment[knot_rows],
+                                             q_start, moved[knot_rows], fraction[knot_rows],
+                                             speed / p[knot_rows, 0], _exp_many, _log)
+                _hermite(moved, times[entry_sample], rows, knots, velocity)
             gaps = np.isnan(moved[rows]).any(axis=1)
             if gaps.any():
                 unreachable[entry_sample[rows[gaps]]] = True
@@ -99,6 +116,82 @@ def _displacements(planner, times: np.ndarray):
     # samples after a segment's end but before the next one starts keep the latest index
     np.maximum.accumulate(active, out=active)
     return positions, active, unreachable
+
+
+KNOT_TIME = 0.016
+"""Robot time (s) between the samples of a TCP path that are solved by inverse kinematics;
+the samples in between are cubic Hermite interpolations of the joints, with the joint
+speeds at the solved samples from the Jacobian (``q̇ = J⁻¹·twist``). Joint paths of
+straight-line moves are smooth away from singularities, where the error of this cubic is of
+the order of ``(h/2)⁴·q⁗`` — far below a micro-radian at 16 ms; near a singularity the
+Jacobian's speeds grow, which is what the checks look for."""
+
+
+def _knots(planner, segments, seg_rows, local, lengths, dt, phase) -> np.ndarray:
+    """Which samples of TCP paths are solved by IK: every ``KNOT_TIME``, the first and last
+    of each move, and those on either side of a change of the profile's phase (accelerating,
+    cruising, braking: the joint accelerations jump there, which a cubic would smooth); all
+    of them for arcs and for models without DH frames (``frames_many``)."""
+    every = max(1, int(round(KNOT_TIME / dt)))
+    if every == 1 or not hasattr(planner.kinematics, "frames_many"):
+        return np.ones(len(local), dtype=bool)
+    arcs = np.array([s.kind == "movec" for s in segments])
+    change = np.zeros(len(local), dtype=bool)
+    switch = (phase[1:] != phase[:-1]) & (seg_rows[1:] == seg_rows[:-1])
+    change[1:] |= switch
+    change[:-1] |= switch
+    return ((local % every == 0) | (local == lengths[seg_rows] - 1) | arcs[seg_rows]
+            | change)
+
+
+def _joint_velocities(planner, segments, which, q_start, moved, fraction, fraction_rate,
+                      exp_many, log) -> np.ndarray:
+    """Joint speeds (M, 6) rad/s at solved samples of straight TCP paths: the twist of the
+    path (linear ``(p1 − p0)·ḟ``, angular ``R0·w·ḟ`` with ``w = log(R0ᵀR1)``) through the
+    damped inverse of the TCP Jacobian. ``fraction_rate`` is ḟ in 1/s."""
+    from ..kinematics import pose as posemath
+
+    q = q_start[which] + moved
+    good = np.isfinite(q).all(axis=1)
+    velocity = np.full_like(q, np.nan)
+    if not good.any():
+        return velocity
+    q, which, rate = q[good], which[good], fraction_rate[good]
+    linear = np.array([s.pose_end[:3, 3] - s.pose_start[:3, 3] for s in segments])
+    angular = np.array([s.pose_start[:3, :3] @ log(s.pose_start[:3, :3].T @ s.pose_end[:3, :3])
+                        for s in segments])
+    twist = np.concatenate([linear[which], angular[which]], axis=1) * rate[:, None]
+    frames = planner.kinematics.frames_many(q)
+    point = frames[:, 6, :3, 3].copy()
+    for index in np.unique(which):
+        tcp = segments[index].tcp
+        if tcp is not None:
+            rows = which == index
+            point[rows] = (frames[rows, 6] @ posemath.to_matrix(tcp))[:, :3, 3]
+    axes, origins = frames[:, :6, :3, 2], frames[:, :6, :3, 3]
+    jacobian = np.concatenate([np.cross(axes, point[:, None] - origins), axes], axis=2)
+    jacobian = jacobian.transpose(0, 2, 1)  # (M, 6 twist rows, 6 joints)
+    normal = jacobian.transpose(0, 2, 1) @ jacobian + 1e-12 * np.eye(6)
+    velocity[good] = np.linalg.solve(normal, (jacobian.transpose(0, 2, 1)
+                                              @ twist[:, :, None]))[:, :, 0]
+    return velocity
+
+
+def _hermite(moved, entry_time, rows, knots, velocity) -> None:
+    """Fill the samples between solved ones (``rows[~knots]``) in place: cubic Hermite on the
+    joint displacements and speeds of the neighbouring solved samples of the same move."""
+    knot_positions = np.flatnonzero(knots)
+    inner = np.flatnonzero(~knots)
+    right = np.searchsorted(knot_positions, inner)  # index of the next solved sample
+    left = right - 1
+    r0, r1 = rows[knot_positions[left]], rows[knot_positions[right]]
+    t0, t1 = entry_time[r0], entry_time[r1]
+    h = (t1 - t0)[:, None]
+    s = ((entry_time[rows[inner]] - t0) / (t1 - t0))[:, None]
+    s2, s3 = s * s, s * s * s
+    moved[rows[inner]] = ((2 * s3 - 3 * s2 + 1) * moved[r0] + (s3 - 2 * s2 + s) * h
+                          * velocity[left] + (-2 * s3 + 3 * s2) * moved[r1]
+                          + (s3 - s2) * h * velocity[right])
 
 
 def _cartesian(planner, segments, which, fraction, q_start, linear, exp_many, log):

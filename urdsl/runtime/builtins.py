@@ -102,12 +102,15 @@ class BuiltinTable:
         rt = self.rt
         if rt.env.unsupported == "error":
             raise rt.error("unsupported", f"{row.name}() is not simulated by urdsl", node)
-        rt.event("unsupported", f"{row.name}() is not simulated; it did nothing here", node.span)
+        rt.event_once("unsupported", f"{row.name}() is not simulated; it did nothing here",
+                      node.span)
         kind = row.returns[0] if row.returns else "None"
-        if kind == "Array":
-            return ListValue([])
+        if kind == "Array":  # nearly all of them return a 6-vector (joints, wrench, speeds)
+            return ListValue([0.0] * 6)
         if kind == "Pose":
             return PoseValue([0.0] * 6)
+        if kind == "Matrix":  # the 6x6 ones: mass matrix, Jacobians
+            return ListValue([ListValue([0.0] * 6) for _ in range(6)])
         return _NEUTRAL.get(kind)
 
     def call_method(self, receiver: Any, method: str, args: list, named: dict,
@@ -348,6 +351,28 @@ def _make_list(rt, node, length, initial_value, capacity=None):
     return ListValue([initial_value] * length, capacity)
 
 
+@implements("inv")
+def _inv(rt, node, m):
+    rows = _matrix_rows(rt, node, m, "inv")
+    if len(rows) != len(rows[0]):
+        raise rt.error("type", f"inv() needs a square matrix, got {len(rows)}x{len(rows[0])}",
+                       node)
+    import numpy as np
+
+    matrix = np.array(rows, dtype=float)
+    if abs(np.linalg.det(matrix)) < 1e-300 or np.linalg.cond(matrix) > 1e15:
+        raise rt.error("arithmetic", "inv() of a singular matrix", node)
+    return ListValue([ListValue(list(map(float, row))) for row in np.linalg.inv(matrix)])
+
+
+def _matrix_rows(rt, node, m, name: str) -> list[list[float]]:
+    if (type(m) is not ListValue or not m or not all(type(r) is ListValue for r in m)
+            or len({len(r) for r in m}) != 1 or not all(is_number(v) for r in m for v in r)):
+        raise rt.error("type", f"{name}() needs a matrix of numbers, not a {type_name(m)}",
+                       node)
+    return [[float(v) for v in row] for row in m]
+
+
 @implements("transpose")
 def _transpose(rt, node, m):
     if type(m) is not ListValue:
@@ -559,3 +584,7 @@ def _socket_set_var(rt, node, name, value, socket_name="socket_0"):
 def _rpc_factory(rt, node, type, url):  # noqa: A002
     rt.event("rpc", f"rpc_factory({type!r}, {url!r}): calls are recorded, not made", node.span)
     return _RemoteHandle(str(type), str(url))
+
+
+# Motion, robot state and pose maths register themselves from their own module.
+from . import motion_builtins  # noqa: E402,F401

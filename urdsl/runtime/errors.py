@@ -42,6 +42,6 @@ class ScriptRuntimeError(ScriptError):
 
     def __init__(self, kind: str, message: str, span: Span = NO_SPAN, hint: str | None = None,
                  time: float | None = None) -> None:
-        super().__init__(Diagnostic.at(span, message, code=CODES[kind], hint=hint))
+        super().__init__(Diagnostic.at(span, message, code=CODES[kind], hint=hint), span)
         self.kind = kind
         self.time = time

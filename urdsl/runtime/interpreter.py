@@ -56,7 +56,7 @@ class RuntimeConfig:
     """
 
     step_time: float = 0.002
-    runaway_limit: int = 200_000
+    runaway_limit: int = 50_000
     max_time: float = 3600.0
     max_call_depth: int = 200
     pace: Callable[[float], None] | None = None
@@ -160,6 +160,7 @@ class Interpreter:
         self.critical: Thread | None = None
         self.halted = False
         self.stop_requested = False
+        self._once: set = set()
         self._threads: list[Thread] = []
         self._order = 0
         self._scheduler: greenlet.greenlet | None = None
@@ -177,7 +178,8 @@ class Interpreter:
         try:
             self._schedule(main, result)
         except ScriptRuntimeError as error:
-            error.time = self.time
+            if error.time is None:
+                error.time = self.time
             result.error = error
         finally:
             for thread in self._threads:
@@ -291,6 +293,14 @@ class Interpreter:
 
     def event(self, kind: str, message: str, span: Span = NO_SPAN) -> None:
         self.events.append(Event(self.time, kind, message, span))
+
+    def event_once(self, kind: str, message: str, span: Span = NO_SPAN) -> None:
+        """An event recorded only the first time this statement causes it (a builtin that is
+        not simulated, called in a loop, is reported once, not at every turn)."""
+        key = (kind, span)
+        if key not in self._once:
+            self._once.add(key)
+            self.event(kind, message, span)
 
     def error(self, kind: str, message: str, node: Any = None, hint: str | None = None):
         span = node.span if node is not None and hasattr(node, "span") else NO_SPAN

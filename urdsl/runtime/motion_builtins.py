@@ -19,6 +19,7 @@ import numpy as np
 from ..kinematics import KinematicsError
 from ..kinematics import pose as posemath
 from .builtins import implements
+from .errors import ScriptRuntimeError
 from .values import ListValue, PoseValue, is_number, type_name
 
 __all__: list[str] = []
@@ -27,11 +28,33 @@ __all__: list[str] = []
 # ---- argument conversion ---------------------------------------------------------------------
 
 
-def _arm(rt, node):
+def _arm(rt, node, resolve: bool = True):
+    """The interpreter's robot, with every move planned so far solved (a target out of reach
+    found now stops the program at that move's line). Straight-line moves pass
+    ``resolve=False``: their targets are solved later, in batches."""
     if rt.robot is None:
         raise rt.error("unsupported", "this program runs without a robot: motion and robot "
                        "state are not available", node)
+    if not resolve:
+        return rt.robot
+    try:
+        rt.robot.resolve()
+    except KinematicsError as error:
+        raise _ik_error(rt, node, error) from None
     return rt.robot
+
+
+def _ik_error(rt, node, error: KinematicsError):
+    """The runtime error for a failed inverse kinematics: at the move whose target failed
+    (when the planner found it later, in a batch), else at ``node``."""
+    span = getattr(error, "span", None)
+    if span is None:
+        return rt.error("ik", f"inverse kinematics failed: {error}", node, _IK_HINT)
+    return ScriptRuntimeError("ik", f"inverse kinematics failed: {error}", span, _IK_HINT,
+                              getattr(error, "time", rt.time))
+
+
+_IK_HINT = "the pose is out of reach of this robot with the active TCP"
 
 
 def _numbers(rt, node, value: Any, count: int, what: str) -> np.ndarray:
@@ -70,7 +93,7 @@ def _pose(rt, node, value: Any, what: str) -> np.ndarray:
 def _matrix(rt, node, value: Any, what: str) -> np.ndarray:
     """A Cartesian target as a 4x4 matrix: a pose, or joints turned into a pose by FK (the
     controller accepts joint vectors as targets of movel/movep/movec)."""
-    arm = _arm(rt, node)
+    arm = _arm(rt, node, resolve=False)
     if type(value) is PoseValue:
         return posemath.to_matrix(np.array(value, dtype=float))
     return arm.fk(_numbers(rt, node, value, 6, what))
@@ -89,8 +112,7 @@ def _solve(rt, node, arm, matrix: np.ndarray, near: np.ndarray | None) -> np.nda
     try:
         return arm.ik(matrix, near)
     except KinematicsError as error:
-        raise rt.error("ik", f"inverse kinematics failed: {error}", node,
-                       "the pose is out of reach of this robot with the active TCP") from None
+        raise _ik_error(rt, node, error) from None
 
 
 def _to_pose(matrix: np.ndarray) -> PoseValue:
@@ -107,8 +129,7 @@ def _plan(rt, node, plan) -> None:
     try:
         resume = plan()
     except KinematicsError as error:
-        raise rt.error("ik", f"inverse kinematics failed: {error}", node,
-                       "the pose is out of reach of this robot with the active TCP") from None
+        raise _ik_error(rt, node, error) from None
     except ValueError as error:
         raise rt.error("arithmetic", str(error), node) from None
     rt.wait_until(resume)
@@ -128,7 +149,7 @@ def _movej(rt, node, q, a=1.4, v=1.05, t=0, r=0):
 
 def _linear(kind: str):
     def move(rt, node, pose, a=1.2, v=0.25, t=0, r=0):
-        arm = _arm(rt, node)
+        arm = _arm(rt, node, resolve=False)
         target = _matrix(rt, node, pose, "the target")
         a, v = _number(rt, node, a, "a"), _number(rt, node, v, "v")
         t, r = _number(rt, node, t, "t"), _number(rt, node, r, "r")
@@ -143,7 +164,7 @@ implements("movep", "servoc")(_linear("movep"))
 
 @implements("movec")
 def _movec(rt, node, pose_via, pose_to, a=1.2, v=0.25, r=0, mode=0):
-    arm = _arm(rt, node)
+    arm = _arm(rt, node, resolve=False)
     via = _matrix(rt, node, pose_via, "pose_via")
     target = _matrix(rt, node, pose_to, "pose_to")
     a, v, r = _number(rt, node, a, "a"), _number(rt, node, v, "v"), _number(rt, node, r, "r")
@@ -358,3 +379,84 @@ def _rotvec2rpy(rt, node, rotation_vector):
 @implements("rpy2rotvec")
 def _rpy2rotvec(rt, node, rpy_vector):
     return _vector(posemath.rpy2rotvec(_numbers(rt, node, rpy_vector, 3, "the RPY vector")))
+
+
+@implements("wrench_trans")
+def _wrench_trans(rt, node, T_from_to, w_from):  # noqa: N803 - the catalog's parameter name
+    """Move a wrench [Fx, Fy, Fz, Mx, My, Mz] (N, N·m) into the frame ``T_from_to`` (the
+    new frame's pose in the old one): ``f' = Rᵀf``, ``m' = Rᵀ(m − p × f)`` [U: the manual
+    gives no formula; this is the rigid-body transformation of a wrench]."""
+    matrix = posemath.to_matrix(_pose(rt, node, T_from_to, "T_from_to"))
+    wrench = _numbers(rt, node, w_from, 6, "w_from")
+    rotation, offset = matrix[:3, :3], matrix[:3, 3]
+    force = rotation.T @ wrench[:3]
+    moment = rotation.T @ (wrench[3:] - np.cross(offset, wrench[:3]))
+    return _vector(np.concatenate([force, moment]))
+
+
+@implements("get_actual_tool_flange_pose")
+def _flange_pose(rt, node):
+    arm = _arm(rt, node)
+    return _to_pose(arm.kinematics.fk(arm.joints_at(rt.time)))
+
+
+@implements("get_target_waypoint")
+def _target_waypoint(rt, node):
+    """Where the current (or last) move goes: the end of everything planned so far."""
+    arm = _arm(rt, node)
+    return _to_pose(arm.fk(arm.target_joints))
+
+
+@implements("is_steady")
+def _is_steady(rt, node):
+    return bool(rt.time >= _arm(rt, node).free_at)
+
+
+@implements("get_jacobian")
+def _get_jacobian(rt, node, q="current_joint_positions", tcp="active_tcp"):
+    """The 6x6 geometric Jacobian at the TCP, rows (v m/s, ω rad/s) in Base axes, columns
+    per joint speed (rad/s) [U: row order and reference point as in UR's 5.22 examples]."""
+    arm = _arm(rt, node)
+    joints = arm.joints_at(rt.time) if isinstance(q, str) else _numbers(rt, node, q, 6, "q")
+    offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
+    return _matrix_value(_tcp_jacobian(arm, joints, offset))
+
+
+def _tcp_jacobian(arm, joints: np.ndarray, offset) -> np.ndarray:
+    jacobian = np.array(arm.kinematics.jacobian(joints), dtype=float)
+    if offset is not None:  # move the reference point from the flange to the TCP
+        flange = arm.kinematics.fk(joints)
+        lever = flange[:3, :3] @ np.asarray(offset, dtype=float)[:3]
+        jacobian[:3] -= np.cross(lever, jacobian[3:].T).T
+    return jacobian
+
+
+def _matrix_value(matrix: np.ndarray) -> ListValue:
+    return ListValue([ListValue([float(v) for v in row]) for row in matrix])
+
+
+@implements("get_jacobian_time_derivative")
+def _get_jacobian_dot(rt, node, q="current_joint_positions", qd="current_joint_speeds",
+                      tcp="active_tcp"):
+    """dJ/dt at joints ``q`` moving with ``qd`` (rad/s), by a central difference along qd."""
+    arm = _arm(rt, node)
+    joints = arm.joints_at(rt.time) if isinstance(q, str) else _numbers(rt, node, q, 6, "q")
+    if isinstance(qd, str):
+        speeds = np.array(_joint_speeds(rt, node), dtype=float)
+    else:
+        speeds = _numbers(rt, node, qd, 6, "qd")
+    offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
+    step = 1e-6
+    ahead = _tcp_jacobian(arm, joints + step * speeds, offset)
+    behind = _tcp_jacobian(arm, joints - step * speeds, offset)
+    return _matrix_value((ahead - behind) / (2 * step))
+
+
+@implements("direct_torque")
+def _direct_torque(rt, node, torques, friction_comp=True):
+    """Torque control is not simulated (urdsl has no dynamics): the arm holds still, and the
+    call lasts one controller step, as on the robot, so that control loops advance time."""
+    _numbers(rt, node, torques, 6, "torques")
+    rt.event_once("unsupported", "direct_torque() is not simulated: the arm holds still",
+                  node.span)
+    rt.wait(rt.config.step_time)

@@ -90,9 +90,10 @@ class Diagnostic:
 class ScriptError(Exception):
     """Base of errors about a URScript program; carries a :class:`Diagnostic`."""
 
-    def __init__(self, diagnostic: Diagnostic) -> None:
+    def __init__(self, diagnostic: Diagnostic, span: Span | None = None) -> None:
         super().__init__(diagnostic.render())
         self.diagnostic = diagnostic
+        self.span = span  # where in the source, when known
 
     @property
     def line(self) -> int:
@@ -120,7 +121,8 @@ class ScriptSyntaxError(ScriptError):
     def at_offset(
         cls, source: Source, start: int, end: int, message: str, hint: str | None = None
     ) -> ScriptSyntaxError:
-        return cls(Diagnostic.at(Span(source, start, end), message, code=cls.CODE, hint=hint))
+        span = Span(source, start, end)
+        return cls(Diagnostic.at(span, message, code=cls.CODE, hint=hint), span)
 
 
 def render(diagnostics: list[Diagnostic]) -> str:

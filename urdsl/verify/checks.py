@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..motion.planner import JOINT_SPACE
 from ..motion.trace import Trace
 from .findings import Finding
 
@@ -71,9 +72,15 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
             "URS304",
             f"{JOINTS[joint]} joint turns at {peak:.2f} rad/s, over its limit of "
             f"{limits[joint]:.2f} rad/s",
-            _span(trace, segment), float(trace.times[sample]),
-            "lower v (rad/s for movej, m/s for movel) or lengthen t"))
+            _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment)))
     return findings
+
+
+def _speed_hint(trace: Trace, segment: int) -> str:
+    kind = trace.segments[segment].kind if segment >= 0 else ""
+    if kind in JOINT_SPACE:
+        return f"lower v (rad/s of the leading joint) or lengthen t of this {kind}"
+    return f"lower v (m/s of the TCP) of this {kind}, or move further from singularities"
 
 
 def joint_accelerations(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = None
@@ -196,37 +203,45 @@ def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
         peak = float(np.max(speed[trace.segment == segment]))
         findings.append(Finding.of(
             "URS306", f"the TCP moves at {peak:.3f} m/s, over the cell's limit of {limit:g} m/s",
-            _span(trace, segment), float(trace.times[sample]),
-            "lower v (movej's v is a joint speed: lower it or use movel with v in m/s)"))
+            _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment)))
     return findings
 
 
-SINGULARITY_MARGINS = {"shoulder": 0.03, "elbow": 0.03, "wrist": 0.03}
-"""Default distances to a singularity below which URS307 warns, in the units of
-:meth:`urdsl.kinematics.Robot.singularity` (see there)."""
+SINGULARITY_MARGINS = {"shoulder": 0.05, "elbow": 0.02, "wrist": 0.05}
+"""Distances to a singularity below which URS307 warns, in the units of
+:meth:`urdsl.kinematics.Robot.singularity`: the wrist centre 5 cm from the vertical plane
+through the base axis (shoulder), the arm 2 cm from fully stretched or folded (elbow), the
+wrist-1 and wrist-3 axes 0.05 rad (2.9°) from parallel (wrist)."""
+
+_UNITS = {"shoulder": "m", "elbow": "m", "wrist": "rad"}
 
 
-def singularities(trace: Trace, robot, margin: float | None = None,
+def singularities(trace: Trace, robot, scale: float | None = None,
                   step: float = 0.01) -> list[Finding]:
-    """URS307: the arm comes close to a shoulder, elbow or wrist singularity, checked every
-    ``step`` s of robot time (also inside blends); ``margin`` replaces the defaults."""
+    """URS307: on a TCP path (also inside blends) the arm comes closer to a shoulder, elbow or
+    wrist singularity than :data:`SINGULARITY_MARGINS` times ``scale`` (default 1), checked
+    every ``step`` s of robot time."""
     stride = max(1, int(round(step / trace.dt)))
     index = np.arange(0, len(trace.times), stride)
     if len(index) == 0:
         return []
     measures = robot.singularity(trace.q[index])
+    # Joint moves pass singular configurations harmlessly; on a TCP path (and in blends into
+    # one) the joint speeds needed near them grow without bound.
+    kinds = np.array([s.kind not in JOINT_SPACE for s in trace.segments] + [False])
+    cartesian = kinds[trace.segment]
     findings = []
     for kind, default in SINGULARITY_MARGINS.items():
-        limit = default if margin is None else margin
+        limit = default * (1.0 if scale is None else scale)
         close = np.zeros(len(trace.times), dtype=bool)
         close[index] = np.abs(np.asarray(measures[kind])) < limit
-        close &= trace.segment >= 0
+        close &= cartesian
         for segment, sample in _per_segment(trace, close):
             move = trace.segments[segment]
             findings.append(Finding.of(
                 "URS307",
                 f"{kind} singularity: the {move.kind} passes within "
-                f"{abs(float(measures[kind][sample // stride])):.3g} of it at "
+                f"{abs(float(measures[kind][sample // stride])):.3g} {_UNITS[kind]} of it at "
                 f"t={trace.times[sample]:.3f} s (joint speeds grow without bound there)",
                 _span(trace, segment), float(trace.times[sample]),
                 _SINGULARITY_HINTS[kind]))
@@ -242,30 +257,38 @@ _SINGULARITY_HINTS = {
 
 def collisions(trace: Trace, robot, cell, step: float = 0.02,
                self_collision: bool = True) -> list[Finding]:
-    """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders) or itself,
-    checked every ``step`` s of robot time while it moves."""
-    from ..kinematics.collision import CollisionModel
-
+    """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders, planes) or itself,
+    checked every ``step`` s of robot time while it moves. ``cell`` is a path of a cell TOML
+    or a ready :class:`urdsl.kinematics.collision.CollisionModel` (None: no obstacles)."""
     if cell is None and not self_collision:
         return []
-    model = CollisionModel(robot, self_collision=self_collision)
-    if cell is not None:
-        model.load_cell(cell)
+    from ..kinematics.collision import CollisionModel
+
+    if isinstance(cell, CollisionModel):
+        model = cell
+    else:
+        model = CollisionModel(robot)
+        if cell is not None:
+            model.load_cell(cell)
     stride = max(1, int(round(step / trace.dt)))
     index = np.arange(0, len(trace.times), stride)
     index = index[trace.segment[index] >= 0]
     if len(index) == 0:
         return []
-    result = model.check(trace.q[index])
+    tcp = trace.segments[-1].tcp if trace.segments else None
+    result = model.check(trace.q[index], tcp=tcp)
     hit = np.zeros(len(trace.times), dtype=bool)
     hit[index] = result.colliding
     position = {int(sample): i for i, sample in enumerate(index)}
     findings = []
     for segment, sample in _per_segment(trace, hit):
-        pair = result.pairs[position[sample]]
-        what = " and ".join(pair) if pair else "an obstacle"
+        where = position[sample]
+        pairs = result.pairs.get(where) or [result.closest[where]]
+        what = ", ".join(" and ".join(pair) for pair in pairs[:3])
+        depth = -float(result.distance[where])
         findings.append(Finding.of(
-            "URS308", f"collision: {what} at t={trace.times[sample]:.3f} s",
+            "URS308", f"collision: {what} (overlap {depth * 1000:.0f} mm) at "
+            f"t={trace.times[sample]:.3f} s",
             _span(trace, segment), float(trace.times[sample]),
             "move around the obstacle with an extra waypoint"))
     return findings

@@ -65,6 +65,10 @@ def add_commands(commands) -> None:
     p.add_argument("--tcp", metavar="POSE", type=lambda t: parse_vector(t, 6, "--tcp"),
                    help="TCP offset from the flange: x,y,z in m and a rotation vector in rad "
                    "(default: the flange; a script's set_tcp() changes it)")
+    p.add_argument("--q-min", metavar="Q", type=lambda t: parse_vector(t, 6, "--q-min"),
+                   help="lower joint limits in rad set for the cell (default: the model's)")
+    p.add_argument("--q-max", metavar="Q", type=lambda t: parse_vector(t, 6, "--q-max"),
+                   help="upper joint limits in rad set for the cell (default: the model's)")
     p.add_argument("--cell", metavar="TOML",
                    help="cell description with the floor, boxes and cylinders to avoid")
     p.add_argument("--tcp-speed-limit", type=float, metavar="M_PER_S",
@@ -72,9 +76,9 @@ def add_commands(commands) -> None:
     p.add_argument("--joint-acceleration-limit", type=float, metavar="RAD_PER_S2",
                    help="maximum joint acceleration in rad/s² (UR publishes none; off "
                    "by default)")
-    p.add_argument("--singularity-margin", type=float, metavar="D",
-                   help="warn closer than this to a singularity (default 0.03: metres for "
-                   "shoulder, sine of the joint angle for elbow and wrist)")
+    p.add_argument("--singularity-scale", type=float, metavar="F",
+                   help="scale the distances at which URS307 warns (default 1: shoulder "
+                   "0.05 m, elbow 0.02 m, wrist 0.05 rad); 0 turns the warning off")
     p.add_argument("--no-self-collision", action="store_true",
                    help="do not check the arm against itself")
     p.add_argument("--max-time", type=float, default=3600.0, metavar="S",
@@ -102,12 +106,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     options = CheckOptions(
         robot=robot,
         start_joints=args.start_joints or args.start_joints_deg or DEFAULT_START,
-        tcp=args.tcp, cell=args.cell, tcp_speed_limit=args.tcp_speed_limit,
+        tcp=args.tcp, cell=args.cell, q_min=args.q_min, q_max=args.q_max,
+        tcp_speed_limit=args.tcp_speed_limit,
         joint_acceleration_limit=args.joint_acceleration_limit,
-        singularity_margin=args.singularity_margin, max_time=args.max_time,
+        singularity_scale=args.singularity_scale, max_time=args.max_time,
         self_collision=not args.no_self_collision)
     if args.cell:
-        _check_cell(args.cell)
+        options.cell = _load_cell(robot, args.cell)
     reports = []
     for name in args.files:
         if name.endswith(".py"):
@@ -130,17 +135,18 @@ def cmd_check(args: argparse.Namespace) -> int:
     return EXIT_PROBLEMS if any(r.has_errors for r in reports) else EXIT_OK
 
 
-def _check_cell(path: str) -> None:
+def _load_cell(robot: str, path: str):
+    """The collision model of ``robot`` with the cell's obstacles, or a usage error."""
     from ..cli import UsageError
-    from ..kinematics import MODELS, KinematicsError, Robot
+    from ..kinematics import KinematicsError, Robot
     from ..kinematics.collision import CollisionModel
 
+    model = CollisionModel(Robot.model(robot))
     try:
-        CollisionModel(Robot.model(next(iter(MODELS)))).load_cell(path)
-    except OSError as error:
-        raise UsageError(f"cannot read the cell {path}: {error.strerror}") from None
-    except (KinematicsError, ValueError) as error:
-        raise UsageError(f"bad cell description {path}: {error}") from None
+        model.load_cell(path)
+    except KinematicsError as error:
+        raise UsageError(f"bad cell description: {error}") from None
+    return model
 
 
 def _check_program(name: str, options):

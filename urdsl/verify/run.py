@@ -19,8 +19,9 @@ import numpy as np
 
 from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
-from ..runtime import Environment, Interpreter, RuntimeConfig
+from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
 from ..script.diagnostics import ScriptSyntaxError
+from ..script.nodes import NO_SPAN
 from ..script.parser import parse
 from . import checks
 from .findings import Finding
@@ -42,7 +43,7 @@ class CheckOptions:
     ``tcp``: TCP pose in the flange frame (m, rad) active from the start; ``cell``: path of a
     cell TOML (obstacles, see :mod:`urdsl.kinematics.collision`); ``tcp_speed_limit`` (m/s);
     ``joint_acceleration_limit`` (rad/s², one value or six); ``q_min``/``q_max``: user joint
-    limits (rad) replacing the model's; ``singularity_margin``: see
+    limits (rad) replacing the model's; ``singularity_scale``: see
     :func:`urdsl.verify.checks.singularities`; ``max_time``: robot time (s) after which a
     program that runs on is stopped; ``sample_time``: trace step in s (default: the
     controller's, 0.002 e-Series / 0.008 CB3); ``collision_step``: robot time (s) between
@@ -57,7 +58,7 @@ class CheckOptions:
     joint_acceleration_limit: float | tuple[float, ...] | None = None
     q_min: tuple[float, ...] | None = None
     q_max: tuple[float, ...] | None = None
-    singularity_margin: float | None = None
+    singularity_scale: float | None = None
     max_time: float = 3600.0
     sample_time: float | None = None
     collision_step: float = 0.02
@@ -74,7 +75,7 @@ def check_text(text: str, filename: str = "<script>", *, robot: str = "ur5e",
     except ScriptSyntaxError as error:
         report = Report(filename, options.robot)
         report.findings.append(Finding(error.diagnostic.code or "URS001", "error",
-                                       error.diagnostic.message, error.diagnostic.span,
+                                       error.diagnostic.message, error.span or NO_SPAN,
                                        None, error.diagnostic.hint))
         return report
     return check_tree(module, filename, options)
@@ -103,7 +104,7 @@ def check_tree(module, filename: str, options: CheckOptions) -> Report:
     robot = _robot_model(options.robot)
     cb3 = getattr(robot.spec, "generation", "") == "cb3"
     step = 0.008 if cb3 else 0.002
-    planner = MotionPlanner(robot, options.start_joints, step_time=step)
+    planner = MotionPlanner(robot, options.start_joints, step_time=step, lazy_ik=True)
     if options.tcp is not None:
         planner.tcp = np.asarray(options.tcp, dtype=float)
     config = RuntimeConfig(step_time=step, max_time=options.max_time)
@@ -113,6 +114,19 @@ def check_tree(module, filename: str, options: CheckOptions) -> Report:
 
     report = Report(filename, options.robot)
     report.events = result.events
+    if result.error is None and planner.failure is not None:
+        # found when the last moves were solved, after the script had run on: the robot
+        # stops at that move, so nothing after it happens
+        failure = planner.failure
+        result.error = ScriptRuntimeError("ik", f"inverse kinematics failed: {failure}",
+                                          failure.span, "the pose is out of reach of this "
+                                          "robot with the active TCP", failure.time)
+    if result.error is not None and result.error.kind == "ik":
+        # a target solved in a batch may fail after the script ran on: the robot stops at
+        # the move, so nothing after its start happens
+        result.time = min(result.time, result.error.time)
+        planner.end_time = max([result.time] + [s.end for s in planner.segments])
+        report.events = [e for e in result.events if e.time <= result.error.time]
     if result.error is not None:
         report.findings.append(_runtime_finding(result.error))
     for warning in planner.warnings:
@@ -142,9 +156,9 @@ def check_tree(module, filename: str, options: CheckOptions) -> Report:
 def _runtime_finding(error) -> Finding:
     diagnostic = error.diagnostic
     if error.kind == "ik":
-        return Finding.of("URS301", diagnostic.message, diagnostic.span, error.time,
+        return Finding.of("URS301", diagnostic.message, error.span, error.time,
                           diagnostic.hint)
-    return Finding(diagnostic.code, "error", diagnostic.message, diagnostic.span, error.time,
+    return Finding(diagnostic.code, "error", diagnostic.message, error.span, error.time,
                    diagnostic.hint)
 
 
@@ -164,7 +178,7 @@ def _trace_findings(trace, planner, robot, options: CheckOptions) -> list[Findin
     findings += checks.blend_radii(planner.segments)
     if options.tcp_speed_limit is not None:
         findings += checks.tcp_speed(trace, robot, options.tcp_speed_limit)
-    findings += checks.singularities(trace, robot, options.singularity_margin)
+    findings += checks.singularities(trace, robot, options.singularity_scale)
     findings += checks.collisions(trace, robot, options.cell, options.collision_step,
                                   options.self_collision)
     return findings

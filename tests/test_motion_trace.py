@@ -1,0 +1,31 @@
+"""The sampled trace of a real arm: knots with Hermite interpolation agree with solving every
+sample by inverse kinematics."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import urdsl.motion.trace as trace_module
+from urdsl.verify.run import CheckOptions, check_text
+
+PROGRAM = """movej([0, -1.9, 1.9, -1.57, -1.57, 0])
+home = get_actual_tcp_pose()
+movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]), r=0.02)
+movel(pose_add(home, p[0.1, 0.1, 0.05, 0.2, 0, 0]), r=0.02)
+set_tcp(p[0, 0, 0.1, 0, 0, 0])
+movel(pose_add(home, p[-0.1, 0.1, 0.15, 0, 0.3, 0]), v=0.5)
+movep(pose_add(home, p[0, 0, 0.1, 0, 0, 0]))
+"""
+
+
+@pytest.mark.parametrize("robot", ["ur5e", "ur10"])
+def test_interpolated_samples_match_solving_every_sample(robot, monkeypatch):
+    options = CheckOptions(robot=robot, self_collision=False)
+    interpolated = check_text(PROGRAM, "x.script", options=options).trace
+    monkeypatch.setattr(trace_module, "KNOT_TIME", 0.0)
+    dense = check_text(PROGRAM, "x.script", options=options).trace
+    assert interpolated.q.shape == dense.q.shape
+    assert np.abs(interpolated.q - dense.q).max() < 1e-6
+    assert np.abs(interpolated.qd - dense.qd).max() < 1e-3
+    assert np.abs(dense.qd).max() > 0.5  # the program moves fast enough to mean something
