@@ -623,6 +623,11 @@ class VirtualController:
         except ScriptError as error:
             self._report_error(error)
             return
+        except Exception as error:  # a bug in urdsl: report it, keep the controller up
+            self._publish(ControllerMessage(self.now(), "error",
+                                            f"internal error of the virtual controller in a "
+                                            f"sec program: {type(error).__name__}: {error}"))
+            return
         self._publish_env_messages()
         if result.error is not None:
             self._report_error(result.error)
@@ -913,6 +918,13 @@ class _ArmView:
 
     def joints_at(self, t: float) -> np.ndarray:
         return np.array(self._controller.snapshot().q)
+
+    def resolve(self) -> None:
+        return None
+
+    @property
+    def target_joints(self) -> np.ndarray:
+        return self.joints_at(0.0)
 
     def tcp_at(self, t: float) -> np.ndarray:
         return self.kinematics.fk(self.joints_at(t), tcp=self.tcp)
