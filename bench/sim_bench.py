@@ -16,13 +16,13 @@ does not run here. The numbers are absolute.
 from __future__ import annotations
 
 import argparse
+import multiprocessing
 import os
 import shutil
 import socket
 import struct
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -73,8 +73,9 @@ def _ask(sock: socket.socket, kind: str, payload: bytes = b"") -> bytes:
             return data
 
 
-def record(port: int, seconds: float, out: dict) -> None:
-    """One recording client: arrival times (s, perf_counter) and controller timestamps."""
+def record(port: int, seconds: float, out) -> None:
+    """One recording client (its own process): arrival times (s, perf_counter) and
+    controller timestamps, put on the queue ``out``."""
     sock = socket.create_connection(("127.0.0.1", port), timeout=5)
     _ask(sock, "V", struct.pack(">H", 2))
     recipe = _ask(sock, "O", struct.pack(">d", 500.0) + b"timestamp,actual_q")[0]
@@ -88,7 +89,7 @@ def record(port: int, seconds: float, out: dict) -> None:
             arrivals.append(time.perf_counter())
             stamps.append(layout.unpack(data)[1])
     sock.close()
-    out["arrivals"], out["stamps"] = np.array(arrivals), np.array(stamps)
+    out.put({"arrivals": np.array(arrivals), "stamps": np.array(stamps)})
 
 
 def main() -> int:
@@ -114,15 +115,17 @@ def main() -> int:
         with socket.create_connection(("127.0.0.1", 30002 + OFFSET), timeout=5) as sender:
             sender.sendall(PROGRAM.encode())
         time.sleep(0.5)
-        results = [dict() for _ in range(args.clients)]
-        threads = [threading.Thread(target=record, args=(30004 + OFFSET, args.seconds, r))
-                   for r in results]
+        queue = multiprocessing.Queue()
+        clients = [multiprocessing.Process(target=record,
+                                           args=(30004 + OFFSET, args.seconds, queue))
+                   for _ in range(args.clients)]
         cpu0, wall0 = _cpu_seconds(process.pid), time.perf_counter()
-        for thread in threads:
-            thread.start()
-        for thread in threads:
-            thread.join(args.seconds + 30)
+        for client in clients:
+            client.start()
+        results = [queue.get(timeout=args.seconds + 60) for _ in clients]
         cpu = (_cpu_seconds(process.pid) - cpu0) / (time.perf_counter() - wall0)
+        for client in clients:
+            client.join(10)
     finally:
         process.terminate()
         try:

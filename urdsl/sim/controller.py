@@ -59,6 +59,10 @@ seconds; clients poll ``robotmode`` either way."""
 UNLOCK_DELAY = 5.0
 """Controller time (s) after a protective stop before it may be unlocked (UR_FACTS.md §6)."""
 
+CATCH_UP = 50
+"""Controller steps (100 ms on e-Series) the clock publishes late, back to back, after a
+delay of the process; after a longer pause it skips ahead and counts the steps missed."""
+
 FOREVER = 1e12
 """Robot time limit (s) for programs: a controller runs a ``while True`` cell forever."""
 
@@ -677,9 +681,11 @@ class VirtualController:
                 time.sleep(left)
             else:
                 behind = int(-left / step_wall)
-                if behind > 0:  # fell behind (a pause of the process): skip, do not burst
+                if behind > CATCH_UP:  # a long pause of the process: skip, do not burst
                     tick += behind
                     self.stats.missed_ticks += behind
+                # a short delay: publish the late steps back to back (every one of them
+                # carries its own controller time), as a client must not see gaps
             self._step(tick * step_wall * self.speed)
 
     def _step(self, now: float) -> None:
