@@ -211,6 +211,29 @@ def test_python_urx_reads_joints_and_pose_and_movej_moves_the_arm(standard_sim):
         _rest()
 
 
+def test_ur_rtde_control_uploads_its_script_and_moves_j_and_l(standard_sim):
+    """Stretch goal: RTDEControlInterface sends its own control script (hundreds of lines
+    of URScript with threads and register handshakes), which our interpreter runs."""
+    rtde_control = pytest.importorskip("rtde_control")
+    rtde_receive = pytest.importorskip("rtde_receive")
+    control = rtde_control.RTDEControlInterface("127.0.0.1")
+    receiver = rtde_receive.RTDEReceiveInterface("127.0.0.1")
+    try:
+        assert control.isConnected() and control.isProgramRunning()
+        assert control.moveJ(TARGET, 1.4, 1.05)
+        assert np.allclose(receiver.getActualQ(), TARGET, atol=1e-6)
+        goal = np.array(receiver.getActualTCPPose())
+        goal[:3] += (0.03, 0.0, -0.05)
+        assert control.moveL(goal.tolist(), 0.5, 0.25)
+        reached = np.array(receiver.getActualTCPPose())
+        assert np.allclose(reached[:3], goal[:3], atol=1e-6)
+    finally:
+        control.stopScript()
+        control.disconnect()
+        receiver.disconnect()
+        _rest()
+
+
 @pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_urdsl_sim_shuts_down_cleanly_on_signals(sig):

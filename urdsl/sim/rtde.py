@@ -228,7 +228,7 @@ class RtdeSession:
         self.frequency = max_frequency
         self.started = False
         self._buffer = b""
-        self._next_id = 1
+        self._next_id = 1  # input recipes count from 1 (ur_rtde relies on it)
         self._phase = 0.0
         self._every = 1
         self._count = 0
@@ -305,9 +305,8 @@ class RtdeSession:
         recipe = _Recipe(names, types, _layout(types) if valid else None,
                          [OUTPUTS[n][1] for n in names] if valid else [], valid)
         self.output = recipe
-        self.output_id = self._next_id if valid else 0
+        self.output_id = 1 if valid else 0  # one output recipe per connection
         if valid:
-            self._next_id += 1
             self.frequency = frequency
             if self.version.e_series:
                 self._every = 1
