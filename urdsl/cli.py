@@ -208,6 +208,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 _COMMAND_MODULES: list[str] = [
+    "urdsl.dsl.command",
     "urdsl.kinematics.cli",
     "urdsl.verify.command",
     "urdsl.sim.command",

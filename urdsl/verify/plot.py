@@ -51,8 +51,11 @@ def plot_report(report, path: str | Path, robot=None) -> None:
         limit = float(robot.qd_max[joint])
         ax_qd.axhline(limit, color=colour, linestyle=":", linewidth=0.8)
         ax_qd.axhline(-limit, color=colour, linestyle=":", linewidth=0.8)
-    ax_q.axhline(float(np.max(robot.q_max)), color="grey", linestyle="--", linewidth=0.8)
-    ax_q.axhline(float(np.min(robot.q_min)), color="grey", linestyle="--", linewidth=0.8)
+    for bound in (robot.q_max, robot.q_min):  # UR3 wrist 3 is unlimited (infinite bound)
+        finite = np.asarray(bound)[np.isfinite(bound)]
+        if len(finite):
+            ax_q.axhline(float(np.max(np.abs(finite)) * np.sign(finite[0])), color="grey",
+                         linestyle="--", linewidth=0.8)
     for finding in report.findings:
         if finding.time is not None and finding.severity == "error":
             ax_q.axvline(finding.time, color="red", linewidth=0.8)

@@ -54,8 +54,17 @@ class Report:
     trace: Any = field(default=None, repr=False)
 
     def sort(self) -> None:
-        """Order findings by position in the file, then by time."""
+        """Order findings by position in the file, then by time; a finding repeated word for
+        word at the same statement (a function called in a loop) is kept once."""
         self.findings.sort(key=lambda f: (f.span.line, f.span.column, f.time or 0.0, f.code))
+        seen: set = set()
+        unique = []
+        for finding in self.findings:
+            key = (finding.code, finding.span, finding.message)
+            if key not in seen:
+                seen.add(key)
+                unique.append(finding)
+        self.findings = unique
 
     def count(self, severity: str) -> int:
         return sum(1 for f in self.findings if f.severity == severity)

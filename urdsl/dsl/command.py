@@ -1,0 +1,103 @@
+"""``urdsl compile``: run a DSL program file and print its URScript."""
+
+from __future__ import annotations
+
+import argparse
+import runpy
+import sys
+import traceback
+from pathlib import Path
+
+from .errors import DslError
+from .program import Program
+
+__all__ = ["add_commands", "load_program", "ProgramFileError"]
+
+_DESCRIPTION = """\
+Compile a Python program written with urdsl.dsl into URScript. The file defines a
+Program named `program`, or a function main() that returns one; it is run as Python (it is
+your program), with __name__ set to "__urdsl__" so that an `if __name__ == "__main__":`
+block does not run. The output is exactly what `urdsl fmt` prints for it.
+
+Exit status: 0 compiled, 1 the program has a mistake (shown with file:line), 2 usage errors.
+"""
+
+_EPILOG = """\
+examples:
+  urdsl compile programs/pick_and_place.py
+  urdsl compile programs/toolpath.py -o toolpath.script
+  urdsl compile programs/palletizing.py | urdsl check - --robot ur10e
+"""
+
+
+class ProgramFileError(Exception):
+    """A DSL program file that fails: its own exception, or neither ``program`` nor
+    ``main``. The message names the file and line."""
+
+
+def load_program(path: str | Path) -> Program:
+    """Run the program file ``path`` and return its :class:`Program` (``program`` or
+    ``main()``). Raises :class:`DslError` for DSL mistakes, :class:`ProgramFileError` when
+    the file raises or defines no program, ``OSError`` when it cannot be read."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(2, "No such file", str(path))
+    try:
+        namespace = runpy.run_path(str(path), run_name="__urdsl__")
+        program = namespace.get("program")
+        if program is None and callable(namespace.get("main")):
+            program = namespace["main"]()
+    except DslError:
+        raise
+    except SyntaxError as error:
+        raise ProgramFileError(f"{error.filename}:{error.lineno}: error: {error.msg}\n"
+                               f"  {(error.text or '').strip()}") from None
+    except Exception as error:  # the user's own code failed: show where, in their file
+        raise ProgramFileError(_where(error, path)) from None
+    if not isinstance(program, Program):
+        found = "nothing" if program is None else f"a {type(program).__name__}"
+        raise ProgramFileError(f"{path}: error: defines {found} as its program; it must define "
+                               "`program = Program(...)` or `def main(): return Program(...)`")
+    return program
+
+
+def _where(error: Exception, path: Path) -> str:
+    frames = [f for f in traceback.extract_tb(error.__traceback__)
+              if Path(f.filename).resolve() == path.resolve()]
+    head = f"{type(error).__name__}: {error}"
+    if not frames:
+        return f"{path}: error: {head}"
+    frame = frames[-1]
+    return f"{frame.filename}:{frame.lineno}: error: {head}\n  {(frame.line or '').strip()}"
+
+
+def add_commands(commands) -> None:
+    p = commands.add_parser("compile", help="compile a Python DSL program to URScript",
+                            description=_DESCRIPTION, epilog=_EPILOG,
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("program", metavar="PROGRAM.py", help="a Python file using urdsl.dsl")
+    p.add_argument("-o", "--output", metavar="OUT.script",
+                   help="write the URScript here instead of standard output")
+    p.set_defaults(run=cmd_compile)
+
+
+def cmd_compile(args: argparse.Namespace) -> int:
+    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+
+    try:
+        program = load_program(args.program)
+        text = program.script()
+    except OSError as error:
+        raise UsageError(f"cannot read {args.program}: {error.strerror}") from None
+    except (DslError, ProgramFileError) as error:
+        print(str(error), file=sys.stderr)
+        return EXIT_PROBLEMS
+    if args.output:
+        try:
+            Path(args.output).write_text(text, encoding="utf-8")
+        except OSError as error:
+            raise UsageError(f"cannot write {args.output}: {error.strerror}") from None
+        print(f"wrote {args.output} ({text.count(chr(10))} lines)", file=sys.stderr)
+    else:
+        sys.stdout.write(text)
+    return EXIT_OK
