@@ -1,0 +1,158 @@
+"""How steadily does ``urdsl sim`` publish RTDE at 500 Hz?
+
+Starts ``urdsl sim`` in its own process, runs a program that keeps the arm moving, and
+connects three RTDE clients that record timestamp and actual_q at 500 Hz for the given time.
+Prints, per client: packages received, the arrival interval (p50, p99, max, in ms), the
+jitter (|interval - 2 ms|, p99), dropped samples (gaps in the controller's timestamps), and
+the simulator process's CPU use. Target: p99 jitter < 1 ms, no drops.
+
+There is no peer to run side by side: URSim (the official simulator) is a Docker image that
+does not run here. The numbers are absolute.
+
+    .venv/bin/python bench/sim_bench.py                 # 60 s, 3 clients
+    .venv/bin/python bench/sim_bench.py --seconds 10 --clients 5
+"""
+
+from __future__ import annotations
+
+import argparse
+import multiprocessing
+import os
+import shutil
+import socket
+import struct
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+OFFSET = 3100
+PROGRAM = """def bench():
+  while True:
+    movej([0.8, -1.3, 1.2, -1.5, -1.5, 0.5], a=2, v=1.5)
+    movej([-0.8, -1.8, 1.8, -1.6, -1.6, -0.5], a=2, v=1.5)
+  end
+end
+"""
+
+
+def _command(*args: str) -> list[str]:
+    script = Path(sys.executable).with_name("urdsl")
+    found = str(script) if script.exists() else shutil.which("urdsl")
+    return [found, "sim", *args] if found else [sys.executable, "-m", "urdsl.cli", "sim", *args]
+
+
+def _cpu_seconds(pid: int) -> float:
+    with open(f"/proc/{pid}/stat") as handle:
+        fields = handle.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _recv(sock: socket.socket, count: int) -> bytes:
+    data = b""
+    while len(data) < count:
+        chunk = sock.recv(count - len(data))
+        if not chunk:
+            raise ConnectionError("closed")
+        data += chunk
+    return data
+
+
+def _package(sock: socket.socket) -> tuple[int, bytes]:
+    size, kind = struct.unpack(">HB", _recv(sock, 3))
+    return kind, _recv(sock, size - 3)
+
+
+def _ask(sock: socket.socket, kind: str, payload: bytes = b"") -> bytes:
+    sock.sendall(struct.pack(">HB", len(payload) + 3, ord(kind)) + payload)
+    while True:
+        got, data = _package(sock)
+        if got == ord(kind):
+            return data
+
+
+def record(port: int, seconds: float, out) -> None:
+    """One recording client (its own process): arrival times (s, perf_counter) and
+    controller timestamps, put on the queue ``out``."""
+    sock = socket.create_connection(("127.0.0.1", port), timeout=5)
+    _ask(sock, "V", struct.pack(">H", 2))
+    recipe = _ask(sock, "O", struct.pack(">d", 500.0) + b"timestamp,actual_q")[0]
+    _ask(sock, "S")
+    layout = struct.Struct(">Bd6d")
+    arrivals, stamps = [], []
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end:
+        kind, data = _package(sock)
+        if kind == ord("U") and data[0] == recipe:
+            arrivals.append(time.perf_counter())
+            stamps.append(layout.unpack(data)[1])
+    sock.close()
+    out.put({"arrivals": np.array(arrivals), "stamps": np.array(stamps)})
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--seconds", type=float, default=60.0)
+    parser.add_argument("--clients", type=int, default=3)
+    args = parser.parse_args()
+
+    process = subprocess.Popen(_command("--port-offset", str(OFFSET), "--quiet"),
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                with socket.create_connection(("127.0.0.1", 29999 + OFFSET), timeout=1):
+                    break
+            except OSError:
+                if time.monotonic() > deadline or process.poll() is not None:
+                    print("urdsl sim did not start", file=sys.stderr)
+                    return 1
+                time.sleep(0.2)
+        with socket.create_connection(("127.0.0.1", 30002 + OFFSET), timeout=5) as sender:
+            sender.sendall(PROGRAM.encode())
+        time.sleep(0.5)
+        queue = multiprocessing.Queue()
+        clients = [multiprocessing.Process(target=record,
+                                           args=(30004 + OFFSET, args.seconds, queue))
+                   for _ in range(args.clients)]
+        cpu0, wall0 = _cpu_seconds(process.pid), time.perf_counter()
+        for client in clients:
+            client.start()
+        results = [queue.get(timeout=args.seconds + 60) for _ in clients]
+        cpu = (_cpu_seconds(process.pid) - cpu0) / (time.perf_counter() - wall0)
+        for client in clients:
+            client.join(10)
+    finally:
+        process.terminate()
+        try:
+            process.wait(20)
+        except subprocess.TimeoutExpired:
+            process.kill()
+
+    print(f"urdsl sim RTDE at 500 Hz, {args.clients} clients, {args.seconds:g} s "
+          f"(no peer controller to compare against: URSim does not run here)")
+    print(f"{'client':>6} {'packages':>9} {'p50 ms':>7} {'p99 ms':>7} {'max ms':>7} "
+          f"{'jitter p99 ms':>13} {'dropped':>8}")
+    worst = 0.0
+    drops = 0
+    for index, result in enumerate(results):
+        intervals = np.diff(result["arrivals"]) * 1000
+        steps = np.diff(result["stamps"])
+        dropped = int(np.sum(np.round(steps / 0.002) - 1))
+        jitter = np.percentile(np.abs(intervals - 2.0), 99)
+        worst, drops = max(worst, jitter), drops + dropped
+        print(f"{index:>6} {len(result['stamps']):>9} {np.percentile(intervals, 50):7.3f} "
+              f"{np.percentile(intervals, 99):7.3f} {intervals.max():7.3f} {jitter:13.3f} "
+              f"{dropped:>8}")
+    print(f"simulator CPU: {cpu * 100:.0f}% of one core; worst p99 jitter {worst:.3f} ms "
+          f"(target < 1 ms): {'met' if worst < 1 else 'NOT met'}; dropped {drops} "
+          f"(target 0): {'met' if drops == 0 else 'NOT met'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,238 @@
+"""Server-side byte formats of the virtual controller: realtime packets, primary/secondary
+robot state and robot messages (no sockets).
+
+Layouts follow ../shared/reference/UR_FACTS.md §3 (realtime) and §4 (primary/secondary); all
+big-endian. Quantities the simulation does not model (motor currents, temperatures,
+voltages, forces) are sent as 0.0 so that clients parse complete packets; the real values
+are what the arm moves (joints, speeds, TCP pose and speed, modes, I/O).
+
+The sans-I/O client side (decoders) lives in :mod:`urdsl.protocol`; these encoders exist
+because the simulator had to serve before that layer landed (see the issue-8 note).
+"""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+
+from .state import ControllerVersion, ProgramState, RobotMode, SafetyMode, Snapshot
+
+__all__ = [
+    "realtime_size", "encode_realtime", "encode_robot_state", "encode_version_message",
+    "encode_text_message", "encode_runtime_exception", "encode_safety_message",
+    "ROBOT_STATE", "ROBOT_MESSAGE",
+]
+
+ROBOT_STATE = 16
+ROBOT_MESSAGE = 20
+SOURCE_CONTROLLER = -2  # [U] the int8 source the controller puts on its own messages
+
+
+# ---- realtime (30003 / 30013) ---------------------------------------------------------------
+
+
+def realtime_size(version: ControllerVersion) -> int:
+    """Total packet size (bytes, including the int32 size field) for a software version
+    (UR_FACTS.md §3.3; 3.14/3.15 and 5.9 are sent as 1116, the last confirmed layout [U])."""
+    major, minor = version.major, version.minor
+    if major == 3:
+        if minor <= 1:
+            return 1044
+        if minor <= 4:
+            return 1060
+        if minor <= 9:
+            return 1108
+        return 1116
+    if minor <= 3:
+        return 1108
+    if minor <= 9:
+        return 1116
+    return 1220
+
+
+def _col(number: int) -> int:
+    """Index in the double array of the realtime table's 1-based (gnuplot) column."""
+    return number - 1
+
+
+def encode_realtime(snap: Snapshot, version: ControllerVersion) -> bytes:
+    """One realtime packet: int32 size, then doubles at the offsets of UR_FACTS.md §3.1."""
+    size = realtime_size(version)
+    values = np.zeros((size - 4) // 8)
+    values[_col(1)] = snap.time
+    values[_col(2):_col(8)] = snap.q           # q target (the planner's path is the target)
+    values[_col(8):_col(14)] = snap.qd         # qd target
+    values[_col(14):_col(20)] = snap.qdd       # qdd target
+    values[_col(32):_col(38)] = snap.q         # q actual
+    values[_col(38):_col(44)] = snap.qd        # qd actual
+    values[_col(56):_col(62)] = snap.tcp       # tool vector actual
+    values[_col(62):_col(68)] = snap.tcp_speed
+    values[_col(74):_col(80)] = snap.tcp       # tool vector target
+    values[_col(80):_col(86)] = snap.tcp_speed
+    values[_col(86)] = snap.digital_inputs
+    values[_col(93)] = snap.time               # controller timer
+    values[_col(95)] = int(snap.robot_mode)
+    values[_col(96):_col(102)] = int(snap.joint_mode)
+    values[_col(102)] = int(snap.safety_mode)
+    values[_col(118)] = snap.speed_scaling
+    if size > 1044:
+        values[_col(131)] = snap.digital_outputs
+        values[_col(132)] = int(snap.program_state)
+    if size > 1060:
+        values[_col(133):_col(136)] = snap.elbow
+        values[_col(136):_col(139)] = snap.elbow_speed
+    if size > 1108:
+        values[_col(139)] = int(snap.safety_mode)
+    if size > 1116:
+        values[_col(143)] = snap.payload_mass
+        values[_col(144):_col(147)] = snap.payload_cog
+    return struct.pack(">i", size) + values.astype(">f8").tobytes()
+
+
+# ---- primary / secondary (30001 / 30002, read-only 30011 / 30012) ----------------------------
+
+
+def _package(kind: int, body: bytes) -> bytes:
+    """A ROBOT_STATE sub-package: uint32 size (incl. the 5-byte header), uint8 type, body."""
+    return struct.pack(">IB", len(body) + 5, kind) + body
+
+
+def _robot_mode_data(snap: Snapshot, version: ControllerVersion) -> bytes:
+    running = snap.program_running
+    head = struct.pack(
+        ">Q???????BBdd", int(snap.time * 1000), True, snap.power_on, snap.power_on,
+        False, snap.safety_mode == SafetyMode.PROTECTIVE_STOP, running, snap.program_paused,
+        max(int(snap.robot_mode), 0), 0, snap.target_speed_fraction, snap.speed_scaling)
+    if version < ControllerVersion(3, 2):
+        return _package(0, head)                                     # 38 bytes
+    head += struct.pack(">d", 1.0)                                   # target speed limit
+    if version < ControllerVersion(3, 5):
+        return _package(0, head)                                     # 46 bytes
+    return _package(0, head + b"\x00")                               # 47 bytes
+
+
+def _joint_data(snap: Snapshot) -> bytes:
+    body = b"".join(
+        struct.pack(">dddffffB", snap.q[i], snap.q[i], snap.qd[i], 0.0, 0.0, 0.0, 0.0,
+                    int(snap.joint_mode))
+        for i in range(6))
+    return _package(1, body)                                         # 251 bytes
+
+
+def _tool_data(snap: Snapshot) -> bytes:
+    body = struct.pack(">BBddfBffB", 0, 0, snap.tool_analog_inputs[0],
+                       snap.tool_analog_inputs[1], 0.0, 0, 0.0, 0.0, 0)
+    return _package(2, body)                                         # 37 bytes
+
+
+def _masterboard_data(snap: Snapshot) -> bytes:
+    body = struct.pack(
+        ">IIBBddBBddffffBBBIBBB",
+        snap.digital_inputs & 0xFFFFFFFF, snap.digital_outputs & 0xFFFFFFFF, 0, 0,
+        snap.analog_inputs[0], snap.analog_inputs[1], 0, 0,
+        snap.analog_outputs[0], snap.analog_outputs[1], 0.0, 0.0, 0.0, 0.0,
+        int(snap.safety_mode), snap.safety_mode == SafetyMode.REDUCED, False, 0, 0, False, 0)
+    return _package(3, body)
+
+
+def _cartesian_info(snap: Snapshot, version: ControllerVersion) -> bytes:
+    body = struct.pack(">6d", *snap.tcp)
+    if version >= ControllerVersion(3, 2):
+        body += struct.pack(">6d", *snap.tcp_offset)
+    return _package(4, body)                                         # 101 bytes (53 < 3.2)
+
+
+def _kinematics_info(spec) -> bytes:
+    body = struct.pack(">6I", *([0] * 6))
+    body += struct.pack(">24d", *([0.0] * 6), *spec.dh_a, *spec.dh_d, *spec.dh_alpha)
+    return _package(5, body + struct.pack(">I", 0))                  # 225 bytes
+
+
+def _configuration_data(spec, qd_max, q_min, q_max) -> bytes:
+    limits = [v for i in range(6) for v in (q_min[i], q_max[i])]
+    limits = [v if np.isfinite(v) else np.sign(v) * 1e9 for v in limits]
+    speeds = [v for i in range(6) for v in (qd_max[i], 0.0)]  # max accel: not published
+    defaults = (1.05, 1.4, 0.25, 1.2, 0.0)  # movej v, a; movel v, a (script defaults); eq radius
+    body = struct.pack(">12d12d5d", *limits, *speeds, *defaults)
+    body += struct.pack(">24d", *spec.dh_a, *spec.dh_d, *spec.dh_alpha, *([0.0] * 6))
+    body += struct.pack(">4i", 0, 0, int(getattr(spec, "robot_type", 0)), 0)
+    return _package(6, body)                                         # 445 bytes
+
+
+def _force_mode_data() -> bytes:
+    return _package(7, struct.pack(">7d", *([0.0] * 7)))             # 61 bytes
+
+
+def _additional_info(version: ControllerVersion) -> bytes:
+    if version.e_series:  # freedrive button pressed / enabled, IO-enabled freedrive [U]
+        return _package(8, struct.pack(">???", False, False, False))
+    return _package(8, struct.pack(">??", False, False))             # teach button
+
+
+def encode_robot_state(snap: Snapshot, version: ControllerVersion, spec=None,
+                       limits: tuple | None = None, configuration: bool = False) -> bytes:
+    """A ROBOT_STATE message (type 16): robot mode, joint, tool, masterboard, cartesian,
+    (kinematics and configuration when ``configuration`` and a model ``spec`` are given),
+    force mode and additional info sub-packages. ``limits`` = (qd_max, q_min, q_max)."""
+    parts = [_robot_mode_data(snap, version), _joint_data(snap), _tool_data(snap),
+             _masterboard_data(snap), _cartesian_info(snap, version)]
+    if configuration and spec is not None:
+        parts.append(_kinematics_info(spec))
+        if limits is not None:
+            parts.append(_configuration_data(spec, *limits))
+    if version >= ControllerVersion(3, 2):
+        parts += [_force_mode_data(), _additional_info(version)]
+    body = b"".join(parts)
+    return struct.pack(">iB", len(body) + 5, ROBOT_STATE) + body
+
+
+def _robot_message(time: float, kind: int, body: bytes) -> bytes:
+    head = struct.pack(">QbB", int(time * 1000), SOURCE_CONTROLLER, kind)
+    payload = head + body
+    return struct.pack(">iB", len(payload) + 5, ROBOT_MESSAGE) + payload
+
+
+def encode_version_message(version: ControllerVersion, time: float = 0.0,
+                           build_date: str = "urdsl virtual controller") -> bytes:
+    """ROBOT_MESSAGE VERSION (type 3), the first message on 30001/30002 (layout of 3.12+/5.x)."""
+    name = b"URControl"
+    body = struct.pack(">b", len(name)) + name
+    body += struct.pack(">BBii", version.major, version.minor, version.bugfix, version.build)
+    return _robot_message(time, 3, body + build_date.encode("utf-8"))
+
+
+def encode_text_message(text: str, time: float = 0.0) -> bytes:
+    """ROBOT_MESSAGE TEXT (type 0): what ``textmsg`` shows."""
+    return _robot_message(time, 0, text.encode("utf-8", errors="replace"))
+
+
+def encode_runtime_exception(line: int, column: int, text: str, time: float = 0.0) -> bytes:
+    """ROBOT_MESSAGE RUNTIME_EXCEPTION (type 10): uint32 line, uint32 column, text."""
+    body = struct.pack(">II", max(line, 0), max(column, 0))
+    return _robot_message(time, 10, body + text.encode("utf-8", errors="replace"))
+
+
+def encode_safety_message(code: int, argument: int, mode: SafetyMode, time: float = 0.0) -> bytes:
+    """ROBOT_MESSAGE SAFETY_MODE (type 5): int32 code, int32 argument, uint8 safety mode,
+    uint32 report data type (0: none), uint32 report data."""
+    body = struct.pack(">iiBII", code, argument, int(mode), 0, 0)
+    return _robot_message(time, 5, body)
+
+
+def robot_status_bits(snap: Snapshot) -> int:
+    """RTDE ``robot_status_bits``: bit 0 power on, 1 program running, 2 teach button,
+    3 power button."""
+    return int(snap.power_on) | int(snap.program_running) << 1
+
+
+def safety_status_bits(snap: Snapshot) -> int:
+    """RTDE ``safety_status_bits``: bit 0 normal, 1 reduced, 2 protective stop, 3 recovery,
+    4 safeguard stop, 5 system e-stop, 6 robot e-stop, 7 e-stop, 8 violation, 9 fault."""
+    mode = snap.safety_mode
+    if mode == SafetyMode.NORMAL:
+        return 1
+    return 1 << (int(mode) - 1) if 1 <= int(mode) <= 10 else 0
+
+
+__all__ += ["robot_status_bits", "safety_status_bits", "ProgramState", "RobotMode"]
