@@ -106,7 +106,7 @@ def test_record_and_plot(sim, tmp_path):
                   duration=0.6, port=sim["rtde"])
     assert rows > 20
     with open(output, newline="") as handle:
-        table = list(csv.reader(handle))
+        table = list(csv.reader(handle, delimiter=" "))  # UR record.py's format
     assert table[0][:3] == ["timestamp", "actual_q_0", "actual_q_1"]
     assert len(table[0]) == 1 + 6 + 6 + 1 and len(table) == rows + 1
     times = [float(r[0]) for r in table[1:]]

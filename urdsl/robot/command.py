@@ -61,9 +61,10 @@ def add_commands(commands) -> None:
 
     p = commands.add_parser(
         "record", help="record RTDE outputs to a CSV file",
-        description="Record RTDE outputs (protocol 2, falling back to 1) to CSV: a header "
-        "row with timestamp first and vectors expanded (actual_q_0 … actual_q_5). Ctrl-C "
-        "stops and keeps what was recorded.",
+        description="Record RTDE outputs (protocol 2, falling back to 1) to CSV in the "
+        "format of UR's record.py (space-delimited, a header row with timestamp first and "
+        "vectors expanded: actual_q_0 … actual_q_5). Ctrl-C stops and keeps what was "
+        "recorded.",
         epilog="examples:\n  urdsl record --host 127.0.0.1 --duration 10 -o run.csv\n"
         "  urdsl record --host 127.0.0.1 --fields actual_q,actual_TCP_pose --frequency 500 "
         "-o fast.csv",

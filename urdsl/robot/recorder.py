@@ -1,8 +1,9 @@
 """Recording RTDE outputs to CSV, and plotting a recording.
 
-The CSV has one header row: ``timestamp`` first, vectors expanded to ``name_0`` …
-``name_5`` (as UR's own ``record.py`` names them, but comma-separated). Rows are flushed
-every 0.5 s, so an interrupted recording keeps what was received.
+The CSV is the format of UR's own ``record.py`` (so UR's ``csv_reader`` and plotting
+examples read it): space-delimited, one header row, ``timestamp`` first, vectors expanded to
+``name_0`` … ``name_5``. Rows are flushed every 0.5 s, so an interrupted recording keeps what
+was received. :func:`plot_csv` reads space- and comma-delimited files.
 """
 
 from __future__ import annotations
@@ -65,7 +66,7 @@ def record(host: str, output: str | Path, fields: list[str] | None = None,
         columns = rtde.expand_names(list(setup.names), list(setup.types))
         stop = Deadline(duration) if duration is not None else None
         with open(output, "w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle)
+            writer = csv.writer(handle, delimiter=" ")
             writer.writerow(columns)
             flushed = time.monotonic()
             try:
@@ -109,7 +110,9 @@ def plot_csv(csv_path: str | Path, png_path: str | Path, columns: list[str] | No
     import numpy as np
 
     with open(csv_path, newline="", encoding="utf-8") as handle:
-        reader = csv.reader(handle)
+        first = handle.readline()
+        handle.seek(0)
+        reader = csv.reader(handle, delimiter="," if "," in first else " ")
         try:
             header = next(reader)
         except StopIteration:
