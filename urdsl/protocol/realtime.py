@@ -155,9 +155,15 @@ def encode(fields: dict, size: int = 1220, layout: str | None = None) -> bytes:
         raise ProtocolError(f"the {name} realtime layout has no field {sorted(unknown)[0]!r}")
     count = (size - 4) // 8
     values: list[float] = []
+    written = set()
     for entry in table:
         if len(values) + entry.count > count:
+            missing = sorted(set(fields) - written)
+            if missing:
+                raise ProtocolError(f"field {missing[0]!r} does not fit in a {size}-byte "
+                                    f"{name} realtime packet")
             break
+        written.add(entry.name)
         value = fields.get(entry.name, 0.0 if entry.count == 1 else (0.0,) * entry.count)
         items = (value,) if entry.count == 1 else tuple(value)
         if len(items) != entry.count:
