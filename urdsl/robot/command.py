@@ -9,8 +9,8 @@ import time
 
 __all__ = ["add_commands"]
 
-_HOST_HELP = ("the controller's address, e.g. 127.0.0.1 for `urdsl sim`, or your robot's "
-              "(such as 192.168.0.10)")
+_HOST_HELP = ("the controller's address (default 127.0.0.1: `urdsl sim` on this machine); "
+              "your robot's, such as 192.168.0.10")
 
 
 def add_commands(commands) -> None:
@@ -27,7 +27,7 @@ def add_commands(commands) -> None:
         "  urdsl send sec_io.script --host 127.0.0.1 --port 30003 --no-wait",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("file", metavar="FILE|PROGRAM.py")
-    p.add_argument("--host", required=True, help=_HOST_HELP)
+    p.add_argument("--host", default="127.0.0.1", help=_HOST_HELP)
     p.add_argument("--port", type=int, default=30002,
                    help="script port: 30001 primary, 30002 secondary (default), 30003 "
                    "realtime (or a simulator's shifted port)")
@@ -50,7 +50,7 @@ def add_commands(commands) -> None:
         "  urdsl state --host 127.0.0.1 --interface rtde --json\n"
         "  urdsl state --host 127.0.0.1 --watch",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--host", required=True, help=_HOST_HELP)
+    p.add_argument("--host", default="127.0.0.1", help=_HOST_HELP)
     p.add_argument("--interface", choices=("realtime", "primary", "rtde"), default="realtime")
     p.add_argument("--port", type=int, help="default: 30003, 30002 or 30004 by interface")
     p.add_argument("--watch", action="store_true", help="print the state every 0.5 s until "
@@ -69,7 +69,7 @@ def add_commands(commands) -> None:
         "  urdsl record --host 127.0.0.1 --fields actual_q,actual_TCP_pose --frequency 500 "
         "-o fast.csv",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--host", required=True, help=_HOST_HELP)
+    p.add_argument("--host", default="127.0.0.1", help=_HOST_HELP)
     p.add_argument("--port", type=int, default=30004)
     p.add_argument("--fields", default="actual_q,actual_qd,actual_TCP_pose,runtime_state",
                    help="comma-separated RTDE output names")
@@ -98,7 +98,7 @@ def add_commands(commands) -> None:
         "  urdsl dashboard --host 127.0.0.1 power on\n"
         "  urdsl dashboard --host 127.0.0.1 load pick.urp",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--host", required=True, help=_HOST_HELP)
+    p.add_argument("--host", default="127.0.0.1", help=_HOST_HELP)
     p.add_argument("--port", type=int, default=29999)
     p.add_argument("--timeout", type=float, default=5.0, metavar="S")
     p.add_argument("words", nargs="+", metavar="COMMAND")
