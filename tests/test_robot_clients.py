@@ -159,3 +159,45 @@ def test_a_server_that_hangs_up_is_a_clear_error():
         with pytest.raises(RobotConnectionError, match="closed the connection"):
             read_state(HOST, "realtime", port, timeout=2.0)
         thread.join(timeout=2)
+
+
+def test_a_recording_cut_off_mid_stream_leaves_a_valid_file(tmp_path):
+    """An RTDE server (written here with the codecs) that streams 50 samples and hangs up."""
+    import struct
+    import threading
+
+    from urdsl.protocol import rtde
+
+    server = socket.socket()
+    server.bind((HOST, 0))
+    server.listen(1)
+    port = server.getsockname()[1]
+
+    def serve():
+        connection, _ = server.accept()
+        connection.settimeout(5)
+        decoder = rtde.PackageDecoder()
+        replies = {86: b"\x01", 79: b"\x01DOUBLE,VECTOR6D", 83: b"\x01"}
+        answered = 0
+        while answered < 3:
+            for kind, _payload in decoder.feed(connection.recv(4096)):
+                connection.sendall(rtde.encode_package(kind, replies[kind]))
+                answered += 1
+        for i in range(50):
+            connection.sendall(rtde.encode_package(85, struct.pack(">Bd6d", 1, i * 0.008,
+                                                                   *[i] * 6)))
+        whole = rtde.encode_package(85, struct.pack(">Bd6d", 1, 1.0, *[0] * 6))
+        connection.sendall(whole[:20])  # half a package, then gone
+        connection.close()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    output = tmp_path / "cut.csv"
+    with pytest.raises(RobotConnectionError, match="closed the connection"):
+        record(HOST, output, ["actual_q"], 125.0, duration=5.0, port=port, timeout=3.0)
+    thread.join(timeout=5)
+    server.close()
+    with open(output, newline="") as handle:
+        table = list(csv.reader(handle, delimiter=" "))
+    assert table[0] == ["timestamp"] + [f"actual_q_{i}" for i in range(6)]
+    assert len(table) == 51 and float(table[-1][1]) == 49

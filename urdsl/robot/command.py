@@ -162,6 +162,7 @@ def map_back(sent_tree, sent_text: str, line: int, column: int):
 def cmd_send(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE
     from ..kinematics import MODELS
+    from ..protocol import ProtocolError
     from ..script.diagnostics import Diagnostic
     from ..script.printer import format as format_tree
     from .connection import RobotConnectionError
@@ -193,7 +194,7 @@ def cmd_send(args: argparse.Namespace) -> int:
             return EXIT_OK
         result = run_program(text, args.host, args.port, timeout=args.timeout,
                              primary_port=args.primary_port)
-    except RobotConnectionError as error:
+    except (RobotConnectionError, ProtocolError) as error:
         print(f"urdsl: error: {error}", file=sys.stderr)
         return EXIT_USAGE
     for message in result.messages:
@@ -223,6 +224,7 @@ def cmd_send(args: argparse.Namespace) -> int:
 
 def cmd_state(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_USAGE
+    from ..protocol import ProtocolError
     from .connection import RobotConnectionError
     from .state import read_state
 
@@ -242,7 +244,7 @@ def cmd_state(args: argparse.Namespace) -> int:
                 return EXIT_OK
             sys.stdout.flush()
             time.sleep(0.5)
-    except RobotConnectionError as error:
+    except (RobotConnectionError, ProtocolError) as error:
         print(f"urdsl: error: {error}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
@@ -251,6 +253,7 @@ def cmd_state(args: argparse.Namespace) -> int:
 
 def cmd_record(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_USAGE
+    from ..protocol import ProtocolError
     from .connection import RobotConnectionError
     from .recorder import record
 
@@ -263,7 +266,7 @@ def cmd_record(args: argparse.Namespace) -> int:
     try:
         rows = record(args.host, args.output, fields, args.frequency, args.duration,
                       args.port, progress=progress, messages=messages)
-    except (RobotConnectionError, ValueError) as error:
+    except (RobotConnectionError, ProtocolError, ValueError) as error:
         print(f"\nurdsl: error: {error}", file=sys.stderr)
         return EXIT_USAGE
     except OSError as error:
@@ -291,6 +294,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 def cmd_dashboard(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE
+    from ..protocol import ProtocolError
     from .connection import RobotConnectionError
     from .dashboard import DashboardClient
 
@@ -298,7 +302,7 @@ def cmd_dashboard(args: argparse.Namespace) -> int:
     try:
         with DashboardClient(args.host, args.port, args.timeout) as dashboard:
             reply = dashboard.command(command)
-    except RobotConnectionError as error:
+    except (RobotConnectionError, ProtocolError) as error:
         print(f"urdsl: error: {error}", file=sys.stderr)
         return EXIT_USAGE
     print(reply.text)

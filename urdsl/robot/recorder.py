@@ -40,13 +40,18 @@ def record(host: str, output: str | Path, fields: list[str] | None = None,
     client = rtde.RtdeClient()
     deadline = Deadline(timeout)
 
+    pending: list = []  # events that arrived with a reply (data right after "started")
+
     def expect(kind):
         while True:
-            for event in client.feed(read_until(sock, deadline, "an RTDE reply", host, port)):
-                if isinstance(event, kind):
-                    return event
-                if isinstance(event, rtde.Message) and messages is not None:
-                    messages.append(event)
+            if not pending:
+                pending.extend(client.feed(read_until(sock, deadline, "an RTDE reply", host,
+                                                      port)))
+            event = pending.pop(0)
+            if isinstance(event, kind):
+                return event
+            if isinstance(event, rtde.Message) and messages is not None:
+                messages.append(event)
 
     rows = 0
     try:
@@ -73,7 +78,8 @@ def record(host: str, output: str | Path, fields: list[str] | None = None,
                 while stop is None or not stop.passed:
                     wait = Deadline(min(timeout, stop.left) if stop else timeout)
                     data = read_until(sock, wait, "RTDE data", host, port) if wait.left else b""
-                    for event in client.feed(data):
+                    events, pending[:] = pending + client.feed(data), []
+                    for event in events:
                         if isinstance(event, rtde.DataPackage):
                             row = []
                             for name in setup.names:

@@ -131,11 +131,16 @@ def _rtde(sock, host, port, timeout) -> RobotStateSample:
     client = rtde.RtdeClient()
     deadline = Deadline(timeout)
 
+    pending: list = []
+
     def expect(kind):
         while True:
-            for event in client.feed(read_until(sock, deadline, "an RTDE reply", host, port)):
-                if isinstance(event, kind):
-                    return event
+            if not pending:
+                pending.extend(client.feed(read_until(sock, deadline, "an RTDE reply", host,
+                                                      port)))
+            event = pending.pop(0)
+            if isinstance(event, kind):
+                return event
 
     sock.sendall(client.request_protocol_version(2))
     if not expect(rtde.ProtocolVersion).accepted:
