@@ -76,9 +76,12 @@ def record(host: str, output: str | Path, fields: list[str] | None = None,
             flushed = time.monotonic()
             try:
                 while stop is None or not stop.passed:
-                    wait = Deadline(min(timeout, stop.left) if stop else timeout)
-                    data = read_until(sock, wait, "RTDE data", host, port) if wait.left else b""
-                    events, pending[:] = pending + client.feed(data), []
+                    events, pending[:] = list(pending), []
+                    if not events:  # what came with the replies first, then the socket
+                        wait = Deadline(min(timeout, stop.left) if stop else timeout)
+                        if wait.left:
+                            events = client.feed(read_until(sock, wait, "RTDE data", host,
+                                                            port))
                     for event in events:
                         if isinstance(event, rtde.DataPackage):
                             row = []
