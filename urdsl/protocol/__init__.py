@@ -1,1 +1,21 @@
-"""Sans-I/O codecs for the controller's interfaces (realtime, primary, RTDE, dashboard)."""
+"""Sans-I/O codecs for the controller's interfaces: bytes in, typed messages out, and back.
+
+No sockets, threads or clocks live here (the model is h11): a socket layer feeds received
+bytes to a decoder and writes the bytes an encoder returns. Malformed input raises
+:class:`ProtocolError` with the field, offset and size that were wrong.
+
+==========================  ======  ================================================
+module                      port    what
+==========================  ======  ================================================
+:mod:`.dashboard`           29999   dashboard server line protocol (both sides)
+:mod:`.realtime`            30003   realtime ("Matlab") interface, every version
+:mod:`.primary`             30001/2 primary/secondary: robot state and messages
+:mod:`.rtde`                30004   RTDE protocol v1/v2, client and server machines
+==========================  ======  ================================================
+"""
+
+from __future__ import annotations
+
+from .errors import ProtocolError
+
+__all__ = ["ProtocolError"]
