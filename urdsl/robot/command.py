@@ -1,0 +1,195 @@
+"""``urdsl send``, ``state``, ``record``, ``plot`` and ``dashboard``: the robot commands.
+
+Network failures (refused, timed out, dropped) are printed as one message naming
+``host:port`` and exit with status 1; usage mistakes exit with 2; never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from .errors import RobotError
+
+__all__ = ["add_commands"]
+
+_FORMATTER = argparse.RawDescriptionHelpFormatter
+
+
+def _fail(message: str) -> int:
+    print(f"urdsl: error: {message}", file=sys.stderr)
+    return 1
+
+
+def _host(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--host", required=True, metavar="HOST",
+                        help="the controller's IP address or name (a real robot, e.g. the "
+                        "course's 192.168.x.x, or 127.0.0.1 for `urdsl sim`)")
+
+
+def _positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
+# ---- plot ----------------------------------------------------------------------------------
+
+_PLOT_DESCRIPTION = """\
+Plot a recording (from `urdsl record` or UR's record.py) into a PNG: one panel per field
+against time in s, joints named, units on the axes, TCP poses split into position (m) and
+rotation (rad). Without --fields: actual_q and actual_qd (or target_q/target_qd).
+
+Exit status: 0 written, 1 the file cannot be read or lacks a field, 2 usage errors.
+"""
+
+_PLOT_EPILOG = """\
+examples:
+  urdsl plot run.csv -o run.png
+  urdsl plot run.csv --fields actual_q,actual_TCP_pose -o pose.png
+  urdsl plot run.csv --fields actual_qd --degrees -o speeds.png
+  urdsl plot robot_data.csv --fields target_q_1 -o q1.png     (UR's example_plotting.py)
+"""
+
+
+def cmd_plot(args: argparse.Namespace) -> int:
+    from .csvfile import RecordingFormatError
+    from .plot import plot_recording
+
+    fields = [f.strip() for f in args.fields.split(",") if f.strip()] if args.fields else None
+    try:
+        summary = plot_recording(args.recording, args.output, fields, degrees=args.degrees,
+                                 title=args.title)
+    except FileNotFoundError:
+        return _fail(f"cannot read {args.recording}: no such file")
+    except OSError as error:
+        return _fail(f"{error.filename or args.recording}: {error.strerror}")
+    except RecordingFormatError as error:
+        return _fail(str(error))
+    except KeyError as error:
+        return _fail(str(error.args[0]))
+    print(f"plot written to {summary.path} ({', '.join(summary.fields)}; {summary.samples} "
+          f"samples over {summary.duration:.3f} s)", file=sys.stderr)
+    return 0
+
+
+# ---- dashboard -----------------------------------------------------------------------------
+
+_DASHBOARD_DESCRIPTION = """\
+Send one command to the dashboard server (port 29999) and print its reply. The words after
+the options form the command, as the dashboard server spells it (case matters):
+
+"""
+
+_DASHBOARD_EPILOG = """\
+On e-Series robots most commands need the robot in Remote Control mode (set on the teach
+pendant); otherwise the server answers with an explanation and urdsl exits 1.
+
+Exit status: 0 the reply is the documented success, 1 a failure reply, no reply or no
+connection, 2 an unknown command or other usage error.
+
+examples:
+  urdsl dashboard --host 127.0.0.1 robotmode
+  urdsl dashboard --host 127.0.0.1 power on --wait      (then waits for IDLE)
+  urdsl dashboard --host 127.0.0.1 brake release --wait (then waits for RUNNING)
+  urdsl dashboard --host 127.0.0.1 load /programs/pick.urp
+  urdsl dashboard --host 127.0.0.1 play
+  urdsl dashboard --host 127.0.0.1 programState --json
+"""
+
+_WAIT_FOR = {"power on": {"IDLE", "RUNNING"}, "brake release": {"RUNNING"},
+             "power off": {"POWER_OFF"}}
+
+
+def _dashboard_description() -> str:
+    from ..protocol.dashboard import COMMANDS
+
+    lines = []
+    for spec in COMMANDS.values():
+        usage = spec.name + (f" <{spec.argument}>" if spec.argument else "")
+        lines.append(f"  {usage:<34} {spec.doc}")
+    return _DASHBOARD_DESCRIPTION + "\n".join(lines) + "\n"
+
+
+def cmd_dashboard(args: argparse.Namespace) -> int:
+    from ..cli import UsageError
+    from .dashboard import Dashboard, parse_command_words, wait_for_mode
+
+    try:
+        name, argument = parse_command_words(args.words)
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    if args.wait and name not in _WAIT_FOR:
+        raise UsageError(f"--wait works with {', '.join(_WAIT_FOR)}; not with {name!r}")
+    try:
+        with Dashboard(args.host, args.port, timeout=args.timeout) as dashboard:
+            reply = dashboard.command(name, argument)
+            mode = None
+            if reply.ok and args.wait:
+                mode = wait_for_mode(dashboard, _WAIT_FOR[name], args.wait_timeout)
+    except RobotError as error:
+        return _fail(error.message)
+    if args.json:
+        document = {"command": reply.command, "reply": reply.text, "ok": reply.ok,
+                    "value": reply.value, "fields": dict(reply.fields)}
+        if mode is not None:
+            document["robotmode"] = mode
+        json.dump(document, sys.stdout)
+        sys.stdout.write("\n")
+    else:
+        print(reply.text)
+        if mode is not None:
+            print(f"Robotmode: {mode}")
+    if not reply.ok:
+        hint = ""
+        if "remote" in reply.text.lower():
+            hint = " (switch the robot to Remote Control on the teach pendant)"
+        print(f"urdsl: the dashboard server did not do {reply.command!r}: {reply.text}{hint}",
+              file=sys.stderr)
+        return 1
+    return 0
+
+
+# ---- registration --------------------------------------------------------------------------
+
+
+def add_commands(commands) -> None:
+    from ..protocol.dashboard import PORT
+
+    p = commands.add_parser("plot", help="plot a recording (CSV) into a PNG",
+                            description=_PLOT_DESCRIPTION, epilog=_PLOT_EPILOG,
+                            formatter_class=_FORMATTER)
+    p.add_argument("recording", metavar="RECORDING.csv",
+                   help="a file written by `urdsl record` or UR's record.py")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.png", help="the PNG to write")
+    p.add_argument("--fields", metavar="F1,F2",
+                   help="comma-separated fields (actual_q, actual_TCP_pose, speed_scaling) or "
+                   "single columns (actual_q_1); default: actual_q,actual_qd")
+    p.add_argument("--degrees", action="store_true",
+                   help="show joint angles and speeds in degrees (default: rad)")
+    p.add_argument("--title", help="title of the figure (default: file, samples, rate)")
+    p.set_defaults(run=cmd_plot)
+
+    p = commands.add_parser("dashboard", help="send a dashboard command (play, stop, power "
+                            "on, …) and print the reply", description=_dashboard_description(),
+                            epilog=_DASHBOARD_EPILOG, formatter_class=_FORMATTER)
+    _host(p)
+    p.add_argument("words", nargs="+", metavar="COMMAND",
+                   help="the command and its argument, e.g. `robotmode` or `load pick.urp`")
+    p.add_argument("--port", type=int, default=PORT, help=f"dashboard port (default {PORT})")
+    p.add_argument("--timeout", type=_positive, default=5.0, metavar="S",
+                   help="seconds to wait for the connection and the reply (default 5; "
+                   "`load` waits at least 30)")
+    p.add_argument("--wait", action="store_true",
+                   help="after `power on`, `brake release` or `power off`: wait until the "
+                   "robot mode is IDLE, RUNNING or POWER_OFF")
+    p.add_argument("--wait-timeout", type=_positive, default=60.0, metavar="S",
+                   help="seconds --wait waits (default 60)")
+    p.add_argument("--json", action="store_true",
+                   help="print {command, reply, ok, value, fields} as JSON")
+    p.set_defaults(run=cmd_dashboard)
