@@ -155,6 +155,122 @@ def cmd_dashboard(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---- state --------------------------------------------------------------------------------
+
+_STATE_DESCRIPTION = """\
+Show the robot's joints, TCP pose, robot mode and safety mode, read from one of the
+controller's interfaces: realtime (port 30003, every control cycle), primary (the secondary
+port 30002 by default, 10 Hz) or RTDE (30004). Each sample shown is the newest: urdsl
+drains the socket and skips queued packets, so a slow terminal never shows old positions.
+
+Exit status: 0 ok, 1 no connection or no sample, 2 usage errors.
+"""
+
+_STATE_EPILOG = """\
+examples:
+  urdsl state --host 127.0.0.1
+  urdsl state --host 127.0.0.1 --interface rtde --json
+  urdsl state --host 127.0.0.1 --watch                 (Ctrl-C to stop)
+  urdsl state --host 127.0.0.1 --watch --json --duration 10 > states.jsonl
+"""
+
+
+def _vector(values, digits: int = 4) -> str:
+    return "  ".join(f"{v:{digits + 4}.{digits}f}" for v in values)
+
+
+def render_state(state) -> str:
+    """A sample as lines of text: modes, joints in rad and degrees, TCP pose."""
+    import math
+
+    head = f"{state.host}:{state.port} ({state.interface})"
+    if state.version:
+        head += f", controller {state.version}"
+    if state.time is not None:
+        head += f", time {state.time:.3f} s"
+    lines = [head]
+    if state.robot_mode is not None:
+        lines.append(f"robot mode    {state.robot_mode_name} ({state.robot_mode})")
+    if state.safety_mode is not None:
+        lines.append(f"safety mode   {state.safety_mode_name} ({state.safety_mode})")
+    if state.program_state is not None:
+        lines.append(f"program       {state.program_state_name}")
+    elif state.program_running is not None:
+        lines.append(f"program       {'running' if state.program_running else 'not running'}")
+    if state.joints is not None:
+        lines.append(f"joints [rad]  {_vector(state.joints)}")
+        lines.append(f"joints [deg]  {_vector([math.degrees(v) for v in state.joints], 2)}")
+    if state.joint_speeds is not None:
+        lines.append(f"speeds [rad/s]{_vector(state.joint_speeds)}")
+    if state.tcp_pose is not None:
+        pose = state.tcp_pose
+        lines.append(f"TCP [m]       x {pose[0]:.4f}  y {pose[1]:.4f}  z {pose[2]:.4f}")
+        lines.append(f"TCP [rad]     rx {pose[3]:.4f}  ry {pose[4]:.4f}  rz {pose[5]:.4f}")
+    if state.speed_scaling is not None:
+        lines.append(f"speed scaling {state.speed_scaling:.2f}")
+    return "\n".join(lines)
+
+
+def cmd_state(args: argparse.Namespace) -> int:
+    from .state import StateReader
+
+    try:
+        with StateReader(args.host, args.interface, args.port, timeout=args.timeout) as reader:
+            if not args.watch:
+                state = reader.read()
+                if args.json:
+                    print(json.dumps(state.to_dict()))
+                else:
+                    print(render_state(state))
+                return 0
+            return _watch(reader, args)
+    except RobotError as error:
+        return _fail(error.message)
+
+
+def _watch(reader, args: argparse.Namespace) -> int:
+    import time
+
+    from .errors import ConnectionLost
+
+    period = 1.0 / args.rate
+    end = None if args.duration is None else time.monotonic() + args.duration
+    live = None
+    if not args.json and sys.stdout.isatty():
+        from rich.console import Console
+        from rich.live import Live
+        from rich.text import Text
+
+        live = Live(Text("connecting"), console=Console(), auto_refresh=False)
+        live.start()
+    try:
+        while end is None or time.monotonic() < end:
+            tick = time.monotonic()
+            try:
+                state = reader.read()
+            except ConnectionLost as error:
+                print(f"urdsl: {error.message}; reconnecting", file=sys.stderr)
+                reader.reconnect()
+                continue
+            if args.json:
+                print(json.dumps(state.to_dict()), flush=True)
+            elif live is not None:
+                from rich.text import Text
+
+                live.update(Text(render_state(state) + "\n(Ctrl-C to stop)"), refresh=True)
+            else:
+                print(render_state(state) + "\n", flush=True)
+            rest = period - (time.monotonic() - tick)
+            if rest > 0:
+                time.sleep(rest if end is None else min(rest, max(end - time.monotonic(), 0)))
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if live is not None:
+            live.stop()
+    return 0
+
+
 # ---- registration --------------------------------------------------------------------------
 
 
@@ -174,6 +290,30 @@ def add_commands(commands) -> None:
                    help="show joint angles and speeds in degrees (default: rad)")
     p.add_argument("--title", help="title of the figure (default: file, samples, rate)")
     p.set_defaults(run=cmd_plot)
+
+    from .state import INTERFACES
+
+    p = commands.add_parser("state", help="show joints, TCP pose, robot and safety mode",
+                            description=_STATE_DESCRIPTION, epilog=_STATE_EPILOG,
+                            formatter_class=_FORMATTER)
+    _host(p)
+    p.add_argument("--interface", choices=INTERFACES, default="realtime",
+                   help="where to read: realtime (default, port 30003), primary (port 30002) "
+                   "or rtde (port 30004)")
+    p.add_argument("--port", type=int, metavar="P",
+                   help="port (default: 30003 / 30002 / 30004 by interface)")
+    p.add_argument("--watch", action="store_true",
+                   help="keep showing the newest state until Ctrl-C (or --duration)")
+    p.add_argument("--rate", type=_positive, default=10.0, metavar="HZ",
+                   help="samples shown per second with --watch (default 10)")
+    p.add_argument("--duration", type=_positive, metavar="S",
+                   help="stop watching after S seconds")
+    p.add_argument("--json", action="store_true",
+                   help="print each sample as one JSON object per line (joints in rad, pose "
+                   "in m and rad, mode numbers and names)")
+    p.add_argument("--timeout", type=_positive, default=5.0, metavar="S",
+                   help="seconds to wait for the connection and for a sample (default 5)")
+    p.set_defaults(run=cmd_state)
 
     p = commands.add_parser("dashboard", help="send a dashboard command (play, stop, power "
                             "on, …) and print the reply", description=_dashboard_description(),
