@@ -8,9 +8,14 @@ timeout. Nothing here listens on or connects to any other address.
 
 from __future__ import annotations
 
+import queue
+import select
 import socket
 import threading
+import time
 from collections.abc import Callable
+
+from urdsl.protocol import primary as p
 
 LOOPBACK = "127.0.0.1"
 IO_TIMEOUT = 10.0  # s: no fake server socket blocks longer than this
@@ -99,3 +104,115 @@ def recv_until_closed(sock: socket.socket, limit: int = 1 << 20) -> bytes:
             break
         data += chunk
     return bytes(data)
+
+
+# ---- a fake controller speaking the primary interface ------------------------------------
+
+HOME = (0.0, -1.5707963267948966, 0.0, -1.5707963267948966, 0.0, 0.0)
+
+
+def robot_state(running: bool, q=HOME, safety_mode: int = 1, timestamp: int = 0) -> bytes:
+    """A CB3.5-style ROBOT_STATE message with robot mode, joints, TCP pose and safety mode."""
+    return p.RobotState((
+        p.RobotModeData(variant="3.5", timestamp=timestamp, is_real_robot_connected=True,
+                        is_robot_power_on=True, is_program_running=running, robot_mode=7,
+                        target_speed_fraction=1.0, speed_scaling=1.0,
+                        target_speed_fraction_limit=1.0, reserved=0),
+        p.JointData(variant="3.0", q_actual=q, q_target=q, qd_actual=(0.0,) * 6,
+                    i_actual=(0.0,) * 6, v_actual=(48.0,) * 6, t_motor=(30.0,) * 6,
+                    t_micro=(30.0,) * 6, joint_mode=(253,) * 6),
+        p.CartesianInfo(variant="3.2", tcp_pose=(0.1, -0.4, 0.3, 0.0, 3.1, 0.0),
+                        tcp_offset=(0.0,) * 6),
+        p.MasterboardData(variant="3.2", safety_mode=safety_mode,
+                          operational_mode_selector_input=0,
+                          three_position_enabling_device_input=False),
+    )).encode()
+
+
+def version_message() -> bytes:
+    return p.VersionMessage(major=3, minor=15, bugfix=7, build_number=106331,
+                            build_date="11-01-2021, 13:18:33").encode()
+
+
+class FakeController:
+    """A controller model shared by fake primary and script servers.
+
+    ``behaviour(program_text)`` returns the events that running the program causes, each one
+    of ``("run", ticks)`` (program running for that many state ticks), ``("text", s)``,
+    ``("exception", line, column, text)``, ``("safety", mode)``. ``programs`` collects the
+    texts received. States go out every ``period`` s (the real controller: 0.1 s).
+    """
+
+    def __init__(self, behaviour, period: float = 0.02, lifetime: float = 10.0) -> None:
+        self.behaviour = behaviour
+        self.period = period
+        self.lifetime = lifetime
+        self.programs: list[str] = []
+        self.inbox: queue.Queue[str] = queue.Queue()
+
+    def _take_program(self, buffer: bytearray) -> None:
+        text = buffer.decode("utf-8", "replace")
+        if text.endswith("end\n"):
+            self.programs.append(text)
+            self.inbox.put(text)
+            buffer.clear()
+
+    def primary(self, sock, index) -> None:
+        """Serve the primary interface (also takes scripts, as 30001 does)."""
+        sock.sendall(version_message())
+        buffer = bytearray()
+        events: list = []
+        running_ticks = 0
+        safety_mode = 1
+        end = time.monotonic() + self.lifetime
+        next_tick = time.monotonic()
+        tick = 0
+        while time.monotonic() < end:
+            wait = max(next_tick - time.monotonic(), 0.0)
+            ready, _, _ = select.select([sock], [], [], wait)
+            if ready:
+                data = sock.recv(65536)
+                if not data:
+                    return
+                buffer += data
+                self._take_program(buffer)
+            if time.monotonic() < next_tick:
+                continue
+            next_tick += self.period
+            tick += 1
+            while not self.inbox.empty():
+                events = list(self.behaviour(self.inbox.get()))
+                running_ticks = 0
+            out = b""
+            while events and running_ticks == 0:
+                event = events.pop(0)
+                if event[0] == "run":
+                    running_ticks = event[1]
+                elif event[0] == "text":
+                    out += p.TextMessage(text=event[1]).encode()
+                elif event[0] == "exception":
+                    out += p.RuntimeExceptionMessage(line=event[1], column=event[2],
+                                                     text=event[3]).encode()
+                elif event[0] == "safety":
+                    safety_mode = event[1]
+                    out += p.SafetyModeMessage(code=209, argument=0,
+                                               safety_mode_type=event[1]).encode()
+            running = running_ticks > 0
+            if running_ticks:
+                running_ticks -= 1
+            out += robot_state(running, safety_mode=safety_mode, timestamp=tick * 100)
+            sock.sendall(out)
+
+    def script_port(self, sock, index) -> None:
+        """Serve a secondary-like port: state now and then, takes scripts, no messages."""
+        sock.sendall(version_message() + robot_state(False))
+        buffer = bytearray()
+        end = time.monotonic() + self.lifetime
+        while time.monotonic() < end:
+            ready, _, _ = select.select([sock], [], [], 0.05)
+            if ready:
+                data = sock.recv(65536)
+                if not data:
+                    return
+                buffer += data
+                self._take_program(buffer)

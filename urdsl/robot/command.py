@@ -155,6 +155,116 @@ def cmd_dashboard(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---- send ---------------------------------------------------------------------------------
+
+_SEND_DESCRIPTION = """\
+Check a program offline, send it to the controller and follow it until it finishes or
+fails. The program is a URScript file or a Python DSL program (PROGRAM.py, compiled as
+`urdsl compile` does). What is sent is the canonical printout, wrapped in
+`def urdsl_program(): ... end` when the file is bare statements; a running program is
+replaced, as UR's controller does with every new program.
+
+urdsl then listens on the primary interface (port 30001) and reports that the program
+started, finished, or failed; a runtime exception is shown at the line of YOUR file
+(file:line:col with the line), not at the line of the text that was sent.
+
+Exit status: 0 finished (or still running when --timeout ended the wait), 1 the check found
+errors (nothing sent), the program failed, or the controller could not be reached,
+2 usage errors.
+"""
+
+_SEND_EPILOG = """\
+examples:
+  urdsl send pick.script --host 127.0.0.1
+  urdsl send programs/pick_and_place.py --host 127.0.0.1 --robot ur5e
+  urdsl send pick.script --host 127.0.0.1 --port 30001 --timeout 120
+  urdsl send pick.script --host 127.0.0.1 --dry-run      (check and print, send nothing)
+
+ports: 30001 primary, 30002 secondary (default), 30003 realtime — all three take scripts;
+urdsl follows the program on 30001 either way (--monitor-port to change that).
+"""
+
+
+def _load_program(name: str, robot: str):
+    """(tree, filename) of a .script file or a DSL .py program; problems as exceptions."""
+    from ..cli import UsageError, read_input
+    from ..script.parser import parse
+
+    if name.endswith(".py"):
+        from ..dsl.command import load_program
+
+        try:
+            program = load_program(name)
+        except OSError as error:
+            raise UsageError(f"cannot read {name}: {error.strerror}") from None
+        return program.tree(), name
+    source = read_input(name)
+    return parse(source.text, source.name), source.name
+
+
+def cmd_send(args: argparse.Namespace) -> int:
+    from ..dsl.command import ProgramFileError
+    from ..dsl.errors import DslError
+    from ..script.diagnostics import ScriptError
+    from .errors import CheckFailedError
+    from .program import prepare_tree
+    from .sender import default_checker, send_prepared
+
+    robot = args.robot.lower()
+    _check_robot(robot)
+    try:
+        tree, filename = _load_program(args.program, robot)
+    except ScriptError as error:
+        print(error.diagnostic.render(), file=sys.stderr)
+        return 1
+    except (DslError, ProgramFileError) as error:
+        print(str(error), file=sys.stderr)
+        return 1
+    prepared = prepare_tree(tree, filename)
+    if args.check:
+        report = default_checker(tree, filename, robot)
+        if report.has_errors:
+            sys.stderr.write(report.render_text(moves=False))
+            print(str(CheckFailedError(report, filename)), file=sys.stderr)
+            return 1
+        warnings = report.count("warning") if hasattr(report, "count") else 0
+        if warnings:
+            sys.stderr.write(report.render_text(moves=False))
+        print(f"checked {filename} on {robot}: no errors"
+              + (f", {warnings} warning(s)" if warnings else ""), file=sys.stderr)
+    if args.dry_run:
+        sys.stdout.write(prepared.text)
+        return 0
+    try:
+        result = send_prepared(prepared, args.host, args.port, timeout=args.timeout,
+                               follow=not args.no_follow, monitor_port=args.monitor_port,
+                               connect_timeout=args.connect_timeout)
+    except RobotError as error:
+        return _fail(error.message)
+    lines = prepared.text.count("\n")
+    print(f"sent {result.program!r} ({lines} lines) to {args.host}:{args.port}"
+          + (f", controller {result.controller_version}" if result.controller_version else ""),
+          file=sys.stderr)
+    for message in result.messages:
+        print(f"  controller: {message}", file=sys.stderr)
+    if result.error is not None:
+        print(result.error.render(), file=sys.stderr)
+    print(result.summary(), file=sys.stderr)
+    if result.status == "sent" and not args.no_follow:
+        print("  (no start was seen: a program that runs in under 0.1 s leaves no trace in "
+              "the 10 Hz robot state; on e-Series the robot must be in Remote Control)",
+              file=sys.stderr)
+    return 0 if result.ok else 1
+
+
+def _check_robot(robot: str) -> None:
+    from ..cli import UsageError
+    from ..kinematics import MODELS
+
+    if robot not in MODELS:
+        raise UsageError(f"unknown robot model {robot!r}; known: {', '.join(MODELS)}")
+
+
 # ---- state --------------------------------------------------------------------------------
 
 _STATE_DESCRIPTION = """\
@@ -292,6 +402,32 @@ def add_commands(commands) -> None:
     p.set_defaults(run=cmd_plot)
 
     from .state import INTERFACES
+
+    p = commands.add_parser("send", help="check a program, send it to the robot and report "
+                            "how it ends", description=_SEND_DESCRIPTION, epilog=_SEND_EPILOG,
+                            formatter_class=_FORMATTER)
+    p.add_argument("program", metavar="FILE|PROGRAM.py",
+                   help="a URScript file ('-' reads stdin) or a Python DSL program")
+    _host(p)
+    p.add_argument("--port", type=int, default=30002, metavar="PORT",
+                   help="where to send: 30001, 30002 (default) or 30003")
+    p.add_argument("--robot", default="ur5e", metavar="MODEL",
+                   help="robot model the check uses (default: ur5e)")
+    p.add_argument("--no-check", dest="check", action="store_false",
+                   help="send without checking first (not recommended)")
+    p.add_argument("--timeout", type=_positive, default=60.0, metavar="S",
+                   help="seconds to wait for the program to finish (default 60); it keeps "
+                   "running on the robot after that")
+    p.add_argument("--connect-timeout", type=_positive, default=5.0, metavar="S",
+                   help="seconds to wait for each connection and the first state (default 5)")
+    p.add_argument("--monitor-port", type=int, metavar="PORT",
+                   help="primary-interface port to follow the program on (default 30001)")
+    p.add_argument("--no-follow", action="store_true",
+                   help="send and return at once, without waiting for the outcome")
+    p.add_argument("--dry-run", action="store_true",
+                   help="check and print the text that would be sent; send nothing")
+    p.set_defaults(run=cmd_send)
+
 
     p = commands.add_parser("state", help="show joints, TCP pose, robot and safety mode",
                             description=_STATE_DESCRIPTION, epilog=_STATE_EPILOG,
