@@ -171,3 +171,38 @@ def test_cli_connection_refused_exits_1(capsys):
     err = capsys.readouterr().err
     assert f"connection refused by {LOOPBACK}:{port} (realtime)" in err
     assert "Traceback" not in err
+
+
+def test_primary_interface_state_merges_sub_packages_and_skips_old_states():
+    from _robot_fakes import robot_state, version_message
+
+    sent = threading.Event()
+    done = threading.Event()
+    count = 30
+
+    data = version_message()
+    for i in range(count):
+        data += robot_state(i % 2 == 1, q=(i / 100,) + HOME[1:], timestamp=i * 100)
+
+    def handler(sock, index):
+        sock.sendall(data)
+        sent.set()
+        done.wait(10)
+
+    with FakeServer(handler) as server:
+        with StateReader(LOOPBACK, "primary", server.port, timeout=5) as reader:
+            assert sent.wait(5)
+            deadline = time.monotonic() + 5
+            while _available(reader.connection.sock) < len(data) and \
+                    time.monotonic() < deadline:
+                time.sleep(0.005)
+            state = reader.read()
+            done.set()
+    assert state.interface == "primary"
+    assert state.joints[0] == pytest.approx((count - 1) / 100)
+    assert state.time == pytest.approx((count - 1) / 10)
+    assert state.program_running is True
+    assert state.tcp_pose == pytest.approx((0.1, -0.4, 0.3, 0.0, 3.1, 0.0))
+    assert state.robot_mode_name == "RUNNING" and state.safety_mode_name == "NORMAL"
+    assert state.version == "3.15.7"
+    assert state.skipped == count - 1
