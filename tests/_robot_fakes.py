@@ -216,3 +216,113 @@ class FakeController:
                     return
                 buffer += data
                 self._take_program(buffer)
+
+
+# ---- a fake RTDE server ------------------------------------------------------------------
+
+
+def rtde_values(names, cycle: int, rate: float = 500.0) -> dict:
+    """Deterministic values for every name of a recipe at control cycle ``cycle``:
+    timestamp = cycle / rate; joint i = i + cycle / 1000; poses, modes fixed."""
+    from urdsl.protocol.rtde_fields import FIELDS, TYPES
+
+    values: dict = {}
+    for name in names:
+        kind = FIELDS[name].type
+        code, count = TYPES[kind]
+        if name == "timestamp":
+            values[name] = cycle / rate
+        elif name in ("robot_mode",):
+            values[name] = 7
+        elif name in ("safety_mode",):
+            values[name] = 1
+        elif name == "runtime_state":
+            values[name] = 2
+        elif code == "d" and count == 6:
+            values[name] = tuple(i + cycle / 1000 for i in range(6))
+        elif code == "d" and count == 3:
+            values[name] = (0.0, 0.1, 0.2)
+        elif code == "d":
+            values[name] = 1.0
+        elif code == "?":
+            values[name] = True
+        elif count == 1:
+            values[name] = 1
+        else:
+            values[name] = tuple(range(count))
+    return values
+
+
+class FakeRtde:
+    """An RTDE controller on the protocol's server side (:class:`RtdeServer`).
+
+    Streams the output recipe in bursts of ``burst`` control cycles every ``period`` s (so
+    500 Hz is reached without a 2 ms sleep). Knobs for the tests: ``refuse_v2`` answers the
+    protocol-2 request with "not accepted"; ``stop_after`` closes the connection after that
+    many samples; ``texts`` maps a sample count to a text message sent after it; ``silent``
+    starts but never sends data; ``on_sample(count)`` is called after each sample.
+    """
+
+    def __init__(self, version=(5, 11, 1, 0), *, refuse_v2: bool = False,
+                 stop_after: int | None = None, texts: dict | None = None,
+                 silent: bool = False, burst: int = 10, period: float = 0.02,
+                 lifetime: float = 20.0, on_sample=None) -> None:
+        self.version = version
+        self.refuse_v2 = refuse_v2
+        self.stop_after = stop_after
+        self.texts = texts or {}
+        self.silent = silent
+        self.burst = burst
+        self.period = period
+        self.lifetime = lifetime
+        self.on_sample = on_sample
+        self.sent = 0
+        self.sent_values: list[dict] = []
+        self.requests: list = []
+
+    def handler(self, sock, index) -> None:
+        from urdsl.protocol import rtde as r
+
+        server = r.RtdeServer(self.version)
+        cycle = 0
+        end = time.monotonic() + self.lifetime
+        next_burst = time.monotonic()
+        while time.monotonic() < end:
+            wait = max(min(next_burst - time.monotonic(), 0.05), 0.0) if server.running \
+                else 0.05
+            ready, _, _ = select.select([sock], [], [], wait)
+            if ready:
+                data = sock.recv(65536)
+                if not data:
+                    return
+                if self.refuse_v2 and data[2:3] == b"V" and data[3:5] == b"\x00\x02":
+                    self.requests.append("V2 refused")
+                    sock.sendall(r.encode_rtde(r.ProtocolVersionReply(False), 1))
+                    data = data[5:]
+                    if not data:
+                        continue
+                for event in server.receive_data(data):
+                    self.requests.append(type(event).__name__)
+                sock.sendall(server.data_to_send())
+            if not server.running or self.silent or time.monotonic() < next_burst:
+                continue
+            next_burst += self.period
+            out = b""
+            recipe = server.output_recipe
+            for _ in range(self.burst):
+                package = server.outputs(rtde_values(recipe.names, cycle, server.rate), cycle)
+                cycle += 1
+                if package is None:
+                    continue
+                out += package
+                self.sent += 1
+                self.sent_values.append(rtde_values(recipe.names, cycle - 1, server.rate))
+                if self.sent in self.texts:
+                    out += r.encode_rtde(r.RtdeTextMessage(self.texts[self.sent], "Controller",
+                                                           r.WARNING), server.protocol)
+                if self.stop_after is not None and self.sent >= self.stop_after:
+                    sock.sendall(out)
+                    return
+            sock.sendall(out)
+            if self.on_sample is not None:
+                self.on_sample(self.sent)

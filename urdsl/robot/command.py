@@ -38,6 +38,106 @@ def _positive(text: str) -> float:
     return value
 
 
+# ---- record -------------------------------------------------------------------------------
+
+_RECORD_DESCRIPTION = """\
+Record RTDE outputs (port 30004) into a CSV file that UR's record.py and csv_reader.py
+understand: space-separated, one header line, vector fields expanded into name_0 ... name_5,
+timestamp (s since the controller started) first. RTDE protocol 2 is used, 1 as fallback.
+
+Ctrl-C stops cleanly: every sample received is in the file, each a complete line. A dropped
+connection or a controller that stops sending also ends the recording with the file intact.
+Text messages the controller sends meanwhile are shown and do not stop it.
+
+Exit status: 0 recorded (stopped by --duration, --samples or Ctrl-C), 1 no connection, a
+refused recipe, or the stream ended early (the file keeps what came), 2 usage errors.
+"""
+
+_RECORD_EPILOG = """\
+examples:
+  urdsl record --host 127.0.0.1 -o run.csv                         (Ctrl-C to stop)
+  urdsl record --host 127.0.0.1 --duration 10 --frequency 500 -o run.csv
+  urdsl record --host 127.0.0.1 --fields actual_q,actual_TCP_pose,speed_scaling -o run.csv
+  urdsl plot run.csv -o run.png
+
+common fields: actual_q, actual_qd, target_q, target_qd, actual_TCP_pose, actual_TCP_speed,
+actual_TCP_force, actual_current, joint_temperatures, robot_mode, safety_mode,
+runtime_state, speed_scaling, actual_digital_input_bits, actual_digital_output_bits
+"""
+
+
+def _progress_display(args: argparse.Namespace):
+    """(callback, close) showing samples, rate and missed samples on stderr with rich."""
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+    console = Console(stderr=True)
+    columns = [SpinnerColumn(), TextColumn("recording {task.fields[samples]:>7} samples"),
+               TextColumn("{task.fields[rate]:>6.1f} Hz"),
+               TextColumn("{task.fields[missed]} missed"), TimeElapsedColumn()]
+    if args.duration:
+        columns.insert(1, BarColumn())
+    progress = Progress(*columns, console=console, transient=False)
+    task = progress.add_task("record", total=args.duration or None, samples=0, rate=0.0,
+                             missed=0)
+    progress.start()
+    shown: set[str] = set()
+
+    def update(state) -> None:
+        rate = (state.samples - 1) / state.span if state.span > 0 else 0.0
+        progress.update(task, completed=min(state.elapsed, args.duration or state.elapsed),
+                        samples=state.samples, rate=rate, missed=state.missed)
+        if state.message and state.message not in shown:
+            shown.add(state.message)
+            progress.console.print(f"controller: {state.message}")
+
+    return update, progress.stop
+
+
+def cmd_record(args: argparse.Namespace) -> int:
+    import os
+    import signal
+    import threading
+
+    from ..cli import UsageError
+    from .recorder import parse_fields, record
+
+    try:
+        fields = parse_fields(args.fields)
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    folder = os.path.dirname(os.path.abspath(args.output))
+    if not os.path.isdir(folder):
+        raise UsageError(f"cannot write {args.output}: no folder {folder}")
+    stop = threading.Event()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGINT, lambda *_: stop.set())
+    update, close = (None, None) if args.quiet else _progress_display(args)
+    try:
+        result = record(args.host, args.output, fields, frequency=args.frequency,
+                        duration=args.duration, samples=args.samples, port=args.port,
+                        timeout=args.timeout, stall_timeout=args.stall_timeout, stop=stop,
+                        progress=update, delimiter="," if args.comma else " ")
+    except RobotError as error:
+        return _fail(error.message)
+    except OSError as error:
+        raise UsageError(f"cannot write {args.output}: {error.strerror}") from None
+    finally:
+        if close is not None:
+            close()
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+    rate = (result.samples - 1) / result.span if result.span > 0 else 0.0
+    print(f"recorded {result.samples} samples ({result.span:.3f} s of controller time, "
+          f"{rate:.1f} Hz, {result.missed} missed by the controller) from "
+          f"{args.host}:{args.port} (RTDE v{result.protocol}, controller "
+          f"{result.controller_version}) to {result.path}", file=sys.stderr)
+    if result.error:
+        return _fail(result.error)
+    return 0
+
+
 # ---- plot ----------------------------------------------------------------------------------
 
 _PLOT_DESCRIPTION = """\
@@ -386,6 +486,31 @@ def _watch(reader, args: argparse.Namespace) -> int:
 
 def add_commands(commands) -> None:
     from ..protocol.dashboard import PORT
+
+    p = commands.add_parser("record", help="record RTDE data (joints, TCP, …) into a CSV file",
+                            description=_RECORD_DESCRIPTION, epilog=_RECORD_EPILOG,
+                            formatter_class=_FORMATTER)
+    _host(p)
+    p.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="the file to write")
+    p.add_argument("--fields", metavar="F1,F2",
+                   help="RTDE output fields, comma-separated (default: actual_q,actual_qd,"
+                   "actual_TCP_pose); timestamp is always recorded, first")
+    p.add_argument("--frequency", type=_positive, default=125.0, metavar="HZ",
+                   help="samples per second: up to 125 on CB3, 500 on e-Series (default 125)")
+    p.add_argument("--duration", type=_positive, metavar="S",
+                   help="stop after S seconds (default: at Ctrl-C)")
+    p.add_argument("--samples", type=int, metavar="N",
+                   help="stop after N samples")
+    p.add_argument("--port", type=int, default=30004, help="RTDE port (default 30004)")
+    p.add_argument("--timeout", type=_positive, default=5.0, metavar="S",
+                   help="seconds to wait for the connection and each setup reply (default 5)")
+    p.add_argument("--stall-timeout", type=_positive, default=10.0, metavar="S",
+                   help="end the recording when no sample came for S seconds (default 10)")
+    p.add_argument("--comma", action="store_true",
+                   help="separate columns with commas instead of spaces (record.py uses "
+                   "spaces)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress display")
+    p.set_defaults(run=cmd_record)
 
     p = commands.add_parser("plot", help="plot a recording (CSV) into a PNG",
                             description=_PLOT_DESCRIPTION, epilog=_PLOT_EPILOG,
