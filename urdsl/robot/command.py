@@ -335,18 +335,18 @@ def cmd_send(args: argparse.Namespace) -> int:
     if args.dry_run:
         sys.stdout.write(prepared.text)
         return 0
+    def report(kind: str, text: str) -> None:
+        prefix = "  controller: " if kind == "message" else ""
+        print(prefix + text, file=sys.stderr, flush=True)
+
     try:
         result = send_prepared(prepared, args.host, args.port, timeout=args.timeout,
                                follow=not args.no_follow, monitor_port=args.monitor_port,
-                               connect_timeout=args.connect_timeout)
+                               connect_timeout=args.connect_timeout, report=report)
     except RobotError as error:
         return _fail(error.message)
-    lines = prepared.text.count("\n")
-    print(f"sent {result.program!r} ({lines} lines) to {args.host}:{args.port}"
-          + (f", controller {result.controller_version}" if result.controller_version else ""),
-          file=sys.stderr)
-    for message in result.messages:
-        print(f"  controller: {message}", file=sys.stderr)
+    if result.controller_version:
+        print(f"  (controller software {result.controller_version})", file=sys.stderr)
     if result.error is not None:
         print(result.error.render(), file=sys.stderr)
     print(result.summary(), file=sys.stderr)
@@ -394,7 +394,9 @@ def render_state(state) -> str:
     import math
 
     head = f"{state.host}:{state.port} ({state.interface})"
-    if state.version:
+    if state.version and state.interface == "realtime":
+        head += f", packet layout {state.version}"
+    elif state.version:
         head += f", controller {state.version}"
     if state.time is not None:
         head += f", time {state.time:.3f} s"

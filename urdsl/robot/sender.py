@@ -20,6 +20,7 @@ Waiting is bounded by ``timeout``: a program still running then is reported as
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -153,7 +154,8 @@ class _Follower:
     """Reads the primary interface and decides started / finished / failed."""
 
     def __init__(self, connection: Connection, prepared: PreparedProgram,
-                 result: SendResult) -> None:
+                 result: SendResult, report: Callable[[str, str], None] | None) -> None:
+        self.report = report or (lambda kind, text: None)
         self.connection = connection
         self.prepared = prepared
         self.result = result
@@ -192,6 +194,11 @@ class _Follower:
         if not self.result.started:
             self.result.started = True
             self.start_time = now
+            self.report("started", f"{self.result.program}: started")
+
+    def _message(self, text: str) -> None:
+        self.result.messages.append(text)
+        self.report("message", text)
 
     def handle(self, messages: list, now: float) -> None:
         result = self.result
@@ -199,7 +206,7 @@ class _Follower:
             if isinstance(message, p.RuntimeExceptionMessage):
                 location = self.prepared.locate(message.line, message.column)
                 result.error = ControllerError(
-                    "runtime exception", message.text.strip(), message.line, message.column,
+                    "runtime exception", _clean(message.text), message.line, message.column,
                     location, self.prepared.sent_line(message.line) if message.line else None)
             elif isinstance(message, p.KeyMessage):
                 title = message.title.upper()
@@ -207,7 +214,7 @@ class _Follower:
                     self._started(now)
                 elif "PROGRAM" in title and "STOPPED" in title and result.started:
                     self.stop_time = self.stop_time or now
-                result.messages.append(f"{message.title} {message.text}".strip())
+                self._message(f"{message.title} {message.text}".strip())
             elif isinstance(message, p.SafetyModeMessage):
                 if message.safety_mode_type not in (0, 1, 2):  # not NORMAL or REDUCED
                     from .state import SAFETY_MODES
@@ -221,11 +228,11 @@ class _Follower:
                 self._started(now)  # the program's own output (textmsg, popup)
                 text = message.text if isinstance(message, p.TextMessage) else \
                     f"popup: {message.title} {message.text}".strip()
-                result.messages.append(text)
+                self._message(text)
             elif isinstance(message, p.ErrorCodeMessage) and message.report_level >= 3:
                 self.safety = self.safety or ControllerError(
                     "error", f"{message.text} (C{message.code}A{message.argument})".strip())
-                result.messages.append(message.text)
+                self._message(message.text)
 
     def follow(self, timeout: float) -> None:
         """Read until the program ended or failed, or ``timeout`` s passed."""
@@ -273,14 +280,22 @@ class _Follower:
             result.duration = max(end - self.start_time, 0.0)
 
 
+def _clean(text: str) -> str:
+    """The controller's exception text without a leading ``<origin>:line:col:`` of its own
+    (urdsl sim prefixes one; the mapped place replaces it)."""
+    return re.sub(r"^<[^>\n]*>:\d+:\d+:\s*", "", text.strip())
+
+
 def send_prepared(prepared: PreparedProgram, host: str, port: int = 30002, *,
                   timeout: float = 5.0, follow: bool = True, monitor_port: int | None = None,
-                  connect_timeout: float = 5.0) -> SendResult:
+                  connect_timeout: float = 5.0,
+                  report: Callable[[str, str], None] | None = None) -> SendResult:
     """Send an already prepared (and checked) program; follow it unless ``follow=False``.
 
     ``timeout`` (s) bounds the wait for the program to finish; ``connect_timeout`` (s) each
     connect and the wait for the first robot state. ``monitor_port`` is the primary port to
-    follow on (default :func:`monitor_port_for`).
+    follow on (default :func:`monitor_port_for`). ``report(kind, text)`` is told as things
+    happen: ``"sent"``, ``"started"``, ``"message"`` (a text from the controller).
     """
     data = prepared.text.encode("utf-8")
     result = SendResult(host, port, prepared.name, len(data), prepared=prepared)
@@ -292,13 +307,16 @@ def send_prepared(prepared: PreparedProgram, host: str, port: int = 30002, *,
             monitor = Connection.open(host, mport, interface="primary" if mport != port
                                       else interface_of_port(port) or "primary",
                                       timeout=connect_timeout)
-            follower = _Follower(monitor, prepared, result)
+            follower = _Follower(monitor, prepared, result, report)
             follower.wait_ready(connect_timeout)
             sender = monitor if mport == port else Connection.open(
                 host, port, timeout=connect_timeout)
         else:
             sender = Connection.open(host, port, timeout=connect_timeout)
         sender.send(data, connect_timeout)
+        if report is not None:
+            report("sent", f"sent {result.program!r} ({prepared.text.count(chr(10))} lines, "
+                   f"{len(data)} bytes) to {sender.where}")
         if sender is not monitor:
             _read_a_little(sender, min(connect_timeout, 1.0))
             sender.close()
