@@ -232,3 +232,23 @@ def test_truncated_packets_wait_or_fail_cleanly(state, data):
     assert RealtimeDecoder().feed(whole[:cut]) == []  # incomplete: wait for the rest
     with pytest.raises(ProtocolError):
         decode_realtime(whole[:cut])
+
+
+@pytest.mark.filterwarnings("ignore:notifyAll:DeprecationWarning")
+def test_python_urx_reads_our_packets_at_the_same_offsets():
+    # An independent parser: python-urx's realtime monitor, fed from memory (no socket use).
+    urrtmon = pytest.importorskip("urx.urrtmon")
+    target = (0.5, 0.1, 0.2, 0.0, 3.1, 0.0)
+    data = encode_realtime(realtime_state("3.10", q_actual=Q, tool_vector_actual=POSE,
+                                          tool_vector_target=target, tcp_force=(1,) * 6))
+    monitor = urrtmon.URRTMonitor("127.0.0.1")
+    monitor._rtSock.close()
+    chunks = iter([data[:4], data[4:]])
+    monitor._URRTMonitor__recv_bytes = lambda count: next(chunks)
+    monitor._URRTMonitor__recvTime = 0.0
+    monitor._URRTMonitor__recv_rt_data()
+    assert tuple(monitor._qActual) == Q
+    assert tuple(monitor._tcp_force) == (1,) * 6
+    # urx indexes 3.x packets with the 1.x order: its "tcp" is the target pose at 588
+    # (UR_FACTS.md §3.3 pitfall), which urdsl reads by name instead.
+    assert tuple(monitor._tcp) == target == decode_realtime(data).tool_vector_target

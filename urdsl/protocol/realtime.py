@@ -33,7 +33,6 @@ are computed from the tables, never written by hand; ``layout.offset("q_actual")
 
 from __future__ import annotations
 
-import operator
 import struct
 from dataclasses import dataclass, fields
 from types import MappingProxyType
@@ -114,24 +113,20 @@ class RealtimeLayout:
         self.size = _HEADER.size + 8 * self.doubles
         self.struct = struct.Struct(f">{self.doubles}d")
         self._offsets: dict[str, int] = {}
-        # The decode plan, grouped by what has to be done to each field, so that the hot
-        # loop does the least per field: scalar doubles in one itemgetter call, vectors as
-        # slices, integer fields converted and checked.
-        scalars, vectors, ints, int_vectors = [], [], [], []
+        # The decode plan: every field's key into the unpacked tuple (an index for a scalar,
+        # a slice for a vector), so that one C-level map over the keys builds all values;
+        # integer fields are then converted and checked.
+        keys: list[int | slice] = []
+        ints, int_vectors = [], []
         index = 0
         for item in table:
             self._offsets[item.name] = _HEADER.size + 8 * index
+            keys.append(index if item.count == 1 else slice(index, index + item.count))
             if item.kind == "int":
                 (ints if item.count == 1 else int_vectors).append(
                     (item.name, index, index + item.count))
-            elif item.count == 1:
-                scalars.append((item.name, index))
-            else:
-                vectors.append((item.name, index, index + item.count))
             index += item.count
-        self._scalar_names = tuple(name for name, _ in scalars)
-        self._scalar_get = operator.itemgetter(*(i for _, i in scalars))
-        self._vectors = tuple(vectors)
+        self._keys = tuple(keys)
         self._ints = tuple(ints)
         self._int_vectors = tuple(int_vectors)
         self.names = tuple(f.name for f in table)
@@ -316,9 +311,7 @@ _INF = float("inf")
 def _decode_fields(layout: RealtimeLayout, data: bytes | bytearray | memoryview,
                    start: int) -> dict[str, object]:
     values = layout.struct.unpack_from(data, start + _HEADER.size)
-    out = dict(zip(layout._scalar_names, layout._scalar_get(values), strict=True))
-    for name, begin, end in layout._vectors:
-        out[name] = values[begin:end]
+    out = dict(zip(layout.names, map(values.__getitem__, layout._keys), strict=False))
     try:
         for name, begin, _ in layout._ints:
             value = values[begin]
