@@ -354,6 +354,33 @@ def test_five_clients_garbage_a_dropped_rtde_stream_and_a_stalled_reader(sim):
     dash.close()
 
 
+def test_serve_as_the_only_context_manager_runs_and_stops_the_controller():
+    with VirtualController(speed=4.0).serve(ports={k: 0 for k in STANDARD_PORTS}) as sim:
+        sock = socket.create_connection(("127.0.0.1", sim.ports["secondary"]), TIMEOUT)
+        sock.sendall(f"def p():\n  movej({TARGET}, a=3, v=2)\nend\n".encode())
+        sim.wait_snapshot(lambda s: np.allclose(s.q, TARGET, atol=1e-9), 10)
+        sock.close()
+        threads = list(sim.controller._threads)
+    assert threads and not any(thread.is_alive() for thread in threads)
+
+
+def test_a_100000_line_program_sent_on_a_socket_runs_while_others_are_served(sim):
+    body = "".join(f"  x{i % 50} = {i} + 1\n" for i in range(100_000))
+    reader = connect(sim, "realtime")
+    sender = connect(sim, "primary")
+    sender.sendall(("def big():\n" + body + "  write_output_integer_register(0, x49)\nend\n")
+                   .encode())
+    stamps = []
+    deadline = time.monotonic() + 60
+    while sim.snapshot().output_int_registers[0] != 100_000:
+        assert time.monotonic() < deadline, "the big program did not finish"
+        stamps.append(struct.unpack_from(">d", realtime_packet(reader), 4)[0])
+    assert len(stamps) > 100 and np.all(np.diff(stamps) > 0)  # realtime kept streaming
+    assert not [m for m in sim.messages if m.kind == "runtime_exception"]
+    sender.close()
+    reader.close()
+
+
 def test_a_program_that_never_ends_its_def_is_kept_until_the_connection_sends_end(sim):
     sock = connect(sim, "secondary")
     sock.sendall(b"def p():\n  write_output_integer_register(1, 5)\n")

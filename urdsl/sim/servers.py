@@ -125,7 +125,7 @@ class SimServers:
         self._closing = threading.Event()
         self._thread: threading.Thread | None = None
         self._last_state_time = 0.0
-        self._state_cache: tuple[float, bytes] | None = None
+        self.owns_controller = False
 
     # ---- life cycle ----------------------------------------------------------------------
 
@@ -164,7 +164,16 @@ class SimServers:
         self._poke(None)
         if self._thread is not None:
             self._thread.join(timeout)
+            self._thread = None
         self._close_sockets()
+        if self.owns_controller:
+            self.sim.close(timeout)
+
+    def __getattr__(self, name: str):
+        # the controller's API through the servers object (``sim.submit``, ``sim.snapshot``)
+        if name.startswith("_") or name == "sim":
+            raise AttributeError(name)
+        return getattr(self.sim, name)
 
     def __enter__(self) -> SimServers:
         return self
@@ -181,6 +190,8 @@ class SimServers:
         return len(self._clients)
 
     def _close_sockets(self) -> None:
+        if self._wake_r.fileno() < 0:
+            return
         for client in list(self._clients):
             self._drop(client, "")
         for listener in self._listeners:
