@@ -35,5 +35,5 @@ with program.function("transfer", "grip", "drop") as transfer:
 
 for k, (x, y) in enumerate([(0.45, -0.20), (0.45, -0.10), (0.45, 0.0)]):
     program.comment(f"part {k + 1}")
-    transfer.call(Pose(x, y, 0.05, *DOWN), Pose(0.30, 0.35 + 0.05 * k, 0.08, *DOWN))
+    transfer.call(Pose(x, y, 0.05, *DOWN), Pose(0.30, round(0.35 + 0.05 * k, 3), 0.08, *DOWN))
 program.textmsg("placed parts: ", 3)

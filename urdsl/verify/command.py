@@ -113,26 +113,35 @@ def cmd_check(args: argparse.Namespace) -> int:
         self_collision=not args.no_self_collision)
     if args.cell:
         options.cell = _load_cell(robot, args.cell)
+    from ..dsl.command import ProgramFileError
+    from ..dsl.errors import DslError
+
     reports = []
+    failed = False
     for name in args.files:
         if name.endswith(".py"):
-            report = _check_program(name, options)
+            try:
+                report = _check_program(name, options)
+            except (DslError, ProgramFileError) as error:
+                print(str(error), file=sys.stderr)
+                failed = True
+                continue
         else:
             source = read_input(name)
             report = check_text(source.text, source.name, options=options)
         reports.append(report)
         if not args.json:
             _print(report, args.all_moves)
-    if args.json:
+    if args.json and reports:
         import json
 
         documents = [r.to_dict() for r in reports]
         json.dump(documents[0] if len(documents) == 1 else documents, sys.stdout, indent=2)
         sys.stdout.write("\n")
-    if args.plot:
+    if args.plot and reports:
         reports[0].plot(args.plot)
         print(f"plot written to {args.plot}", file=sys.stderr)
-    return EXIT_PROBLEMS if any(r.has_errors for r in reports) else EXIT_OK
+    return EXIT_PROBLEMS if failed or any(r.has_errors for r in reports) else EXIT_OK
 
 
 def _load_cell(robot: str, path: str):
