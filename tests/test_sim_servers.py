@@ -404,3 +404,36 @@ def test_servers_close_every_connection_on_shutdown(tmp_path):
                 if not sock.recv(65536):
                     raise ConnectionError("closed")
         sock.close()
+
+
+# ---- the project's own decoders read what the simulator sends -----------------------------------
+
+
+def test_urdsl_protocol_decoders_read_the_simulators_realtime_and_primary_streams(sim):
+    realtime = pytest.importorskip("urdsl.protocol.realtime")
+    primary = pytest.importorskip("urdsl.protocol.primary")
+    sock = connect(sim, "realtime")
+    state = realtime.decode(realtime_packet(sock))
+    sock.close()
+    assert state.size == 1220 and state.robot_mode == 7 and state.safety_mode == 1
+    assert np.allclose(state.q_actual, sim.snapshot().q)
+    assert np.allclose(state.tcp_pose, sim.snapshot().tcp)
+
+    sock = connect(sim, "primary")
+    decoder = primary.PrimaryDecoder()
+    sock.sendall(b"def oops():\n  x = 1 +* 2\nend\n")
+    decoded = []
+    deadline = time.monotonic() + TIMEOUT
+    while time.monotonic() < deadline and not any(
+            isinstance(m, primary.RuntimeExceptionMessage) for m in decoded):
+        decoded += decoder.feed(sock.recv(65536))
+    sock.close()
+    version = decoded[0]
+    assert isinstance(version, primary.VersionMessage)
+    assert (version.project, version.major, version.minor) == ("URControl", 5, 15)
+    robot_state = next(m for m in decoded if isinstance(m, primary.RobotState))
+    assert robot_state.get(primary.RobotModeData).robot_mode == 7
+    assert np.allclose(robot_state.get(primary.JointData).q_actual, sim.snapshot().q)
+    assert np.allclose(robot_state.get(primary.CartesianInfo).tcp_pose, sim.snapshot().tcp)
+    error = next(m for m in decoded if isinstance(m, primary.RuntimeExceptionMessage))
+    assert (error.line, error.column) == (2, 10) and "2:10" in error.text
