@@ -313,8 +313,6 @@ class SimServers:
 
     def _open(self, client: _Client) -> None:
         kind = client.kind
-        self._clients.add(client)
-        self._selector.register(client.sock, selectors.EVENT_READ, client)
         sim = self.sim
         if kind == "dashboard":
             client.session = DashboardSession(sim)
@@ -330,6 +328,11 @@ class SimServers:
                 client.send(wire.encode_robot_state(
                     snap, sim.version, sim.spec, (sim.kinematics.qd_max, sim.q_min, sim.q_max)
                     if hasattr(sim.kinematics, "qd_max") else None, configuration=True))
+        # only now may the clock and the message publisher add to its stream: the version
+        # message must come first
+        self._clients.add(client)
+        self._selector.register(client.sock, selectors.EVENT_READ, client)
+        self._flush(client)
 
     def _read(self, client: _Client) -> None:
         try:
