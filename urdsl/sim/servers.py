@@ -76,12 +76,31 @@ class _Client:
         self.framer = None
         self.last_state = 0.0
         self.writing = False
+        self.registered = False  # direct writes only once the connection's first
+        # messages are out and the network thread knows it
 
     def send(self, data: bytes) -> None:
         """Queue ``data``; drop the client when its buffer would exceed the limit."""
         if self.closed:
             return
         with self.lock:
+            if self.closed:  # checked under the lock: _drop closes the socket under it
+                return
+            if not self.out and self.registered:
+                # nothing queued: write at once from this thread (the socket does not
+                # block), sparing the hand-over to the network thread for every packet
+                try:
+                    sent = self.sock.send(data)
+                except (BlockingIOError, InterruptedError):
+                    sent = 0
+                except OSError:
+                    self.closed = True
+                    sent = len(data)
+                if sent == len(data):
+                    if self.closed:
+                        self.servers._poke(self)
+                    return
+                data = data[sent:]
             if len(self.out) + len(data) > self.servers.send_limit:
                 self.dropped_for = "stalled: its send buffer is full"
                 self.closed = True
@@ -333,6 +352,7 @@ class SimServers:
         self._clients.add(client)
         self._selector.register(client.sock, selectors.EVENT_READ, client)
         self._flush(client)
+        client.registered = True
 
     def _read(self, client: _Client) -> None:
         try:
@@ -412,10 +432,11 @@ class SimServers:
             self._selector.unregister(client.sock)
         except (KeyError, ValueError, OSError):
             pass
-        try:
-            client.sock.close()
-        except OSError:
-            pass
+        with client.lock:  # no direct write from the clock thread is under way
+            try:
+                client.sock.close()
+            except OSError:
+                pass
 
 
 def _encode_message(message: ControllerMessage) -> bytes:
