@@ -14,10 +14,10 @@ rtde        30004    RTDE (:mod:`urdsl.sim.rtde`)
 ==========  =======  ===============================================================
 
 Every client has a bounded send buffer. The controller's clock thread writes a packet
-straight to a client's non-blocking socket when nothing is queued for it, and queues the rest;
-the network thread writes queued data out as the socket drains. A client that stops reading until its
-buffer is full is dropped, so one stalled reader never delays the others. A client that
-breaks a protocol's framing is dropped too; its neighbours do not notice.
+straight to a client's non-blocking socket when nothing is queued for it, and queues the
+rest; the network thread writes queued data out as the socket drains. A client that stops
+reading until its buffer is full is dropped, so one stalled reader never delays the others.
+A client that breaks a protocol's framing is dropped too; its neighbours do not notice.
 """
 
 from __future__ import annotations
