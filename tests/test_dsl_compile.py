@@ -22,6 +22,39 @@ def test_every_example_program_compiles_to_formatted_urscript(path, capsys):
     assert path.read_text().lstrip().startswith('"""')  # a header saying what it shows
 
 
+@pytest.mark.parametrize("path", PROGRAMS, ids=lambda p: p.name)
+def test_compiled_programs_parse_back_into_the_dsl_tree(path, tmp_path, capsys):
+    program = load_program(path)
+    assert parse(program.script(), path.name) == program.tree()
+    script = tmp_path / "out.script"
+    script.write_text(program.script())
+    assert main(["fmt", "--check", str(script)]) == 0
+
+
+def test_the_socket_example_checks_and_sends_to_the_simulator(monkeypatch, capsys):
+    import runpy
+
+    from urdsl.sim import VirtualController
+    from urdsl.sim.servers import STANDARD_PORTS
+
+    module = runpy.run_path(str(PROGRAMS[0].parent / "socket_send.py"), run_name="example")
+    with VirtualController(robot="ur5e", speed=4.0) as sim, \
+            sim.serve(ports={k: 0 for k in STANDARD_PORTS}) as servers:
+        monkeypatch.setattr("sys.argv", ["socket_send.py", "--port",
+                                         str(servers.ports["secondary"]), "--primary-port",
+                                         str(servers.ports["primary"])])
+        assert module["main"]() == 0
+    assert "127.0.0.1" in capsys.readouterr().out
+
+
+def test_course_examples_compile_to_what_the_course_shows(capsys):
+    assert main(["compile", str(PROGRAMS[0].parent / "course_examples.py")]) == 0
+    text = capsys.readouterr().out
+    assert "  movej([0, -1.57079632, 0, -1.57079632, 0, 0])\n" in text
+    assert "C = pose_trans(p[0.2, -0.3, 0.3, 0.5, 0, -0.3], p[0, 0, 0.1, 0, 0, 0])" in text
+    assert "D = pose_add(p[0.2, -0.3, 0.3, 0.5, 0, -0.3], p[0, 0, 0.1, 0, 0, 0])" in text
+
+
 def test_output_file(tmp_path, capsys):
     out = tmp_path / "pick.script"
     assert main(["compile", str(PROGRAMS[0]), "-o", str(out)]) == 0

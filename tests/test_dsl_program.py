@@ -195,3 +195,10 @@ def test_an_unclosed_block_is_reported():
     manager.__enter__()
     with pytest.raises(DslError, match="still open"):
         program.tree()
+
+
+def test_a_pose_where_joints_are_required():
+    program = Program()
+    program.movej(Pose(0.3, 0.1, 0.3, 0, 3.14, 0))  # movej solves a pose: allowed
+    with pytest.raises(DslError, match="servoj needs joint angles, not a Pose"):
+        program.servoj(Pose(0.3, 0.1, 0.3, 0, 3.14, 0))

@@ -211,6 +211,7 @@ _COMMAND_MODULES: list[str] = [
     "urdsl.dsl.command",
     "urdsl.kinematics.cli",
     "urdsl.verify.command",
+    "urdsl.robot.command",
     "urdsl.sim.command",
 ]
 """Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""

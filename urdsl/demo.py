@@ -1,11 +1,11 @@
 """``make demo``: what urdsl can do today, end to end, on the files in ``programs/``.
 
-Today: read a URScript program and show its canonical form; show how urdsl reports the
-mistakes of the course's slides (file:line:col, the line, a caret, a hint); check the
-course's program offline on a simulated UR5e — first as the slides order it (a straight
-line out of a singular pose, which the robot cannot do), then corrected — and write the
-report (JSON) and a plot. The demo grows with the project (compile, send to ``urdsl sim``,
-record).
+Read a URScript program and show its canonical form; show how urdsl reports the mistakes
+of the course's slides (file:line:col, the line, a caret, a hint); compile a Python DSL
+program; check the course's program offline on a simulated UR5e — first as the slides order
+it (a straight line out of a singular pose, which the robot cannot do), then corrected —
+and write its report and plot; finally the whole story against the built-in virtual
+controller: check, send, record RTDE while the program runs, plot (all on 127.0.0.1).
 """
 
 from __future__ import annotations
@@ -44,10 +44,37 @@ def main() -> int:
             console.print(f"[bold]{title}[/bold]")
             console.print(error.diagnostic.render(), markup=False, highlight=False)
             console.print()
+    compile_program(console)
     check_programs(console)
+    story = run_story(console)
     console.rule("[bold]done")
-    console.print("next: urdsl fmt --help, urdsl check --help")
-    return 0
+    console.print("next: urdsl compile --help, urdsl check --help, urdsl sim --help")
+    return 0 if story else 1
+
+
+def compile_program(console: Console) -> None:
+    """``urdsl compile`` on the DSL pick-and-place program."""
+    from .dsl.command import load_program
+
+    console.rule("[bold]urdsl compile: a Python program becomes URScript")
+    program = PROGRAMS / "pick_and_place.py"
+    text = load_program(program).script()
+    head = "\n".join(text.splitlines()[:14]) + "\n  ..."
+    console.print(Panel(Syntax(head, "python", theme="ansi_dark"),
+                        title=f"urdsl compile {program.relative_to(PROGRAMS.parent)}"))
+
+
+def run_story(console: Console) -> bool:
+    """Write → check → send → record → plot against the built-in virtual controller."""
+    from .sim.story import demo_story
+
+    console.rule("[bold]urdsl sim: send the checked program, record RTDE while it runs")
+    result = demo_story("out", speed=4.0)
+    console.print(f"sent: {result.sent}; {result.samples} RTDE samples; planned cycle time "
+                  f"{result.planned_time:.2f} s, observed {result.observed_time:.2f} s")
+    for path in result.paths():
+        console.print(f"  wrote {path}")
+    return result.sent
 
 
 def check_programs(console: Console) -> None:

@@ -47,12 +47,17 @@ def _number(value, name: str, what: str = "") -> None:
         raise DslError(f"{name} must not be negative, got {value:g}{what}")
 
 
-def _joints(value, what: str) -> object:
-    """A joint target: Joints, six numbers (checked like Joints), or an expression."""
+def _joints(value, what: str, pose_ok: bool = False) -> object:
+    """A joint target: Joints, six numbers (checked like Joints), or an expression; a Pose
+    only where the controller solves it (``movej``)."""
     if isinstance(value, (Expr, Joints)):
         return value
     if isinstance(value, Pose):
-        return value
+        if pose_ok:
+            return value
+        raise DslError(f"{what} needs joint angles, not a Pose",
+                       "only movej solves a pose by inverse kinematics; for a straight line "
+                       "use movel")
     if isinstance(value, (list, tuple)):
         if len(value) != 6:
             raise DslError(f"{what} needs 6 joint angles, got {len(value)}",
@@ -199,7 +204,7 @@ class Program:
     def movej(self, q, a=None, v=None, t=None, r=None) -> None:
         """Move in joint space to ``q`` (Joints, or a Pose solved by IK closest to the current
         joints): ``a`` rad/s² (1.4), ``v`` rad/s (1.05), ``t`` s, ``r`` blend radius m."""
-        target = _joints(q, "movej")
+        target = _joints(q, "movej", pose_ok=True)
         self._check_motion("movej", a, v, t, r)
         self._statement_call("movej", (target,), self._given(a=a, v=v, t=t, r=r))
 

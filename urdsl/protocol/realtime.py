@@ -130,18 +130,31 @@ def decode(packet: bytes, layout: str | None = None) -> RealtimeState:
                             "doubles")
     name, table = _layout_for(size, layout)
     count = (size - 4) // 8
-    values = struct.unpack_from(f">{count}d", packet, 4)
-    fields: dict = {}
-    position = 0
-    for entry in table:
-        if position + entry.count > count:
-            break
-        chunk = values[position:position + entry.count]
-        if entry.integer:
-            chunk = tuple(int(v) for v in chunk)
-        fields[entry.name] = chunk[0] if entry.count == 1 else chunk
-        position += entry.count
-    return RealtimeState(size, name, fields, bytes(packet[4 + 8 * position:]))
+    unpack, plan, used = _plan(name, table, count)
+    values = unpack(packet, 4)
+    fields = {key: (values[start] if scalar else values[start:end]) if not integer else
+              (int(values[start]) if scalar else tuple(int(v) for v in values[start:end]))
+              for key, start, end, scalar, integer in plan}
+    return RealtimeState(size, name, fields, bytes(packet[4 + 8 * used:]))
+
+
+_PLANS: dict = {}
+
+
+def _plan(name: str, table: tuple[Field, ...], count: int):
+    """For a layout and a packet of ``count`` doubles: one compiled unpacker and the slice of
+    every whole field that fits (cached: a stream has one size)."""
+    key = (name, count)
+    if key not in _PLANS:
+        plan, position = [], 0
+        for entry in table:
+            if position + entry.count > count:
+                break
+            plan.append((entry.name, position, position + entry.count, entry.count == 1,
+                         entry.integer))
+            position += entry.count
+        _PLANS[key] = (struct.Struct(f">{count}d").unpack_from, tuple(plan), position)
+    return _PLANS[key]
 
 
 def encode(fields: dict, size: int = 1220, layout: str | None = None) -> bytes:
@@ -155,9 +168,15 @@ def encode(fields: dict, size: int = 1220, layout: str | None = None) -> bytes:
         raise ProtocolError(f"the {name} realtime layout has no field {sorted(unknown)[0]!r}")
     count = (size - 4) // 8
     values: list[float] = []
+    written = set()
     for entry in table:
         if len(values) + entry.count > count:
+            missing = sorted(set(fields) - written)
+            if missing:
+                raise ProtocolError(f"field {missing[0]!r} does not fit in a {size}-byte "
+                                    f"{name} realtime packet")
             break
+        written.add(entry.name)
         value = fields.get(entry.name, 0.0 if entry.count == 1 else (0.0,) * entry.count)
         items = (value,) if entry.count == 1 else tuple(value)
         if len(items) != entry.count:

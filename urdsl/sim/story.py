@@ -140,7 +140,7 @@ def _send(port: int, text: str) -> None:
         send_program = None
     if send_program is not None:
         try:
-            send_program("127.0.0.1", text, port=port)
+            send_program(text, "127.0.0.1", port=port)
             return
         except TypeError:  # a sender without a port argument: use the socket below
             pass
