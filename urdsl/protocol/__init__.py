@@ -1,15 +1,32 @@
 """Sans-I/O codecs for the controller's interfaces: bytes in, typed messages out, and back.
 
-No sockets, threads or clocks here (the model is h11): :mod:`urdsl.robot` and the virtual
-controller are thin socket layers on top. Every malformed input raises :class:`ProtocolError`
-with the field, offset or size that is wrong.
+No sockets, threads or clocks live here (the model is h11): a socket layer feeds received
+bytes to a decoder and writes the bytes an encoder returns. Malformed input raises
+:class:`ProtocolError` naming the field, offset and size that were wrong.
 
-* :mod:`.realtime` — the realtime interface (30003/30013), every layout from 1.6 to 5.x;
-* :mod:`.primary` — primary/secondary (30001/30002): robot state and robot messages;
-* :mod:`.rtde` — RTDE (30004) protocol versions 1 and 2, the client's state machine;
-* :mod:`.dashboard` — the dashboard server's line protocol (29999).
+==========================  =======  ================================================
+module                      port     what
+==========================  =======  ================================================
+:mod:`.dashboard`           29999    dashboard server line protocol (both sides)
+:mod:`.realtime`            30003    realtime ("Matlab") interface, every version
+:mod:`.primary`             30001/2  primary/secondary: robot state and robot messages
+:mod:`.rtde`                30004    RTDE protocol v1/v2, client and server machines
+:mod:`.rtde_fields`                  the RTDE field/type table, as data
+==========================  =======  ================================================
 """
 
-from .errors import ProtocolError
+from __future__ import annotations
 
-__all__ = ["ProtocolError"]
+from .dashboard import DashboardClient, DashboardReply, DashboardServer
+from .errors import ProtocolError
+from .primary import PrimaryDecoder, RobotState, RuntimeExceptionMessage, VersionMessage
+from .realtime import RealtimeDecoder, RealtimeState, decode_realtime, encode_realtime
+from .rtde import DataPackage, Recipe, RtdeClient, RtdeServer
+
+__all__ = [
+    "ProtocolError",
+    "DashboardClient", "DashboardReply", "DashboardServer",
+    "RealtimeDecoder", "RealtimeState", "decode_realtime", "encode_realtime",
+    "PrimaryDecoder", "RobotState", "RuntimeExceptionMessage", "VersionMessage",
+    "RtdeClient", "RtdeServer", "Recipe", "DataPackage",
+]

@@ -1,225 +1,525 @@
-"""The realtime interface (ports 30003/30013): fixed-layout packets pushed at 125 Hz (CB3) or
-500 Hz (e-Series).
+"""The realtime ("Matlab") interface, ports 30003 / 30013, for every controller version.
 
-A packet is an ``int32`` total size (including itself) followed by big-endian doubles — every
-field is a double, even modes and bit masks, which are decoded as ints here. The layout is a
-declarative table per software generation (UR_FACTS.md §3); a packet is decoded by its size
-field: the longest prefix of whole fields that fits is decoded by name and anything after it
-is kept as ``tail`` bytes. Controllers newer than these tables only append fields, so an
-unknown size still decodes everything known.
+The controller pushes one packet per control cycle (CB3: every 8 ms, 125 Hz; e-Series: every
+2 ms, 500 Hz). A packet is a big-endian ``int32`` total size (counting its own 4 bytes)
+followed by IEEE doubles — all of them doubles, even robot mode, joint modes and the digital
+I/O bit masks, which this module hands out as ``int``.
 
-=========  =====  =====================================================================
-software   bytes  fields
-=========  =====  =====================================================================
-1.6        756    time … I_actual, tool accelerometer, TCP force, tool vector, …
-1.7        764    + robot mode
-1.8        812    + joint modes
-3.0–3.1    1044   3.x/5.x order (tool vector actual at byte 444)
-3.2–3.4    1060   + digital outputs, program state
-3.5–3.9    1108   + elbow position and velocity (also 5.0–5.3)
-3.10–3.13  1116   + safety status (also 5.4–5.9)
-5.10+      1220   + payload mass, CoG, inertia
-=========  =====  =====================================================================
+The layout grew by appending fields, and the size field tells which layout a packet has:
+
+=========  ======  ===================================================================
+layout     bytes   software versions
+=========  ======  ===================================================================
+``1.6``    756     CB2 1.6 (its own field order: TCP force at 540, tool vector at 588)
+``1.7``    764     CB2 1.7 (+ robot mode)
+``1.8``    812     CB2 1.8 (+ joint modes)
+``3.0``    1044    CB3 3.0–3.1 (new order: tool vector actual at 444, target at 588)
+``3.2``    1060    CB3 3.2–3.4 (+ digital outputs, program state)
+``3.5``    1108    CB3 3.5–3.9 and e-Series 5.0–5.3 (+ elbow position, velocity)
+``3.10``   1116    CB3 3.10–3.13 and e-Series 5.4–5.8 (+ safety status)
+``5.10``   1220    e-Series 5.10+ (+ payload mass, centre of gravity, inertia)
+=========  ======  ===================================================================
+
+Sizes collide between CB3 and e-Series (1108, 1116): the fields are the same, only the
+version label differs, so a decoder labels such packets with the CB3 name unless it is told
+the version (``RealtimeDecoder(version="5.4")``). CB3 3.14+ and e-Series 5.9 send at least the
+1116-byte layout; what they append is not confirmed in UR's tables, so those bytes are kept
+raw in :attr:`RealtimeState.tail`, as are the bytes after any known layout. A packet whose size
+lies between two layouts is decoded with the longer layout that fits, the rest kept raw.
+
+Layouts are tables (:data:`LAYOUTS`): one row per field with name, kind and count. Offsets
+are computed from the tables, never written by hand; ``layout.offset("q_actual") == 252``.
 """
 
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, fields
+from types import MappingProxyType
 
 from .errors import ProtocolError
 
-__all__ = ["Field", "LAYOUT_1X", "LAYOUT_3X", "RealtimeState", "decode", "encode",
-           "RealtimeDecoder", "MAX_PACKET", "SIZES"]
+__all__ = [
+    "RealtimeField", "RealtimeLayout", "LAYOUTS", "SIZES", "RealtimeState", "RealtimeDecoder",
+    "decode_realtime", "encode_realtime", "realtime_state", "layout_for_version",
+    "layout_for_size", "PORT", "READ_ONLY_PORT", "MIN_SIZE", "MAX_SIZE",
+]
 
-MAX_PACKET = 4096
-"""Largest packet accepted (bytes). The biggest documented layout is 1220 bytes; room for
-fields newer controllers may append, small enough that a corrupt size is caught at once
-rather than after buffering megabytes."""
+PORT = 30003
+READ_ONLY_PORT = 30013
+
+_HEADER = struct.Struct(">i")
 
 
 @dataclass(frozen=True)
-class Field:
-    """``count`` doubles named ``name``; ``integer`` fields hold modes or bit masks."""
+class RealtimeField:
+    """One row of a layout table: ``count`` doubles named ``name``.
+
+    ``kind`` is ``"double"`` for measured values or ``"int"`` for integers the controller
+    sends as doubles (modes, bit masks): those decode to ``int``.
+    """
 
     name: str
+    kind: str
     count: int = 1
-    integer: bool = False
 
 
-def _fields(*spec) -> tuple[Field, ...]:
-    return tuple(Field(*item) if isinstance(item, tuple) else Field(item) for item in spec)
+def _d(name: str, count: int = 1) -> RealtimeField:
+    return RealtimeField(name, "double", count)
 
 
-_COMMON = (
-    "time", ("q_target", 6), ("qd_target", 6), ("qdd_target", 6), ("i_target", 6),
-    ("m_target", 6), ("q_actual", 6), ("qd_actual", 6), ("i_actual", 6),
+def _i(name: str, count: int = 1) -> RealtimeField:
+    return RealtimeField(name, "int", count)
+
+
+# --- the tables (UR "Realtime Client Interface" guide; UR_FACTS.md §3) ---------------------
+
+_HEAD = (  # identical in every version: offsets 4 .. 396
+    _d("time"), _d("q_target", 6), _d("qd_target", 6), _d("qdd_target", 6),
+    _d("i_target", 6), _d("m_target", 6), _d("q_actual", 6), _d("qd_actual", 6),
+    _d("i_actual", 6),
+)
+_V1_6 = _HEAD + (
+    _d("tool_accelerometer_values", 3), _d("reserved_420", 15), _d("tcp_force", 6),
+    _d("tool_vector_actual", 6), _d("tcp_speed_actual", 6), _i("digital_input_bits"),
+    _d("motor_temperatures", 6), _d("controller_timer"), _d("test_value"),
+)
+_V1_7 = _V1_6 + (_i("robot_mode"),)
+_V1_8 = _V1_7 + (_i("joint_modes", 6),)
+_V3_0 = _HEAD + (
+    _d("i_control", 6), _d("tool_vector_actual", 6), _d("tcp_speed_actual", 6),
+    _d("tcp_force", 6), _d("tool_vector_target", 6), _d("tcp_speed_target", 6),
+    _i("digital_input_bits"), _d("motor_temperatures", 6), _d("controller_timer"),
+    _d("test_value"), _i("robot_mode"), _i("joint_modes", 6), _i("safety_mode"),
+    _d("reserved_820", 6), _d("tool_accelerometer_values", 3), _d("reserved_892", 6),
+    _d("speed_scaling"), _d("linear_momentum_norm"), _d("reserved_956"), _d("reserved_964"),
+    _d("v_main"), _d("v_robot"), _d("i_robot"), _d("v_actual", 6),
+)
+_V3_2 = _V3_0 + (_i("digital_outputs"), _i("program_state"))
+_V3_5 = _V3_2 + (_d("elbow_position", 3), _d("elbow_velocity", 3))
+_V3_10 = _V3_5 + (_i("safety_status"),)
+_V5_10 = _V3_10 + (
+    _d("reserved_1116", 3), _d("payload_mass"), _d("payload_cog", 3), _d("payload_inertia", 6),
 )
 
-LAYOUT_3X = _fields(
-    *_COMMON, ("i_control", 6), ("tool_vector_actual", 6), ("tcp_speed_actual", 6),
-    ("tcp_force", 6), ("tool_vector_target", 6), ("tcp_speed_target", 6),
-    ("digital_input_bits", 1, True), ("motor_temperatures", 6), "controller_timer",
-    "test_value", ("robot_mode", 1, True), ("joint_modes", 6, True), ("safety_mode", 1, True),
-    ("reserved_1", 6), ("tool_accelerometer", 3), ("reserved_2", 6), "speed_scaling",
-    "linear_momentum_norm", "reserved_3", "reserved_4", "v_main", "v_robot", "i_robot",
-    ("v_actual", 6), ("digital_outputs", 1, True), ("program_state", 1, True),
-    ("elbow_position", 3), ("elbow_velocity", 3), ("safety_status", 1, True),
-    ("reserved_5", 3), "payload_mass", ("payload_cog", 3), ("payload_inertia", 6),
-)
-"""Software 3.0 and later, e-Series included (UR_FACTS.md §3.1)."""
 
-LAYOUT_1X = _fields(
-    *_COMMON, ("tool_accelerometer", 3), ("unused", 15), ("tcp_force", 6),
-    ("tool_vector_actual", 6), ("tcp_speed_actual", 6), ("digital_input_bits", 1, True),
-    ("motor_temperatures", 6), "controller_timer", "test_value", ("robot_mode", 1, True),
-    ("joint_modes", 6, True),
-)
-"""CB2, software 1.6–1.8 (UR_FACTS.md §3.2): a different order after I_actual."""
+class RealtimeLayout:
+    """A packet layout: its table, total size in bytes and the offset of every field."""
 
-SIZES = {756: "1.6", 764: "1.7", 812: "1.8", 1044: "3.0", 1060: "3.2", 1108: "3.5",
-         1116: "3.10", 1220: "5.10"}
-"""Known packet sizes and the first software version that sends them."""
+    def __init__(self, name: str, table: tuple[RealtimeField, ...]) -> None:
+        self.name = name
+        self.table = table
+        self.doubles = sum(f.count for f in table)
+        self.size = _HEADER.size + 8 * self.doubles
+        self.struct = struct.Struct(f">{self.doubles}d")
+        self._offsets: dict[str, int] = {}
+        # The decode plan: every field's key into the unpacked tuple (an index for a scalar,
+        # a slice for a vector), so that one C-level map over the keys builds all values;
+        # integer fields are then converted and checked.
+        keys: list[int | slice] = []
+        ints, int_vectors = [], []
+        index = 0
+        for item in table:
+            self._offsets[item.name] = _HEADER.size + 8 * index
+            keys.append(index if item.count == 1 else slice(index, index + item.count))
+            if item.kind == "int":
+                (ints if item.count == 1 else int_vectors).append(
+                    (item.name, index, index + item.count))
+            index += item.count
+        self._keys = tuple(keys)
+        self._ints = tuple(ints)
+        self._int_vectors = tuple(int_vectors)
+        self.names = tuple(f.name for f in table)
 
-_NAMES_3X = {f.name for f in LAYOUT_3X}
+    def offset(self, name: str) -> int:
+        """Byte offset of a field from the start of the packet (the size field is at 0)."""
+        try:
+            return self._offsets[name]
+        except KeyError:
+            raise KeyError(f"the {self.name} realtime layout has no field {name!r}") from None
+
+    def __repr__(self) -> str:
+        return f"RealtimeLayout({self.name!r}, {self.size} bytes)"
+
+
+LAYOUTS: MappingProxyType[str, RealtimeLayout] = MappingProxyType({
+    name: RealtimeLayout(name, table) for name, table in (
+        ("1.6", _V1_6), ("1.7", _V1_7), ("1.8", _V1_8), ("3.0", _V3_0), ("3.2", _V3_2),
+        ("3.5", _V3_5), ("3.10", _V3_10), ("5.10", _V5_10),
+    )
+})
+"""Every known layout by its name (the first software version that sends it)."""
+
+SIZES: MappingProxyType[int, RealtimeLayout] = MappingProxyType(
+    {layout.size: layout for layout in LAYOUTS.values()})
+"""Layouts by packet size."""
+
+_BY_SIZE = sorted(LAYOUTS.values(), key=lambda layout: layout.size)
+
+MIN_SIZE = _BY_SIZE[0].size
+"""Smallest packet accepted: the 1.6 layout (756 bytes); older CB2 software is not known."""
+
+MAX_SIZE = 8192
+"""Largest packet accepted, in bytes.
+
+The largest documented packet has 1220 bytes (5.10+) and each release so far appended at
+most ~100 bytes. Allowing 8 KiB keeps room for future fields (kept raw) while a corrupt or
+desynchronised size field — almost any 4 random bytes read as int32 exceed it — is
+rejected at once instead of making the decoder wait for megabytes that never come.
+"""
+
+
+def layout_for_size(size: int) -> RealtimeLayout:
+    """The layout for a packet of ``size`` bytes: exact match, else the longest that fits."""
+    layout = SIZES.get(size)
+    if layout is not None:
+        return layout
+    if size < MIN_SIZE:
+        raise ProtocolError(f"packet size {size} is smaller than the smallest known layout "
+                            f"(1.6, {MIN_SIZE} bytes)", interface="realtime", offset=0)
+    best = _BY_SIZE[0]
+    for candidate in _BY_SIZE:
+        if candidate.size <= size:
+            best = candidate
+    return best
+
+
+def _version_tuple(version: str) -> tuple[int, int]:
+    try:
+        parts = version.strip().split(".")
+        return int(parts[0]), int(parts[1]) if len(parts) > 1 else 0
+    except (ValueError, IndexError):
+        raise ProtocolError(f"controller version {version!r} is not of the form 'major.minor'",
+                            interface="realtime") from None
+
+
+def layout_for_version(version: str) -> RealtimeLayout:
+    """The layout a controller of software ``version`` (``"3.12"``, ``"5.11.1"``) sends."""
+    major, minor = _version_tuple(version)
+    if major == 1 and 6 <= minor <= 8:
+        return LAYOUTS[f"1.{minor}"]
+    if major == 1 and minor > 8:
+        return LAYOUTS["1.8"]
+    if major == 3:
+        for floor, name in ((10, "3.10"), (5, "3.5"), (2, "3.2"), (0, "3.0")):
+            if minor >= floor:
+                return LAYOUTS[name]
+    if major == 5:
+        # 5.9 sends at least 3.10's fields; its tail is not confirmed (kept raw).
+        for floor, name in ((10, "5.10"), (4, "3.10"), (0, "3.5")):
+            if minor >= floor:
+                return LAYOUTS[name]
+    if major > 5:
+        return LAYOUTS["5.10"]
+    raise ProtocolError(f"no known realtime layout for controller version {version!r} "
+                        "(known: 1.6–1.8, 3.x, 5.x)", interface="realtime")
+
+
+Vector = tuple[float, ...]
 
 
 @dataclass(frozen=True)
 class RealtimeState:
-    """One decoded packet: ``fields`` by name (floats, ints, or tuples of them), the packet
-    ``size``, the ``layout`` ("1.x" or "3.x") and the undecoded ``tail`` bytes."""
+    """One realtime packet, every field by name (SI units: rad, rad/s, m, N, A, V, °C, s).
 
-    size: int
-    layout: str
-    fields: dict = field(repr=False)
+    Fields a version does not send are ``None``. Modes and bit masks are ``int``; vectors are
+    tuples (joint vectors base … wrist 3; poses x, y, z, rx, ry, rz in the Base frame).
+    ``version`` names the layout (or the version the decoder was told); ``size`` is the
+    packet's size field; ``tail`` holds the bytes after the known layout, undecoded.
+    """
+
+    version: str = "5.10"
+    size: int = 0
+    time: float | None = None
+    q_target: Vector | None = None
+    qd_target: Vector | None = None
+    qdd_target: Vector | None = None
+    i_target: Vector | None = None
+    m_target: Vector | None = None
+    q_actual: Vector | None = None
+    qd_actual: Vector | None = None
+    i_actual: Vector | None = None
+    i_control: Vector | None = None
+    tool_vector_actual: Vector | None = None
+    tcp_speed_actual: Vector | None = None
+    tcp_force: Vector | None = None
+    tool_vector_target: Vector | None = None
+    tcp_speed_target: Vector | None = None
+    digital_input_bits: int | None = None
+    motor_temperatures: Vector | None = None
+    controller_timer: float | None = None
+    test_value: float | None = None
+    robot_mode: int | None = None
+    joint_modes: tuple[int, ...] | None = None
+    safety_mode: int | None = None
+    reserved_420: Vector | None = None
+    reserved_820: Vector | None = None
+    tool_accelerometer_values: Vector | None = None
+    reserved_892: Vector | None = None
+    speed_scaling: float | None = None
+    linear_momentum_norm: float | None = None
+    reserved_956: float | None = None
+    reserved_964: float | None = None
+    v_main: float | None = None
+    v_robot: float | None = None
+    i_robot: float | None = None
+    v_actual: Vector | None = None
+    digital_outputs: int | None = None
+    program_state: int | None = None
+    elbow_position: Vector | None = None
+    elbow_velocity: Vector | None = None
+    safety_status: int | None = None
+    reserved_1116: Vector | None = None
+    payload_mass: float | None = None
+    payload_cog: Vector | None = None
+    payload_inertia: Vector | None = None
     tail: bytes = b""
 
-    def __getattr__(self, name: str):
-        fields = object.__getattribute__(self, "fields")
-        if name in fields:
-            return fields[name]
-        raise AttributeError(f"this {self.layout} realtime packet ({self.size} bytes) has no "
-                             f"field {name!r}")
+    @property
+    def tcp_pose(self) -> Vector | None:
+        """The actual TCP pose (x, y, z, rx, ry, rz) [m, rad] in the Base frame."""
+        return self.tool_vector_actual
 
     @property
-    def tcp_pose(self) -> tuple[float, ...]:
-        """The actual TCP pose (m, rotation vector rad): byte 444 on 3.x/5.x, 588 on 1.x."""
-        return self.fields["tool_vector_actual"]
+    def layout(self) -> RealtimeLayout:
+        """The layout of this packet's known fields."""
+        return LAYOUTS[self.version] if self.version in LAYOUTS else \
+            layout_for_version(self.version)
 
 
-def _layout_for(size: int, layout: str | None) -> tuple[str, tuple[Field, ...]]:
-    if layout is None:
-        layout = "1.x" if size < 1044 else "3.x"
-    if layout not in ("1.x", "3.x"):
-        raise ProtocolError(f"unknown realtime layout {layout!r}: '1.x' or '3.x'")
-    return layout, (LAYOUT_1X if layout == "1.x" else LAYOUT_3X)
+_STATE_FIELDS = frozenset(f.name for f in fields(RealtimeState))
+for _layout in LAYOUTS.values():  # every table row must be a field of RealtimeState
+    assert set(_layout.names) <= _STATE_FIELDS, set(_layout.names) - _STATE_FIELDS
 
 
-def decode(packet: bytes, layout: str | None = None) -> RealtimeState:
-    """Decode one whole packet. ``layout`` forces "1.x" or "3.x" (by default: 1.x below 1044
-    bytes, the smallest 3.x packet)."""
-    if len(packet) < 4:
-        raise ProtocolError(f"a realtime packet starts with a 4-byte size; got {len(packet)} "
-                            "bytes")
-    (size,) = struct.unpack_from(">i", packet, 0)
+def _int_error(layout: RealtimeLayout, values: tuple[float, ...]) -> ProtocolError:
+    """The error for the first integer field of ``values`` that holds no integer."""
+    for name, begin, end in layout._ints + layout._int_vectors:
+        for index in range(begin, end):
+            value = values[index]
+            if value != value or value in (_INF, -_INF) or int(value) != value:
+                offset = _HEADER.size + 8 * index
+                return ProtocolError(f"field {name} at offset {offset} should hold an "
+                                     f"integer, got {value!r}", interface="realtime",
+                                     offset=offset)
+    raise AssertionError("no bad integer field")  # pragma: no cover
+
+
+_INF = float("inf")
+
+
+def _decode_fields(layout: RealtimeLayout, data: bytes | bytearray | memoryview,
+                   start: int) -> dict[str, object]:
+    values = layout.struct.unpack_from(data, start + _HEADER.size)
+    out = dict(zip(layout.names, map(values.__getitem__, layout._keys), strict=False))
+    try:
+        for name, begin, _ in layout._ints:
+            value = values[begin]
+            number = int(value)
+            if number != value:
+                raise ValueError(name)
+            out[name] = number
+        for name, begin, end in layout._int_vectors:
+            segment = values[begin:end]
+            numbers = tuple(map(int, segment))
+            if numbers != segment:
+                raise ValueError(name)
+            out[name] = numbers
+    except (ValueError, OverflowError):
+        raise _int_error(layout, values) from None
+    return out
+
+
+def _make_state(version: str, size: int, values: dict[str, object], tail: bytes) -> RealtimeState:
+    # Building the frozen dataclass through its __dict__ skips 45 object.__setattr__ calls
+    # (the slow part of a frozen __init__); fields a layout lacks fall back to the class
+    # defaults (None), exactly as the constructor would leave them.
+    state = object.__new__(RealtimeState)
+    attrs = state.__dict__
+    attrs.update(values)
+    attrs["version"] = version
+    attrs["size"] = size
+    attrs["tail"] = tail
+    return state
+
+
+def _decode_at(data: bytes | bytearray | memoryview, start: int, size: int,
+               version: str | None) -> RealtimeState:
+    if version is None:
+        layout = layout_for_size(size)
+        label = layout.name
+    else:
+        layout = layout_for_version(version)
+        label = version
+        if size < layout.size:
+            raise ProtocolError(f"a version {version} packet has at least {layout.size} bytes "
+                                f"({layout.name} layout), this one has {size}",
+                                interface="realtime", offset=0)
+    tail = bytes(data[start + layout.size:start + size]) if size > layout.size else b""
+    return _make_state(label, size, _decode_fields(layout, data, start), tail)
+
+
+def _check_size(size: int) -> None:
+    if size < MIN_SIZE or size > MAX_SIZE:
+        raise ProtocolError(f"packet size field says {size} bytes; a realtime packet has "
+                            f"{MIN_SIZE}..{MAX_SIZE} (known layouts: "
+                            f"{', '.join(str(s) for s in sorted(SIZES))})",
+                            interface="realtime", offset=0)
+
+
+def decode_realtime(packet: bytes, version: str | None = None) -> RealtimeState:
+    """Decode exactly one complete packet (size field included).
+
+    ``version`` (``"5.4"``) overrides the version label and layout chosen from the size.
+    Raises :class:`ProtocolError` when the bytes are not one whole packet.
+    """
+    if len(packet) < _HEADER.size:
+        raise ProtocolError(f"{len(packet)} bytes cannot hold the 4-byte size field",
+                            interface="realtime", offset=0)
+    (size,) = _HEADER.unpack_from(packet, 0)
+    _check_size(size)
     if size != len(packet):
-        raise ProtocolError(f"the size field says {size} bytes, the packet has {len(packet)}")
-    if size < 12 or (size - 4) % 8:
-        raise ProtocolError(f"a realtime packet of {size} bytes is not a size field and whole "
-                            "doubles")
-    name, table = _layout_for(size, layout)
-    count = (size - 4) // 8
-    unpack, plan, used = _plan(name, table, count)
-    values = unpack(packet, 4)
-    fields = {key: (values[start] if scalar else values[start:end]) if not integer else
-              (int(values[start]) if scalar else tuple(int(v) for v in values[start:end]))
-              for key, start, end, scalar, integer in plan}
-    return RealtimeState(size, name, fields, bytes(packet[4 + 8 * used:]))
+        raise ProtocolError(f"size field says {size} bytes but the packet has {len(packet)}",
+                            interface="realtime", offset=0)
+    return _decode_at(packet, 0, size, version)
 
 
-_PLANS: dict = {}
+def realtime_state(version: str = "5.10", **values: object) -> RealtimeState:
+    """A state of ``version``'s layout with the given fields and zeros for the others.
 
-
-def _plan(name: str, table: tuple[Field, ...], count: int):
-    """For a layout and a packet of ``count`` doubles: one compiled unpacker and the slice of
-    every whole field that fits (cached: a stream has one size)."""
-    key = (name, count)
-    if key not in _PLANS:
-        plan, position = [], 0
-        for entry in table:
-            if position + entry.count > count:
-                break
-            plan.append((entry.name, position, position + entry.count, entry.count == 1,
-                         entry.integer))
-            position += entry.count
-        _PLANS[key] = (struct.Struct(f">{count}d").unpack_from, tuple(plan), position)
-    return _PLANS[key]
-
-
-def encode(fields: dict, size: int = 1220, layout: str | None = None) -> bytes:
-    """A packet of ``size`` bytes with ``fields`` by name (missing fields are 0.0)."""
-    if size < 12 or (size - 4) % 8 or size > MAX_PACKET:
-        raise ProtocolError(f"no realtime packet has {size} bytes")
-    name, table = _layout_for(size, layout)
-    known = {entry.name for entry in table}
-    unknown = set(fields) - known
+    For the simulator: ``realtime_state("3.10", q_actual=(0, -1.57, 0, -1.57, 0, 0))``.
+    Unknown field names, or names the version's layout does not send, raise ``TypeError``.
+    """
+    layout = layout_for_version(version)
+    known = set(layout.names)
+    unknown = set(values) - known - {"tail"}
     if unknown:
-        raise ProtocolError(f"the {name} realtime layout has no field {sorted(unknown)[0]!r}")
-    count = (size - 4) // 8
+        raise TypeError(f"the {layout.name} realtime layout has no field(s) "
+                        f"{', '.join(sorted(unknown))}")
+    full: dict[str, object] = {}
+    for item in layout.table:
+        zero: object = 0 if item.kind == "int" else 0.0
+        default = zero if item.count == 1 else (zero,) * item.count
+        value = values.get(item.name, default)
+        if item.count > 1:
+            value = tuple(int(v) if item.kind == "int" else float(v) for v in value)
+        else:
+            value = int(value) if item.kind == "int" else float(value)
+        full[item.name] = value
+    tail = bytes(values.get("tail", b""))
+    return _make_state(version, layout.size + len(tail), full, tail)
+
+
+def encode_realtime(state: RealtimeState, version: str | None = None) -> bytes:
+    """The packet the controller sends for ``state`` (the simulator's side).
+
+    ``version`` defaults to ``state.version``. Every field of that version's layout must be
+    set (use :func:`realtime_state` to start from zeros); ``state.tail`` is appended and
+    counted in the size field.
+    """
+    layout = layout_for_version(version or state.version)
     values: list[float] = []
-    written = set()
-    for entry in table:
-        if len(values) + entry.count > count:
-            missing = sorted(set(fields) - written)
-            if missing:
-                raise ProtocolError(f"field {missing[0]!r} does not fit in a {size}-byte "
-                                    f"{name} realtime packet")
-            break
-        written.add(entry.name)
-        value = fields.get(entry.name, 0.0 if entry.count == 1 else (0.0,) * entry.count)
-        items = (value,) if entry.count == 1 else tuple(value)
-        if len(items) != entry.count:
-            raise ProtocolError(f"{entry.name} has {entry.count} values, got {len(items)}")
-        values.extend(float(v) for v in items)
-    values.extend([0.0] * (count - len(values)))
-    return struct.pack(f">i{count}d", size, *values)
+    for item in layout.table:
+        value = getattr(state, item.name)
+        if value is None:
+            raise ProtocolError(f"cannot encode a {layout.name} packet: field {item.name} "
+                                "is not set", interface="realtime",
+                                offset=layout.offset(item.name))
+        if item.count == 1:
+            values.append(float(value))
+        else:
+            if len(value) != item.count:
+                raise ProtocolError(f"field {item.name} needs {item.count} values, "
+                                    f"got {len(value)}", interface="realtime",
+                                    offset=layout.offset(item.name))
+            values.extend(float(v) for v in value)
+    size = layout.size + len(state.tail)
+    if size > MAX_SIZE:
+        raise ProtocolError(f"packet of {size} bytes exceeds {MAX_SIZE}", interface="realtime")
+    return _HEADER.pack(size) + layout.struct.pack(*values) + state.tail
 
 
 class RealtimeDecoder:
-    """Packets from a byte stream, however the stream is split.
+    """Turns the realtime byte stream into :class:`RealtimeState` objects.
 
-    ``feed`` returns every complete packet; :meth:`latest` only the newest — what a client
-    that must not act on stale state wants (a slow reader drains the socket's backlog and
-    keeps the last packet).
+    TCP delivers a byte stream, not packets: ``feed`` accepts any chunk (half a packet, three
+    and a half packets) and returns the packets it completes, oldest first. ``latest`` is the
+    drain a state reader wants: it returns only the newest complete packet and skips the
+    older ones without decoding them (``skipped`` counts them), so a slow reader never
+    acts on a stale sample from the socket's queue.
+
+    After a :class:`ProtocolError` the stream cannot be trusted (packet boundaries are
+    lost); the decoder refuses further input, and the connection has to be reopened.
     """
 
-    def __init__(self, layout: str | None = None) -> None:
-        self.layout = layout
+    def __init__(self, version: str | None = None) -> None:
+        if version is not None:
+            layout_for_version(version)  # fail early on a version we do not know
+        self.version = version
         self._buffer = bytearray()
+        self._error: ProtocolError | None = None
+        self.decoded = 0
+        self.skipped = 0
+
+    @property
+    def pending(self) -> int:
+        """Bytes of an incomplete packet held back."""
+        return len(self._buffer)
+
+    def _frames(self) -> list[tuple[int, int]]:
+        """(start, size) of every complete packet in the buffer; checks each size field."""
+        frames = []
+        buffer = self._buffer
+        pos = 0
+        end = len(buffer)
+        while end - pos >= _HEADER.size:
+            (size,) = _HEADER.unpack_from(buffer, pos)
+            try:
+                _check_size(size)
+            except ProtocolError as exc:
+                self._error = exc
+                raise
+            if end - pos < size:
+                break
+            frames.append((pos, size))
+            pos += size
+        return frames
+
+    def _take(self, data: bytes) -> list[tuple[int, int]]:
+        if self._error is not None:
+            raise ProtocolError(f"stream already failed ({self._error.message}); reconnect",
+                                interface="realtime")
+        self._buffer += data
+        return self._frames()
+
+    def _decode(self, start: int, size: int) -> RealtimeState:
+        try:
+            return _decode_at(self._buffer, start, size, self.version)
+        except ProtocolError as exc:
+            self._error = exc
+            raise
 
     def feed(self, data: bytes) -> list[RealtimeState]:
-        self._buffer += data
-        return [decode(bytes(packet), self.layout) for packet in self._packets()]
+        """Add received bytes; return every packet they complete, oldest first."""
+        frames = self._take(data)
+        states = [self._decode(start, size) for start, size in frames]
+        if frames:
+            last_start, last_size = frames[-1]
+            del self._buffer[:last_start + last_size]
+        self.decoded += len(states)
+        return states
 
     def latest(self, data: bytes = b"") -> RealtimeState | None:
-        """The newest complete packet in the stream so far (older ones are dropped)."""
-        self._buffer += data
-        newest = None
-        for packet in self._packets():
-            newest = packet
-        return None if newest is None else decode(bytes(newest), self.layout)
+        """Add received bytes; return the newest complete packet only (or ``None``).
 
-    def _packets(self) -> Iterator[bytearray]:
-        buffer = self._buffer
-        while len(buffer) >= 4:
-            (size,) = struct.unpack_from(">i", buffer, 0)
-            if not 12 <= size <= MAX_PACKET:
-                self._buffer = bytearray()
-                raise ProtocolError(f"realtime size field {size} is outside 12..{MAX_PACKET} "
-                                    "bytes: the stream is not realtime packets")
-            if len(buffer) < size:
-                return
-            packet = buffer[:size]
-            del buffer[:size]
-            yield packet
+        Older complete packets are dropped undecoded (their sizes are still checked).
+        """
+        frames = self._take(data)
+        if not frames:
+            return None
+        start, size = frames[-1]
+        state = self._decode(start, size)
+        del self._buffer[:start + size]
+        self.skipped += len(frames) - 1
+        self.decoded += 1
+        return state

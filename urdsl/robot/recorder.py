@@ -1,154 +1,223 @@
-"""Recording RTDE outputs to CSV, and plotting a recording.
+"""Recording RTDE outputs to a CSV file (``urdsl record``), as UR's ``record.py`` does, better.
 
-The CSV is the format of UR's own ``record.py`` (so UR's ``csv_reader`` and plotting
-examples read it): space-delimited, one header row, ``timestamp`` first, vectors expanded to
-``name_0`` … ``name_5``. Rows are flushed every 0.5 s, so an interrupted recording keeps what
-was received. :func:`plot_csv` reads space- and comma-delimited files.
+:func:`record` connects to RTDE (protocol 2, falling back to 1), sets up the output recipe
+(``timestamp`` first, then the fields asked for), starts the stream and writes every sample
+it receives — in order, none dropped by the client — to a :class:`urdsl.robot.csvfile.CsvWriter`.
+
+It stops when ``duration`` seconds or ``samples`` samples are reached, when ``stop`` is set
+(the CLI sets it on Ctrl-C), when the controller stays silent for ``stall_timeout``
+seconds, or when the connection drops. In every case the file is flushed and closed and
+holds every sample received, each one a complete line; :class:`RecordResult` says why it
+stopped. Text messages the controller sends during the recording (warnings, errors) are
+collected and do not stop it.
+
+Samples the *controller* skipped (it always sends the newest when it is overloaded, UR's
+RTDE guide) are counted in ``missed`` from gaps in ``timestamp``.
 """
 
 from __future__ import annotations
 
-import csv
+import math
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..protocol import rtde
-from .connection import Deadline, RobotConnectionError, connect, read_until
+from ..protocol import rtde as r
+from .csvfile import CsvWriter
+from .errors import ConnectionLost, RobotError
+from .rtde_session import PORT, RtdeSession
 
-__all__ = ["record", "plot_csv", "DEFAULT_FIELDS"]
+__all__ = ["record", "RecordResult", "RecordProgress", "DEFAULT_FIELDS", "parse_fields"]
 
-DEFAULT_FIELDS = ["timestamp", "actual_q", "actual_qd", "actual_TCP_pose", "runtime_state"]
+DEFAULT_FIELDS = ("actual_q", "actual_qd", "actual_TCP_pose")
+"""Recorded when no fields are given: joint positions and speeds, TCP pose."""
+
+PROGRESS_PERIOD = 0.1
+"""Seconds between progress callbacks."""
+
+RECEIVE_SLICE = 0.2
+"""Longest single wait for data (s): how quickly ``stop`` is noticed."""
 
 
-def record(host: str, output: str | Path, fields: list[str] | None = None,
-           frequency: float = 125.0, duration: float | None = None, port: int = 30004,
-           timeout: float = 5.0, progress: Callable[[int, float], None] | None = None,
-           messages: list | None = None) -> int:
-    """Record ``fields`` at ``frequency`` Hz to ``output`` for ``duration`` s (None: until
-    Ctrl-C). Returns the number of rows. Controller text messages go to ``messages``."""
-    fields = list(fields or DEFAULT_FIELDS)
-    if "timestamp" in fields:
-        fields.remove("timestamp")
-    fields.insert(0, "timestamp")
-    unknown = [f for f in fields if f not in rtde.OUTPUTS]
-    if unknown:
-        raise ValueError(f"unknown RTDE output {unknown[0]!r} (see `urdsl record --help`)")
-    if not 0 < frequency <= 500:
-        raise ValueError(f"RTDE frequency must be in (0, 500] Hz, got {frequency:g}")
-    sock = connect(host, port, timeout)
-    client = rtde.RtdeClient()
-    deadline = Deadline(timeout)
+def parse_fields(text: str | Sequence[str] | None) -> list[str]:
+    """``"actual_q, actual_TCP_pose"`` → the recipe names, ``timestamp`` first, each once."""
+    if text is None:
+        names = list(DEFAULT_FIELDS)
+    elif isinstance(text, str):
+        names = [t.strip() for t in text.split(",") if t.strip()]
+    else:
+        names = [t.strip() for t in text if t.strip()]
+    if not names:
+        raise ValueError("no fields given")
+    ordered = ["timestamp"]
+    for name in names:
+        if name not in ordered:
+            ordered.append(name)
+    return ordered
 
-    pending: list = []  # events that arrived with a reply (data right after "started")
 
-    def expect(kind):
-        while True:
-            if not pending:
-                pending.extend(client.feed(read_until(sock, deadline, "an RTDE reply", host,
-                                                      port)))
-            event = pending.pop(0)
-            if isinstance(event, kind):
-                return event
-            if isinstance(event, rtde.Message) and messages is not None:
-                messages.append(event)
+@dataclass
+class RecordProgress:
+    """Where a recording is: samples written, controller time covered (s), wall time (s),
+    samples the controller skipped, the last controller text message."""
 
-    rows = 0
-    try:
-        sock.sendall(client.request_protocol_version(2))
-        if not expect(rtde.ProtocolVersion).accepted:
-            sock.sendall(client.request_protocol_version(1))
-            if not expect(rtde.ProtocolVersion).accepted:
-                raise RobotConnectionError(f"{host}:{port}: RTDE protocol 1 and 2 refused")
-        sock.sendall(client.setup_outputs(fields, frequency))
-        setup = expect(rtde.OutputSetup)
-        if not setup.valid:
-            raise RobotConnectionError(f"{host}:{port}: the controller has no output "
-                                       f"{', '.join(setup.not_found)}")
-        sock.sendall(client.start())
-        if not expect(rtde.Started).accepted:
-            raise RobotConnectionError(f"{host}:{port}: the controller refused to start RTDE")
-        columns = rtde.expand_names(list(setup.names), list(setup.types))
-        stop = Deadline(duration) if duration is not None else None
-        with open(output, "w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle, delimiter=" ")
-            writer.writerow(columns)
-            flushed = time.monotonic()
-            try:
-                while stop is None or not stop.passed:
-                    wait = Deadline(min(timeout, stop.left) if stop else timeout)
-                    data = read_until(sock, wait, "RTDE data", host, port) if wait.left else b""
-                    events, pending[:] = pending + client.feed(data), []
-                    for event in events:
-                        if isinstance(event, rtde.DataPackage):
-                            row = []
-                            for name in setup.names:
-                                value = event.values[name]
-                                row.extend(value if isinstance(value, tuple) else (value,))
-                            writer.writerow(row)
-                            rows += 1
-                        elif isinstance(event, rtde.Message) and messages is not None:
-                            messages.append(event)
-                    if time.monotonic() - flushed > 0.5:
-                        handle.flush()
-                        flushed = time.monotonic()
-                        if progress is not None:
-                            progress(rows, duration or 0.0)
-            except KeyboardInterrupt:
-                pass  # the rows so far are written; the file closes cleanly
+    samples: int
+    span: float
+    elapsed: float
+    missed: int
+    message: str | None = None
+    stalled: float = 0.0
+
+
+@dataclass
+class RecordResult:
+    """How a recording ended. ``stopped_by`` is ``"duration"``, ``"samples"``, ``"stop"``
+    (Ctrl-C), ``"stall"`` or ``"connection lost"``; ``error`` holds the message for the last
+    two. ``span`` is the controller time between the first and last sample (s)."""
+
+    path: str
+    fields: list[str]
+    types: list[str]
+    frequency: float
+    protocol: int
+    controller_version: str | None
+    samples: int = 0
+    span: float = 0.0
+    elapsed: float = 0.0
+    missed: int = 0
+    stopped_by: str = "stop"
+    error: str | None = None
+    messages: list[str] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return self.error is None
+
+
+def _expected_period(session: RtdeSession, frequency: float) -> float:
+    rate = session.max_frequency
+    if session.protocol < 2:
+        return 1.0 / rate
+    return max(1, math.floor(rate / frequency + 1e-9)) / rate
+
+
+def record(host: str, path: str | Path, fields: str | Sequence[str] | None = None, *,
+           frequency: float = 125.0, duration: float | None = None,
+           samples: int | None = None, port: int = PORT, timeout: float = 5.0,
+           stall_timeout: float = 10.0, stop: threading.Event | None = None,
+           progress: Callable[[RecordProgress], None] | None = None,
+           delimiter: str = " ") -> RecordResult:
+    """Record RTDE ``fields`` from ``host`` into the CSV file ``path`` (see the module
+    docstring). ``frequency`` in Hz (CB3 ≤ 125, e-Series ≤ 500); ``duration`` in s of wall
+    time. Connection and setup failures raise (:mod:`urdsl.robot.errors`; the file is not
+    created then); once recording, failures end it and are reported in the result."""
+    names = parse_fields(fields)
+    stop = stop or threading.Event()
+    with RtdeSession(host, port, timeout=timeout) as session:
+        recipe = session.setup_outputs(names, frequency)
+        result = RecordResult(str(path), names, list(recipe.types), frequency,
+                              session.protocol, session.controller_version)
+        writer = CsvWriter(path, names, recipe.types, delimiter=delimiter)
         try:
-            sock.sendall(client.pause())
-        except OSError:
+            session.start()
+            _loop(session, writer, result, duration, samples, stall_timeout, stop, progress,
+                  _expected_period(session, frequency))
+        finally:
+            writer.close()
+            result.samples = writer.rows
+    return result
+
+
+class _Sink:
+    """Writes samples and keeps the time bookkeeping (span, controller-skipped samples)."""
+
+    def __init__(self, writer: CsvWriter, result: RecordResult, limit: int | None,
+                 period: float) -> None:
+        self.writer = writer
+        self.result = result
+        self.limit = limit
+        self.period = period
+        self.first: float | None = None
+        self.last: float | None = None
+        self.last_data = time.monotonic()
+        self.message: str | None = None
+
+    @property
+    def full(self) -> bool:
+        return self.limit is not None and self.writer.rows >= self.limit
+
+    def take(self, events: list) -> None:
+        result = self.result
+        for event in events:
+            if isinstance(event, r.DataPackage):
+                if self.full:
+                    continue
+                values = event.values
+                self.writer.write([values[n] for n in result.fields])
+                stamp = float(values["timestamp"])  # type: ignore[arg-type]
+                if self.last is not None and self.period > 0:
+                    gap = round((stamp - self.last) / self.period) - 1
+                    if gap > 0:
+                        result.missed += gap
+                if self.first is None:
+                    self.first = stamp
+                self.last = stamp
+                result.span = stamp - self.first
+                self.last_data = time.monotonic()
+            elif isinstance(event, r.RtdeTextMessage):
+                level = {0: "exception", 1: "error", 2: "warning"}.get(event.level, "info")
+                source = f"{event.source}: " if event.source else ""
+                self.message = f"{level}: {source}{event.message}"
+                result.messages.append(self.message)
+
+
+def _loop(session: RtdeSession, writer: CsvWriter, result: RecordResult,
+          duration: float | None, limit: int | None, stall_timeout: float,
+          stop: threading.Event, progress: Callable[[RecordProgress], None] | None,
+          period: float) -> None:
+    sink = _Sink(writer, result, limit, period)
+    begin = time.monotonic()
+    last_progress = 0.0
+    while True:
+        now = time.monotonic()
+        if stop.is_set():
+            result.stopped_by = "stop"
+            break
+        if duration is not None and now - begin >= duration:
+            result.stopped_by = "duration"
+            break
+        if sink.full:
+            result.stopped_by = "samples"
+            break
+        if now - sink.last_data >= stall_timeout:
+            result.stopped_by = "stall"
+            result.error = (f"{session.where} sent no data for {stall_timeout:g} s; "
+                            f"recording stopped")
+            break
+        wait = RECEIVE_SLICE
+        if duration is not None:
+            wait = min(wait, max(begin + duration - now, 0.0))
+        try:
+            sink.take(session.receive(max(wait, 0.001)))
+        except ConnectionLost as error:
+            result.stopped_by = "connection lost"
+            result.error = f"{error.message}; recording stopped"
+            break
+        now = time.monotonic()
+        result.elapsed = now - begin
+        if progress is not None and now - last_progress >= PROGRESS_PERIOD:
+            last_progress = now
+            progress(RecordProgress(writer.rows, result.span, result.elapsed, result.missed,
+                                    sink.message, now - sink.last_data))
+    result.elapsed = time.monotonic() - begin
+    if result.error is None:
+        try:  # pause, and keep what arrived before the pause took effect
+            session.pause(timeout=1.0)
+            sink.take(session.drain())
+        except RobotError:
             pass
-    finally:
-        sock.close()
-    return rows
-
-
-def plot_csv(csv_path: str | Path, png_path: str | Path, columns: list[str] | None = None
-             ) -> list[str]:
-    """Plot ``columns`` (names or prefixes such as ``actual_q``; default: every joint
-    position and speed column) against ``timestamp``; returns the columns drawn."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-
-    with open(csv_path, newline="", encoding="utf-8") as handle:
-        first = handle.readline()
-        handle.seek(0)
-        reader = csv.reader(handle, delimiter="," if "," in first else " ")
-        try:
-            header = next(reader)
-        except StopIteration:
-            raise ValueError(f"{csv_path} is empty") from None
-        rows = [row for row in reader if row]
-    if "timestamp" not in header:
-        raise ValueError(f"{csv_path} has no timestamp column")
-    if not rows:
-        raise ValueError(f"{csv_path} has a header but no rows")
-    data = np.array(rows, dtype=float)
-    time_column = data[:, header.index("timestamp")]
-    wanted = columns or ["actual_q", "actual_qd"]
-    groups = []
-    for name in wanted:
-        chosen = [c for c in header if c == name or c.startswith(name + "_")]
-        if not chosen:
-            raise ValueError(f"{csv_path} has no column {name!r}; it has: "
-                             f"{', '.join(header)}")
-        groups.append((name, chosen))
-    figure, axes = plt.subplots(len(groups), 1, sharex=True, squeeze=False,
-                                figsize=(10, 3 * len(groups)), constrained_layout=True)
-    drawn = []
-    for axis, (name, chosen) in zip(axes[:, 0], groups, strict=True):
-        for column in chosen:
-            axis.plot(time_column - time_column[0], data[:, header.index(column)], label=column)
-            drawn.append(column)
-        axis.set_ylabel(name)
-        axis.legend(loc="upper right", fontsize="small", ncol=3)
-    axes[-1, 0].set_xlabel("time since the first sample [s]")
-    figure.suptitle(f"{Path(csv_path).name}: {len(rows)} samples")
-    figure.savefig(png_path)
-    plt.close(figure)
-    return drawn
+    if progress is not None:
+        progress(RecordProgress(writer.rows, result.span, result.elapsed, result.missed,
+                                sink.message, 0.0))

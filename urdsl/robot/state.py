@@ -1,159 +1,280 @@
-"""Reading the robot's state, always the newest sample.
+"""Reading the robot's state with latest-sample semantics.
 
-Each interface pushes a stream (realtime 125/500 Hz, primary 10 Hz, RTDE at the requested
-rate); a client that reads slowly finds old packets queued in its socket. These readers drain
-what is queued and decode only the newest complete packet, so the state is never stale.
+The controller pushes its state: the realtime interface every control cycle (125 Hz CB3,
+500 Hz e-Series), the primary/secondary interfaces at 10 Hz, RTDE at the frequency asked
+for. A client that reads more slowly than that finds old packets queued in its socket — the
+course's `recv(1108)` loop shows the arm where it was seconds ago. :class:`StateReader`
+never does that: each :meth:`StateReader.read` first drains everything the kernel holds and
+keeps only the newest complete sample (``skipped`` counts the others); only when nothing
+is buffered does it wait, bounded, for the next one.
+
+The result is a :class:`RobotState` with the same fields whatever the interface: joints,
+joint speeds, TCP pose, robot and safety mode (as numbers and names), program state.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+import time
+from dataclasses import dataclass, field
+from typing import Any
 
-from ..protocol import primary, realtime, rtde
-from .connection import Deadline, RobotConnectionError, connect, read_until
+from ..protocol.errors import ProtocolError
+from ..protocol.realtime import RealtimeDecoder, RealtimeState
+from .connection import DEFAULT_PORTS, Connection
+from .errors import ConnectionLost, ControllerProtocolError, RobotTimeout
 
-__all__ = ["RobotStateSample", "read_state", "DEFAULT_PORTS", "ROBOT_MODES", "SAFETY_MODES"]
+__all__ = [
+    "RobotState", "StateReader", "read_state", "INTERFACES", "ROBOT_MODES", "SAFETY_MODES",
+    "PROGRAM_STATES", "default_port",
+]
 
-DEFAULT_PORTS = {"realtime": 30003, "primary": 30002, "rtde": 30004}
+INTERFACES = ("realtime", "primary", "rtde")
 
-ROBOT_MODES = {-1: "NO_CONTROLLER", 0: "DISCONNECTED", 1: "CONFIRM_SAFETY", 2: "BOOTING",
-               3: "POWER_OFF", 4: "POWER_ON", 5: "IDLE", 6: "BACKDRIVE", 7: "RUNNING",
-               8: "UPDATING_FIRMWARE"}
-SAFETY_MODES = {1: "NORMAL", 2: "REDUCED", 3: "PROTECTIVE_STOP", 4: "RECOVERY",
-                5: "SAFEGUARD_STOP", 6: "SYSTEM_EMERGENCY_STOP", 7: "ROBOT_EMERGENCY_STOP",
-                8: "VIOLATION", 9: "FAULT", 10: "VALIDATE_JOINT_ID", 11: "UNDEFINED_SAFETY_MODE",
-                12: "AUTOMATIC_MODE_SAFEGUARD_STOP", 13: "SYSTEM_THREE_POSITION_ENABLING_STOP"}
+ROBOT_MODES = {
+    -1: "NO_CONTROLLER", 0: "DISCONNECTED", 1: "CONFIRM_SAFETY", 2: "BOOTING", 3: "POWER_OFF",
+    4: "POWER_ON", 5: "IDLE", 6: "BACKDRIVE", 7: "RUNNING", 8: "UPDATING_FIRMWARE",
+}
+"""Robot modes of CB3 and e-Series (UR_FACTS.md §4.4)."""
+
+SAFETY_MODES = {
+    1: "NORMAL", 2: "REDUCED", 3: "PROTECTIVE_STOP", 4: "RECOVERY", 5: "SAFEGUARD_STOP",
+    6: "SYSTEM_EMERGENCY_STOP", 7: "ROBOT_EMERGENCY_STOP", 8: "VIOLATION", 9: "FAULT",
+    10: "VALIDATE_JOINT_ID", 11: "UNDEFINED_SAFETY_MODE", 12: "AUTOMATIC_MODE_SAFEGUARD_STOP",
+    13: "SYSTEM_THREE_POSITION_ENABLING_STOP",
+}
+"""Safety modes (UR_FACTS.md §4.4)."""
+
+PROGRAM_STATES = {0: "STOPPING", 1: "STOPPED", 2: "PLAYING", 3: "PAUSING", 4: "PAUSED",
+                  5: "RESUMING"}
+"""RTDE ``runtime_state`` / realtime ``program_state`` values."""
+
+_DEFAULT_PORTS = {"realtime": DEFAULT_PORTS["realtime"], "primary": DEFAULT_PORTS["secondary"],
+                  "rtde": DEFAULT_PORTS["rtde"]}
+
+MAX_DRAINS = 64
+"""Drains per read at most (each up to :data:`urdsl.robot.connection.MAX_DRAIN` bytes): a
+peer that sends faster than we decode cannot keep a read going forever."""
+
+
+def default_port(interface: str) -> int:
+    """The port a state reader uses for ``interface``: realtime 30003, primary 30002 (the
+    secondary interface: the same robot state, and no robot messages to skip), RTDE 30004."""
+    return _DEFAULT_PORTS[interface]
+
+
+def _name(table: dict[int, str], value: int | None) -> str | None:
+    if value is None:
+        return None
+    return table.get(value, f"UNKNOWN({value})")
 
 
 @dataclass(frozen=True)
-class RobotStateSample:
-    """Joints (rad), TCP pose (m, rotation vector rad), modes, and the interface it came
-    from. ``time`` is the controller's clock (s) where the interface sends it."""
+class RobotState:
+    """The robot's state as one interface reported it, in SI units.
+
+    ``joints`` (rad) and ``joint_speeds`` (rad/s) run base … wrist 3; ``tcp_pose`` is
+    (x, y, z [m], rx, ry, rz [rad]) in the Base frame; ``time`` is the controller's clock
+    (s since it started); ``skipped`` counts older samples dropped to hand out this one.
+    Fields an interface (or controller version) does not send are ``None``.
+    """
 
     interface: str
-    joints: tuple[float, ...]
-    tcp_pose: tuple[float, ...]
-    robot_mode: int
-    safety_mode: int
+    host: str
+    port: int
     time: float | None = None
+    joints: tuple[float, ...] | None = None
+    joint_speeds: tuple[float, ...] | None = None
+    tcp_pose: tuple[float, ...] | None = None
+    robot_mode: int | None = None
+    safety_mode: int | None = None
+    program_state: int | None = None
+    program_running: bool | None = None
+    speed_scaling: float | None = None
+    version: str | None = None
+    skipped: int = 0
+    received_at: float = 0.0
+    raw: Any = field(default=None, repr=False, compare=False)
 
     @property
-    def robot_mode_name(self) -> str:
-        return ROBOT_MODES.get(self.robot_mode, str(self.robot_mode))
+    def robot_mode_name(self) -> str | None:
+        return _name(ROBOT_MODES, self.robot_mode)
 
     @property
-    def safety_mode_name(self) -> str:
-        return SAFETY_MODES.get(self.safety_mode, str(self.safety_mode))
+    def safety_mode_name(self) -> str | None:
+        return _name(SAFETY_MODES, self.safety_mode)
 
-    def to_dict(self) -> dict:
-        result = asdict(self)
-        result["robot_mode_name"] = self.robot_mode_name
-        result["safety_mode_name"] = self.safety_mode_name
-        return result
+    @property
+    def program_state_name(self) -> str | None:
+        return _name(PROGRAM_STATES, self.program_state)
 
-
-def read_state(host: str, interface: str = "realtime", port: int | None = None,
-               timeout: float = 5.0, drain: float = 0.05) -> RobotStateSample:
-    """The newest state from ``interface`` ("realtime", "primary" or "rtde"), after reading
-    what arrives for ``drain`` s past the first packet (so that a backlog is skipped)."""
-    if interface not in DEFAULT_PORTS:
-        raise ValueError(f"unknown interface {interface!r}: realtime, primary or rtde")
-    port = port or DEFAULT_PORTS[interface]
-    sock = connect(host, port, timeout)
-    try:
-        if interface == "realtime":
-            return _realtime(sock, host, port, timeout, drain)
-        if interface == "primary":
-            return _primary(sock, host, port, timeout, drain)
-        return _rtde(sock, host, port, timeout)
-    finally:
-        sock.close()
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: every field but ``raw``, plus the mode names."""
+        return {
+            "interface": self.interface, "host": self.host, "port": self.port,
+            "time": self.time, "joints": _list(self.joints),
+            "joint_speeds": _list(self.joint_speeds), "tcp_pose": _list(self.tcp_pose),
+            "robot_mode": self.robot_mode, "robot_mode_name": self.robot_mode_name,
+            "safety_mode": self.safety_mode, "safety_mode_name": self.safety_mode_name,
+            "program_state": self.program_state, "program_state_name": self.program_state_name,
+            "program_running": self.program_running, "speed_scaling": self.speed_scaling,
+            "version": self.version, "skipped": self.skipped,
+        }
 
 
-def _realtime(sock, host, port, timeout, drain) -> RobotStateSample:
-    decoder = realtime.RealtimeDecoder()
-    deadline = Deadline(timeout)
-    newest = None
-    while newest is None:
-        newest = decoder.latest(read_until(sock, deadline, "a realtime packet", host, port))
-    settle = Deadline(drain)
-    while not settle.passed:
-        sock.settimeout(max(settle.left, 0.001))
+def _list(values: tuple | None) -> list | None:
+    return None if values is None else list(values)
+
+
+def _from_realtime(sample: RealtimeState, host: str, port: int, skipped: int) -> RobotState:
+    program_state = sample.program_state
+    return RobotState(
+        "realtime", host, port, time=sample.time, joints=sample.q_actual,
+        joint_speeds=sample.qd_actual, tcp_pose=sample.tcp_pose, robot_mode=sample.robot_mode,
+        safety_mode=sample.safety_mode, program_state=program_state,
+        program_running=None if program_state is None else program_state in (2, 3, 5),
+        speed_scaling=sample.speed_scaling, version=sample.version, skipped=skipped,
+        received_at=time.monotonic(), raw=sample)
+
+
+class _RealtimeSource:
+    """Realtime packets (30003/30013) → :class:`RobotState`."""
+
+    def __init__(self, connection: Connection) -> None:
+        self.connection = connection
+        self.decoder = RealtimeDecoder()
+
+    def start(self, timeout: float) -> None:
+        pass
+
+    def latest(self, data: bytes) -> tuple[Any, int] | None:
+        before = self.decoder.skipped
+        sample = self.decoder.latest(data)
+        if sample is None:
+            return None
+        return sample, self.decoder.skipped - before
+
+    def state(self, sample: Any, skipped: int) -> RobotState:
+        return _from_realtime(sample, self.connection.host, self.connection.port, skipped)
+
+    def stop(self) -> None:
+        pass
+
+
+class StateReader:
+    """A connection that hands out the newest state (see the module docstring).
+
+    ``interface`` is ``"realtime"``, ``"primary"`` or ``"rtde"``; ``port`` defaults per
+    interface (:func:`default_port`). ``timeout`` (s) bounds the connect and each wait for
+    a sample. A context manager.
+    """
+
+    def __init__(self, host: str, interface: str = "realtime", port: int | None = None, *,
+                 timeout: float = 5.0, attempts: int = 1) -> None:
+        if interface not in INTERFACES:
+            raise ValueError(f"unknown interface {interface!r}; use one of "
+                             f"{', '.join(INTERFACES)}")
+        self.host = host
+        self.interface = interface
+        self.port = default_port(interface) if port is None else port
+        self.timeout = timeout
+        self.attempts = attempts
+        self._source: Any = None
+        self._lost: ConnectionLost | None = None
+        self.connection: Connection | None = None
+        self._connect()
+
+    def _connect(self) -> None:
+        self._lost = None
+        self.connection = Connection.open(self.host, self.port, interface=self.interface,
+                                          timeout=self.timeout, attempts=self.attempts)
         try:
-            data = sock.recv(1 << 16)
-        except TimeoutError:
-            break
-        if not data:
-            break
-        newest = decoder.latest(data) or newest
-    fields = newest.fields
-    return RobotStateSample("realtime", fields["q_actual"], fields["tool_vector_actual"],
-                            int(fields.get("robot_mode", -1)),
-                            int(fields.get("safety_mode", 0)), fields["time"])
+            self._source = self._make_source(self.connection)
+            self._source.start(self.timeout)
+        except BaseException:
+            self.connection.close()
+            raise
 
+    def _make_source(self, connection: Connection) -> Any:
+        if self.interface == "realtime":
+            return _RealtimeSource(connection)
+        if self.interface == "primary":
+            from .primary_state import PrimarySource
 
-def _primary(sock, host, port, timeout, drain) -> RobotStateSample:
-    decoder = primary.PrimaryDecoder()
-    deadline = Deadline(timeout)
-    newest = None
-    settle: Deadline | None = None
-    while settle is None or not settle.passed:
-        if settle is not None:
-            sock.settimeout(max(settle.left, 0.001))
+            return PrimarySource(connection)
+        from .rtde_state import RtdeStateSource
+
+        return RtdeStateSource(connection)
+
+    def reconnect(self, attempts: int = 5) -> None:
+        """Open the connection again (after :class:`ConnectionLost`), retrying with backoff."""
+        self.close()
+        self.attempts = max(self.attempts, attempts)
+        self._connect()
+
+    def read(self, timeout: float | None = None) -> RobotState:
+        """The newest complete sample: drains the socket, decodes only the last packet, and
+        waits (at most ``timeout`` s) only if nothing was buffered."""
+        assert self.connection is not None and self._source is not None
+        timeout = self.timeout if timeout is None else timeout
+        connection = self.connection
+        try:
+            found = None
+            skipped = 0
+            if self._lost is not None:
+                raise self._lost
+            for _ in range(MAX_DRAINS):
+                try:
+                    data = connection.drain()
+                except ConnectionLost as error:
+                    if found is None:
+                        raise
+                    self._lost = error  # hand out the last sample; the next read raises
+                    break
+                if not data:
+                    break
+                got = self._source.latest(data)
+                if got is not None:
+                    skipped += got[1] + (found is not None)
+                    found = got
+            deadline = time.monotonic() + timeout
+            while found is None:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    raise RobotTimeout(f"{connection.where} sent no complete {self.interface} "
+                                       f"sample within {timeout:g} s", host=self.host,
+                                       port=self.port, interface=self.interface)
+                try:
+                    data = connection.recv(left)
+                except RobotTimeout:
+                    continue
+                found = self._source.latest(data)
+                if found is not None:
+                    skipped += found[1]
+        except ProtocolError as error:
+            raise ControllerProtocolError(f"{connection.where} sent bytes that are not the "
+                                          f"{self.interface} protocol: {error}",
+                                          host=self.host, port=self.port,
+                                          interface=self.interface) from None
+        return self._source.state(found[0], skipped)
+
+    def close(self) -> None:
+        if self.connection is not None:
             try:
-                data = sock.recv(1 << 16)
-            except TimeoutError:
-                break
-            if not data:
-                break
-        else:
-            data = read_until(sock, deadline, "the robot state", host, port)
-        for message in decoder.feed(data):
-            if isinstance(message, primary.RobotState) and message.get(primary.JointData):
-                newest = message
-        if newest is not None and settle is None:
-            settle = Deadline(drain)
-    joints = newest.get(primary.JointData)
-    cartesian = newest.get(primary.CartesianInfo)
-    mode = newest.get(primary.RobotModeData)
-    board = newest.get(primary.MasterboardData)
-    return RobotStateSample("primary", joints.q_actual,
-                            cartesian.tcp_pose if cartesian else (float("nan"),) * 6,
-                            mode.robot_mode if mode else -1,
-                            board.safety_mode if board else 0,
-                            mode.timestamp / 1000.0 if mode else None)
+                if self._source is not None and not self.connection.closed:
+                    self._source.stop()
+            except (ConnectionLost, RobotTimeout, ProtocolError, OSError):
+                pass
+            self.connection.close()
+
+    def __enter__(self) -> StateReader:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
-_RTDE_FIELDS = ["timestamp", "actual_q", "actual_TCP_pose", "robot_mode", "safety_mode"]
-
-
-def _rtde(sock, host, port, timeout) -> RobotStateSample:
-    client = rtde.RtdeClient()
-    deadline = Deadline(timeout)
-
-    pending: list = []
-
-    def expect(kind):
-        while True:
-            if not pending:
-                pending.extend(client.feed(read_until(sock, deadline, "an RTDE reply", host,
-                                                      port)))
-            event = pending.pop(0)
-            if isinstance(event, kind):
-                return event
-
-    sock.sendall(client.request_protocol_version(2))
-    if not expect(rtde.ProtocolVersion).accepted:
-        sock.sendall(client.request_protocol_version(1))
-        expect(rtde.ProtocolVersion)
-    sock.sendall(client.setup_outputs(_RTDE_FIELDS, 125.0))
-    setup = expect(rtde.OutputSetup)
-    if not setup.valid:
-        raise RobotConnectionError(f"{host}:{port}: the controller lacks "
-                                   f"{', '.join(setup.not_found)}")
-    sock.sendall(client.start())
-    expect(rtde.Started)
-    values = expect(rtde.DataPackage).values
-    sock.sendall(client.pause())
-    return RobotStateSample("rtde", values["actual_q"], values["actual_TCP_pose"],
-                            values["robot_mode"], values["safety_mode"], values["timestamp"])
+def read_state(host: str, interface: str = "realtime", port: int | None = None, *,
+               timeout: float = 5.0) -> RobotState:
+    """One fresh sample from ``host`` (connect, read, close)."""
+    with StateReader(host, interface, port, timeout=timeout) as reader:
+        return reader.read()
