@@ -93,19 +93,17 @@ def standard_sim(tmp_path_factory):
 
 
 def _send_script(text: str) -> None:
-    """Send a program with urdsl's sender (the robot layer); a plain socket until it lands."""
-    try:
-        from urdsl.robot.sender import send_program
-    except ImportError:
-        with socket.create_connection(("127.0.0.1", 30002), timeout=5) as sock:
-            sock.sendall(text.encode())
-            sock.settimeout(2)
-            try:
-                sock.recv(79)  # the UR manual: read before closing so the script is kept
-            except OSError:
-                pass
-        return
-    send_program("127.0.0.1", text)
+    """Send a program with urdsl's sender (``urdsl send`` uses the same function)."""
+    from urdsl.robot.sender import send_program
+
+    send_program(text, "127.0.0.1")
+
+
+def _eventually(condition, timeout: float = 2.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "the condition did not become true in time"
+        time.sleep(0.01)
 
 
 def _rest(timeout: float = 20.0) -> None:
@@ -221,12 +219,13 @@ def test_ur_rtde_control_uploads_its_script_and_moves_j_and_l(standard_sim):
     try:
         assert control.isConnected() and control.isProgramRunning()
         assert control.moveJ(TARGET, 1.4, 1.05)
-        assert np.allclose(receiver.getActualQ(), TARGET, atol=1e-6)
+        # moveJ returns when the script reports the move done; the receiver's newest sample
+        # may be a few controller steps older
+        _eventually(lambda: np.allclose(receiver.getActualQ(), TARGET, atol=1e-6))
         goal = np.array(receiver.getActualTCPPose())
         goal[:3] += (0.03, 0.0, -0.05)
         assert control.moveL(goal.tolist(), 0.5, 0.25)
-        reached = np.array(receiver.getActualTCPPose())
-        assert np.allclose(reached[:3], goal[:3], atol=1e-6)
+        _eventually(lambda: np.allclose(receiver.getActualTCPPose()[:3], goal[:3], atol=1e-6))
     finally:
         control.stopScript()
         control.disconnect()

@@ -354,6 +354,33 @@ def test_five_clients_garbage_a_dropped_rtde_stream_and_a_stalled_reader(sim):
     dash.close()
 
 
+def test_serve_as_the_only_context_manager_runs_and_stops_the_controller():
+    with VirtualController(speed=4.0).serve(ports={k: 0 for k in STANDARD_PORTS}) as sim:
+        sock = socket.create_connection(("127.0.0.1", sim.ports["secondary"]), TIMEOUT)
+        sock.sendall(f"def p():\n  movej({TARGET}, a=3, v=2)\nend\n".encode())
+        sim.wait_snapshot(lambda s: np.allclose(s.q, TARGET, atol=1e-9), 10)
+        sock.close()
+        threads = list(sim.controller._threads)
+    assert threads and not any(thread.is_alive() for thread in threads)
+
+
+def test_a_100000_line_program_sent_on_a_socket_runs_while_others_are_served(sim):
+    body = "".join(f"  x{i % 50} = {i} + 1\n" for i in range(100_000))
+    reader = connect(sim, "realtime")
+    sender = connect(sim, "primary")
+    sender.sendall(("def big():\n" + body + "  write_output_integer_register(0, x49)\nend\n")
+                   .encode())
+    stamps = []
+    deadline = time.monotonic() + 60
+    while sim.snapshot().output_int_registers[0] != 100_000:
+        assert time.monotonic() < deadline, "the big program did not finish"
+        stamps.append(struct.unpack_from(">d", realtime_packet(reader), 4)[0])
+    assert len(stamps) > 100 and np.all(np.diff(stamps) > 0)  # realtime kept streaming
+    assert not [m for m in sim.messages if m.kind == "runtime_exception"]
+    sender.close()
+    reader.close()
+
+
 def test_a_program_that_never_ends_its_def_is_kept_until_the_connection_sends_end(sim):
     sock = connect(sim, "secondary")
     sock.sendall(b"def p():\n  write_output_integer_register(1, 5)\n")
@@ -377,3 +404,36 @@ def test_servers_close_every_connection_on_shutdown(tmp_path):
                 if not sock.recv(65536):
                     raise ConnectionError("closed")
         sock.close()
+
+
+# ---- the project's own decoders read what the simulator sends -----------------------------------
+
+
+def test_urdsl_protocol_decoders_read_the_simulators_realtime_and_primary_streams(sim):
+    realtime = pytest.importorskip("urdsl.protocol.realtime")
+    primary = pytest.importorskip("urdsl.protocol.primary")
+    sock = connect(sim, "realtime")
+    state = realtime.decode(realtime_packet(sock))
+    sock.close()
+    assert state.size == 1220 and state.robot_mode == 7 and state.safety_mode == 1
+    assert np.allclose(state.q_actual, sim.snapshot().q)
+    assert np.allclose(state.tcp_pose, sim.snapshot().tcp)
+
+    sock = connect(sim, "primary")
+    decoder = primary.PrimaryDecoder()
+    sock.sendall(b"def oops():\n  x = 1 +* 2\nend\n")
+    decoded = []
+    deadline = time.monotonic() + TIMEOUT
+    while time.monotonic() < deadline and not any(
+            isinstance(m, primary.RuntimeExceptionMessage) for m in decoded):
+        decoded += decoder.feed(sock.recv(65536))
+    sock.close()
+    version = decoded[0]
+    assert isinstance(version, primary.VersionMessage)
+    assert (version.project, version.major, version.minor) == ("URControl", 5, 15)
+    robot_state = next(m for m in decoded if isinstance(m, primary.RobotState))
+    assert robot_state.get(primary.RobotModeData).robot_mode == 7
+    assert np.allclose(robot_state.get(primary.JointData).q_actual, sim.snapshot().q)
+    assert np.allclose(robot_state.get(primary.CartesianInfo).tcp_pose, sim.snapshot().tcp)
+    error = next(m for m in decoded if isinstance(m, primary.RuntimeExceptionMessage))
+    assert (error.line, error.column) == (2, 10) and "2:10" in error.text

@@ -13,10 +13,11 @@ realtime_ro 30013    as realtime, read-only
 rtde        30004    RTDE (:mod:`urdsl.sim.rtde`)
 ==========  =======  ===============================================================
 
-Every client has a bounded send buffer. The controller's clock thread queues data into it;
-the network thread writes it out without blocking. A client that stops reading until its
-buffer is full is dropped, so one stalled reader never delays the others. A client that
-breaks a protocol's framing is dropped too; its neighbours do not notice.
+Every client has a bounded send buffer. The controller's clock thread writes a packet
+straight to a client's non-blocking socket when nothing is queued for it, and queues the
+rest; the network thread writes queued data out as the socket drains. A client that stops
+reading until its buffer is full is dropped, so one stalled reader never delays the others.
+A client that breaks a protocol's framing is dropped too; its neighbours do not notice.
 """
 
 from __future__ import annotations
@@ -76,12 +77,31 @@ class _Client:
         self.framer = None
         self.last_state = 0.0
         self.writing = False
+        self.registered = False  # direct writes only once the connection's first
+        # messages are out and the network thread knows it
 
     def send(self, data: bytes) -> None:
         """Queue ``data``; drop the client when its buffer would exceed the limit."""
         if self.closed:
             return
         with self.lock:
+            if self.closed:  # checked under the lock: _drop closes the socket under it
+                return
+            if not self.out and self.registered:
+                # nothing queued: write at once from this thread (the socket does not
+                # block), sparing the hand-over to the network thread for every packet
+                try:
+                    sent = self.sock.send(data)
+                except (BlockingIOError, InterruptedError):
+                    sent = 0
+                except OSError:
+                    self.closed = True
+                    sent = len(data)
+                if sent == len(data):
+                    if self.closed:
+                        self.servers._poke(self)
+                    return
+                data = data[sent:]
             if len(self.out) + len(data) > self.servers.send_limit:
                 self.dropped_for = "stalled: its send buffer is full"
                 self.closed = True
@@ -125,7 +145,7 @@ class SimServers:
         self._closing = threading.Event()
         self._thread: threading.Thread | None = None
         self._last_state_time = 0.0
-        self._state_cache: tuple[float, bytes] | None = None
+        self.owns_controller = False
 
     # ---- life cycle ----------------------------------------------------------------------
 
@@ -164,7 +184,16 @@ class SimServers:
         self._poke(None)
         if self._thread is not None:
             self._thread.join(timeout)
+            self._thread = None
         self._close_sockets()
+        if self.owns_controller:
+            self.sim.close(timeout)
+
+    def __getattr__(self, name: str):
+        # the controller's API through the servers object (``sim.submit``, ``sim.snapshot``)
+        if name.startswith("_") or name == "sim":
+            raise AttributeError(name)
+        return getattr(self.sim, name)
 
     def __enter__(self) -> SimServers:
         return self
@@ -181,6 +210,8 @@ class SimServers:
         return len(self._clients)
 
     def _close_sockets(self) -> None:
+        if self._wake_r.fileno() < 0:
+            return
         for client in list(self._clients):
             self._drop(client, "")
         for listener in self._listeners:
@@ -302,8 +333,6 @@ class SimServers:
 
     def _open(self, client: _Client) -> None:
         kind = client.kind
-        self._clients.add(client)
-        self._selector.register(client.sock, selectors.EVENT_READ, client)
         sim = self.sim
         if kind == "dashboard":
             client.session = DashboardSession(sim)
@@ -319,6 +348,12 @@ class SimServers:
                 client.send(wire.encode_robot_state(
                     snap, sim.version, sim.spec, (sim.kinematics.qd_max, sim.q_min, sim.q_max)
                     if hasattr(sim.kinematics, "qd_max") else None, configuration=True))
+        # only now may the clock and the message publisher add to its stream: the version
+        # message must come first
+        self._clients.add(client)
+        self._selector.register(client.sock, selectors.EVENT_READ, client)
+        self._flush(client)
+        client.registered = True
 
     def _read(self, client: _Client) -> None:
         try:
@@ -398,10 +433,11 @@ class SimServers:
             self._selector.unregister(client.sock)
         except (KeyError, ValueError, OSError):
             pass
-        try:
-            client.sock.close()
-        except OSError:
-            pass
+        with client.lock:  # no direct write from the clock thread is under way
+            try:
+                client.sock.close()
+            except OSError:
+                pass
 
 
 def _encode_message(message: ControllerMessage) -> bytes:

@@ -12,13 +12,11 @@ RTDE while the program runs on it, stops the controller, and writes:
 * ``robot_data.png`` — recorded joints over the planned ones.
 
 Everything runs on 127.0.0.1 with ports chosen by the system, so it never collides with a
-running ``urdsl sim``.
+running ``urdsl sim``. Sending and recording use urdsl's own clients (:mod:`urdsl.robot`).
 """
 
 from __future__ import annotations
 
-import socket
-import struct
 import threading
 import time
 from dataclasses import dataclass, field
@@ -31,7 +29,6 @@ __all__ = ["demo_story", "StoryResult", "PROGRAMS"]
 PROGRAMS = Path(__file__).resolve().parents[2] / "programs"
 
 FIELDS = ("timestamp", "actual_q", "actual_TCP_pose", "runtime_state")
-_LAYOUT = struct.Struct(">Bd6d6dI")
 PLAYING, STOPPED = 2, 1
 
 
@@ -76,86 +73,18 @@ def _source(programs: Path) -> tuple[str, str]:
     return "course_examples", format_tree(parse(text, str(script)))
 
 
-class _Recorder:
-    """A minimal RTDE v2 recording client (timestamp, actual_q, actual_TCP_pose,
-    runtime_state) in a thread; every read has a timeout."""
-
-    def __init__(self, port: int, frequency: float) -> None:
-        self.sock = socket.create_connection(("127.0.0.1", port), timeout=5)
-        self.rows: list[tuple] = []
-        self._stop = threading.Event()
-        self._ask(b"V", struct.pack(">H", 2))
-        reply = self._ask(b"O", struct.pack(">d", frequency) + ",".join(FIELDS).encode())
-        if b"NOT_FOUND" in reply:
-            raise RuntimeError(f"RTDE recipe refused: {reply[1:].decode()}")
-        self.recipe = reply[0]
-        self._ask(b"S")
-        self.thread = threading.Thread(target=self._run, name="urdsl-story-rtde", daemon=True)
-        self.thread.start()
-
-    def _recv(self, count: int) -> bytes:
-        data = b""
-        while len(data) < count:
-            chunk = self.sock.recv(count - len(data))
-            if not chunk:
-                raise ConnectionError("RTDE closed")
-            data += chunk
-        return data
-
-    def _package(self) -> tuple[int, bytes]:
-        size, kind = struct.unpack(">HB", self._recv(3))
-        return kind, self._recv(size - 3)
-
-    def _ask(self, kind: bytes, payload: bytes = b"") -> bytes:
-        self.sock.sendall(struct.pack(">HB", len(payload) + 3, kind[0]) + payload)
-        for _ in range(10_000):
-            got, data = self._package()
-            if got == kind[0]:
-                return data
-        raise RuntimeError("no RTDE reply")
-
-    def _run(self) -> None:
-        try:
-            while not self._stop.is_set():
-                kind, data = self._package()
-                if kind == ord("U") and data and data[0] == self.recipe:
-                    self.rows.append(_LAYOUT.unpack(data)[1:])
-        except OSError:
-            return
-
-    def close(self) -> None:
-        self._stop.set()
-        try:
-            self.sock.shutdown(socket.SHUT_RDWR)
-        except OSError:
-            pass
-        self.sock.close()
-        self.thread.join(5)
-
-
-def _send(port: int, text: str) -> None:
-    try:
-        from ..robot.sender import send_program
-    except ImportError:
-        send_program = None
-    if send_program is not None:
-        try:
-            send_program(text, "127.0.0.1", port=port, check=False, follow=False)
-            return
-        except TypeError:  # a sender without a port argument: use the socket below
-            pass
-    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
-        sock.sendall(text.encode("utf-8"))
-
-
-def _write_csv(path: Path, rows: list[tuple]) -> None:
-    header = ["timestamp"] + [f"actual_q_{i}" for i in range(6)] + \
+def _read_csv(path: Path) -> np.ndarray:
+    """The recording as rows of timestamp, actual_q (6), actual_TCP_pose (6), runtime_state."""
+    columns = ["timestamp"] + [f"actual_q_{i}" for i in range(6)] + \
         [f"actual_TCP_pose_{i}" for i in range(6)] + ["runtime_state"]
-    with open(path, "w", encoding="ascii") as handle:
-        handle.write(" ".join(header) + "\n")
-        for row in rows:
-            handle.write(" ".join(repr(float(v)) if i < 13 else str(int(v))
-                                  for i, v in enumerate(row)) + "\n")
+    if not path.exists():
+        return np.zeros((0, len(columns)))
+    with open(path, encoding="utf-8") as handle:
+        header = handle.readline().split()
+        data = np.loadtxt(handle, ndmin=2)
+    if len(data) == 0:
+        return np.zeros((0, len(columns)))
+    return data[:, [header.index(c) for c in columns]]
 
 
 def _plot(path: Path, rows: np.ndarray, start: float, trace, title: str) -> None:
@@ -208,36 +137,42 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
         result.report.write_text("\n".join(lines) + "\n", encoding="utf-8")
         return result
 
+    from ..robot.recorder import record
+    from ..robot.sender import send_program
+
+    result.csv = out / "robot_data.csv"
+    duration = min(report.cycle_time / speed + 1.5, timeout)
     with VirtualController(robot=robot, speed=speed) as sim, \
             sim.serve(ports={k: 0 for k in STANDARD_PORTS}) as servers:
-        recorder = _Recorder(servers.ports["rtde"], frequency)
-        try:
-            _send(servers.ports["secondary"], text)
-            result.sent = True
-            deadline = time.monotonic() + timeout
-            started = finished = None
-            while time.monotonic() < deadline:
-                rows = recorder.rows
-                if rows:
-                    state, stamp = int(rows[-1][-1]), rows[-1][0]
-                    if started is None and state == PLAYING:
-                        started = next(r[0] for r in rows if int(r[-1]) == PLAYING)
-                    if started is not None and state == STOPPED:
-                        finished = stamp
-                        break
-                time.sleep(0.02)
-            time.sleep(0.2)  # a few samples of the arm at rest
-        finally:
-            recorder.close()
-        result.messages = [f"{m.kind}: {m.text}" for m in sim.messages]
+        recording: dict = {}
 
-    rows = np.array(recorder.rows, dtype=float).reshape(-1, 14)
+        def run_recorder() -> None:
+            try:
+                recording["rows"] = record("127.0.0.1", result.csv, list(FIELDS),
+                                           frequency=frequency, duration=duration,
+                                           port=servers.ports["rtde"])
+            except Exception as error:  # shown in the report, the story goes on
+                recording["error"] = error
+
+        recorder = threading.Thread(target=run_recorder, name="urdsl-story-rtde", daemon=True)
+        recorder.start()
+        time.sleep(0.3)  # the recorder is streaming before the program starts
+        send_program(text, "127.0.0.1", servers.ports["secondary"])
+        result.sent = True
+        recorder.join(duration + 10)
+        result.messages = [f"{m.kind}: {m.text}" for m in sim.messages]
+    if "error" in recording:
+        result.messages.append(f"recorder: {recording['error']}")
+
+    rows = _read_csv(result.csv)
     result.samples = len(rows)
-    result.csv = out / "robot_data.csv"
-    _write_csv(result.csv, recorder.rows)
+    playing = rows[rows[:, -1] == PLAYING, 0] if len(rows) else np.zeros(0)
+    started = float(playing[0]) if len(playing) else None
+    after = rows[(rows[:, 0] > playing[-1]) & (rows[:, -1] == STOPPED), 0] \
+        if len(playing) else np.zeros(0)
     begin = started if started is not None else (rows[0, 0] if len(rows) else 0.0)
-    if started is not None and finished is not None:
-        result.observed_time = finished - started
+    if started is not None and len(after):
+        result.observed_time = float(after[0]) - started
     trace = report.trace
     if trace is not None and len(trace.times) and len(rows):
         local = rows[:, 0] - begin
