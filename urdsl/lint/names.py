@@ -245,21 +245,28 @@ def unused_parameter(ctx: LintContext) -> Iterator[Diagnostic]:
 
 @rule(
     "URS114", "builtin-shadowed", "warning",
-    "A variable, parameter, function or thread takes the name of a builtin function.",
+    "A function or thread named like a builtin, or a variable named like a builtin that the "
+    "file also calls.",
     """
-The new definition hides the builtin in the whole program (a `def`) or makes later calls
-fail (a variable); readers and the linter expect the builtin.""",
+A `def` or `thread` with a builtin's name replaces the builtin for the whole program. A
+variable or parameter with a builtin's name (`time`, `length`, `force`) is reported only when
+the same file also calls that builtin: then a reader cannot tell the two apart, and the
+manual does not say that variables and functions live in separate namespaces.""",
     "sleep = 0.5\nsleep(sleep)",
     "wait_time = 0.5\nsleep(wait_time)",
 )
 def builtin_shadowed(ctx: LintContext) -> Iterator[Diagnostic]:
-    def shadows(name: str) -> bool:
+    called = {call.func.id for _scope, call in ctx.calls()}  # type: ignore[union-attr]
+
+    def shadows(name: str, variable: bool) -> bool:
         builtin = lookup(name)
-        return builtin is not None and builtin.callable
+        if builtin is None or not builtin.callable:
+            return False
+        return not variable or name in called
 
     for _scope, statement in ctx.scoped_statements():
         if isinstance(statement, (n.FunctionDef, n.ThreadDef, n.SecDef)):
-            if shadows(statement.name):
+            if shadows(statement.name, False):
                 kind = {n.FunctionDef: "function", n.ThreadDef: "thread",
                         n.SecDef: "sec program"}[type(statement)]
                 yield ctx.diagnostic(
@@ -267,19 +274,21 @@ def builtin_shadowed(ctx: LintContext) -> Iterator[Diagnostic]:
                     f"{statement.name}()", "choose another name")
             if isinstance(statement, n.FunctionDef):
                 for param in statement.params:
-                    if shadows(param.name):
+                    if shadows(param.name, True):
                         yield ctx.diagnostic(
-                            "URS114", param, f"parameter '{param.name}' hides the builtin "
-                            f"{param.name}()", "choose another name")
+                            "URS114", param, f"parameter '{param.name}' has the name of the "
+                            f"builtin {param.name}(), which this file also calls",
+                            "choose another name")
         elif isinstance(statement, n.Assign) and isinstance(statement.target, n.Name):
-            if shadows(statement.target.id):
+            if shadows(statement.target.id, True):
                 yield ctx.diagnostic(
-                    "URS114", statement.target, f"assignment to '{statement.target.id}' hides "
-                    f"the builtin {statement.target.id}()", "choose another name")
-        elif isinstance(statement, n.Declare) and shadows(statement.name):
+                    "URS114", statement.target, f"variable '{statement.target.id}' has the "
+                    f"name of the builtin {statement.target.id}(), which this file also calls",
+                    "choose another name")
+        elif isinstance(statement, n.Declare) and shadows(statement.name, True):
             yield ctx.diagnostic(
-                "URS114", statement, f"variable '{statement.name}' hides the builtin "
-                f"{statement.name}()", "choose another name")
+                "URS114", statement, f"variable '{statement.name}' has the name of the "
+                f"builtin {statement.name}(), which this file also calls", "choose another name")
 
 
 @rule(
