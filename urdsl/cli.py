@@ -210,6 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
 _COMMAND_MODULES: list[str] = [
     "urdsl.kinematics.cli",
     "urdsl.verify.command",
+    "urdsl.lint.command",
 ]
 """Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""
 

@@ -43,7 +43,7 @@ def lint_tree(tree: n.Module, settings: LintSettings | None = None) -> list[Diag
     source = tree.span.source or n.Source("", "<generated>")
     ctx = LintContext(source, tree, analyse(tree), settings.model, settings.version)
     found: list[Diagnostic] = []
-    for code, rule in RULES.items():
+    for code, rule in sorted(RULES.items()):
         if rule.check is None or code not in settings.codes:
             continue
         found.extend(rule.check(ctx))
