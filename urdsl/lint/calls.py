@@ -20,7 +20,7 @@ def _version_text(version: tuple[int, int]) -> str:
     return f"{version[0]}.{version[1]}"
 
 
-def _where(builtin: Builtin) -> str:
+def where_available(builtin: Builtin) -> str:
     """Where a builtin exists, for a message: "from 5.15 on e-Series"."""
     parts = []
     for series, first in builtin.first_versions().items():
@@ -54,7 +54,7 @@ def not_in_version(ctx: LintContext) -> Iterator[Diagnostic]:
         if builtin.available_in(ctx.version) is False:
             yield ctx.diagnostic(
                 "URS103", call.func, f"{builtin.name}() is not available in controller "
-                f"version {version} (it exists on {_where(builtin)})",
+                f"version {version} (it exists on {where_available(builtin)})",
                 "choose another version with --version, or avoid this builtin")
 
 
