@@ -28,7 +28,7 @@ def where_available(builtin: Builtin) -> str:
             parts.append(_SERIES[series])
         else:
             parts.append(f"{_SERIES[series]} from {_version_text(first)}")
-    return ", ".join(parts) if parts else "no known version"
+    return ", ".join(parts) if parts else "controller versions not known to urdsl"
 
 
 @rule(

@@ -73,6 +73,25 @@ class LintContext:
             return True
         return isinstance(self.analysis.program, n.SecDef) and _root(scope).kind == "top"
 
+    def string_prefix(self, node: n.Node) -> n.Span | None:
+        """For a Python-style prefixed string written at statement level (``x = f"a {b}"``
+        parses as ``x = f`` and the string ``"a {b}"``): the span of the prefix and string,
+        given the name or the string node. None otherwise."""
+        text = self.source.text
+        if isinstance(node, n.Name):
+            end = node.span.end
+            if node.id.lower() in _PREFIXES and end < len(text) and text[end] in "\"'":
+                close = text.find(text[end], end + 1)
+                return n.Span(self.source, node.span.start, close + 1 if close > 0 else end + 1)
+        elif isinstance(node, n.String):
+            start = node.span.start
+            begin = start
+            while begin > 0 and (text[begin - 1].isalnum() or text[begin - 1] == "_"):
+                begin -= 1
+            if begin < start and text[begin:start].lower() in _PREFIXES:
+                return n.Span(self.source, begin, node.span.end)
+        return None
+
     # -- calls -------------------------------------------------------------------------------
 
     def builtin(self, call: n.Call) -> Builtin | None:
@@ -156,6 +175,9 @@ class LintContext:
                 return None
             return math.radians(value) if expr.func.id == "d2r" else math.degrees(value)
         return None
+
+
+_PREFIXES = frozenset(("f", "r", "b", "u", "rf", "fr", "rb", "br"))
 
 
 def _root(scope: Scope) -> Scope:

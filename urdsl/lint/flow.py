@@ -38,6 +38,8 @@ def no_effect(ctx: LintContext) -> Iterator[Diagnostic]:
             expr = expr.expr
         if isinstance(expr, (n.Call, n.Run)):
             continue
+        if isinstance(expr, n.String) and ctx.string_prefix(expr) is not None:
+            continue  # x = f"..." : URS119 reports it
         if isinstance(expr, n.BinOp) and expr.op == "==":
             yield ctx.diagnostic("URS115", statement, "comparison has no effect",
                                  "to assign, write '=' instead of '=='")

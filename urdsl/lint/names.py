@@ -108,6 +108,8 @@ def undefined_name(ctx: LintContext) -> Iterator[Diagnostic]:
         for name in scope.reads:
             if analysis.defined(name.id, scope) or _habit(name.id, ctx, scope):
                 continue
+            if ctx.string_prefix(name) is not None:
+                continue  # URS119 reports the prefixed string
             hint = None
             owner = _owner(ctx, name.id)
             if owner is not None:
@@ -305,6 +307,17 @@ kind of hint. A file that defines a function of the same name is left alone.""",
 def python_habit(ctx: LintContext) -> Iterator[Diagnostic]:
     for scope in ctx.analysis.scopes:
         for name in scope.reads:
+            prefixed = ctx.string_prefix(name)
+            if prefixed is not None and not ctx.analysis.defined(name.id, scope):
+                if name.id.lower() in ("f", "rf", "fr"):
+                    yield ctx.diagnostic(
+                        "URS119", prefixed, "URScript has no f-strings",
+                        'build the text with str_cat and to_str: str_cat("x = ", to_str(x))')
+                else:
+                    yield ctx.diagnostic(
+                        "URS119", prefixed, f"URScript strings have no '{name.id}' prefix",
+                        "write the string without it")
+                continue
             hint = _habit(name.id, ctx, scope)
             if hint:
                 yield ctx.diagnostic("URS119", name, f"'{name.id}' is not URScript", hint)
