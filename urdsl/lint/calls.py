@@ -140,6 +140,13 @@ def too_many_arguments(ctx: LintContext) -> Iterator[Diagnostic]:
                     "given twice, by position and by name", "remove one of the two")
 
 
+# What people write for the move parameters a, v, t, r.
+_SYNONYMS = {
+    "speed": "v", "velocity": "v", "vel": "v", "acceleration": "a", "acc": "a", "accel": "a",
+    "time": "t", "duration": "t", "radius": "r", "blend": "r", "blend_radius": "r",
+}
+
+
 @rule(
     "URS106", "unknown-keyword", "error",
     "A keyword argument that the function has no parameter for.",
@@ -158,6 +165,9 @@ def unknown_keyword(ctx: LintContext) -> Iterator[Diagnostic]:
             if keyword.name in signature.names:
                 continue
             close = difflib.get_close_matches(keyword.name, signature.names, n=1, cutoff=0.6)
+            synonym = _SYNONYMS.get(keyword.name.lower())
+            if synonym in signature.names:
+                close = [synonym]
             hint = f"did you mean `{close[0]}`? " if close else ""
             yield ctx.diagnostic(
                 "URS106", keyword, f"{signature.title} has no parameter '{keyword.name}'",
