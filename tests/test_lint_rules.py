@@ -27,6 +27,7 @@ def finding(text: str, code: str, **settings):
 # (code, triggering snippet, expected places, settings)
 TRIGGERS = [
     ("URS001", "p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3])\n", [(1, 45)], {}),
+    ("URS100", "x = 1\n" + "if x:\n" * 3000 + "textmsg(x)\n" + "end\n" * 3000, [(1, 1)], {}),
     ("URS101", "thread blink():\n  on = True\nend\ndef show():\n  textmsg(on)\nend\n",
      [(5, 11)], {}),
     ("URS101", "def f():\n  run worker()\nend\n", [(2, 3)], {}),
@@ -82,6 +83,7 @@ TRIGGERS = [
 # (code, snippet that must not trigger it, settings)
 CLEAN = [
     ("URS001", "p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3]\n", {}),
+    ("URS100", "x = 1\n" + "if x:\n" * 50 + "textmsg(x)\n" + "end\n" * 50, {}),
     ("URS101", "thread blink():\n  global on = True\nend\ndef show():\n  textmsg(on)\nend\n", {}),
     ("URS101", "def prog():\n  def f():\n    textmsg(x)\n  end\n  x = 1\n  f()\nend\n", {}),
     ("URS101", "x = pi / 2\ntextmsg(x)\n", {}),
@@ -140,6 +142,8 @@ def test_every_rule_has_a_trigger_and_a_clean_case():
 def test_every_rule_example_triggers_it_and_its_fix_does_not():
     # `urdsl rules CODE` shows these; they must be true.
     for code, rule in RULES.items():
+        if code == "URS100":
+            continue  # its example is a sketch (thousands of levels)
         settings = {"version": "3.15"} if code == "URS103" else {}
         example = rule.example
         fixed = rule.fixed.replace("# urdsl lint --version 5.15\n", "")
@@ -151,7 +155,8 @@ def test_every_rule_example_triggers_it_and_its_fix_does_not():
 def test_hints_say_what_to_write():
     assert finding("globl x = 1\n", "URS115").hint == "did you mean `global`?"
     assert finding("globl x = 1\n", "URS101").hint == "did you mean `global`?"
-    assert "`global on`" in finding(TRIGGERS[1][1], "URS101").hint
+    blink = "thread blink():\n  on = True\nend\ndef show():\n  textmsg(on)\nend\n"
+    assert "`global on`" in finding(blink, "URS101").hint
     assert "textmsg" in finding('print("x")\n', "URS119").hint
     assert "str_cat" in finding('b = 1\nx = f"{b}"\n', "URS119").hint
     assert "'=='" in finding("if a = 1:\nend\n", "URS001").hint

@@ -146,18 +146,24 @@ class LintContext:
 
     def number(self, expr: n.Expr) -> float | None:
         """The constant value of a numeric expression (``-1.57``, ``2*0.5``, ``d2r(90)``), or
-        None when it is not a constant."""
+        None when it is not a constant (or nests too deeply to fold)."""
+        try:
+            return self._number(expr)
+        except RecursionError:
+            return None
+
+    def _number(self, expr: n.Expr) -> float | None:
         if isinstance(expr, n.Number):
             return float(expr.value)
         if isinstance(expr, n.Paren):
-            return self.number(expr.expr)
+            return self._number(expr.expr)
         if isinstance(expr, n.UnaryOp) and expr.op in ("-", "+"):
-            value = self.number(expr.operand)
+            value = self._number(expr.operand)
             if value is None:
                 return None
             return -value if expr.op == "-" else value
         if isinstance(expr, n.BinOp) and expr.op in ("+", "-", "*", "/"):
-            left, right = self.number(expr.left), self.number(expr.right)
+            left, right = self._number(expr.left), self._number(expr.right)
             if left is None or right is None:
                 return None
             if expr.op == "+":
@@ -170,7 +176,7 @@ class LintContext:
         if (isinstance(expr, n.Call) and isinstance(expr.func, n.Name) and len(expr.args) == 1
                 and not expr.keywords and expr.func.id in ("d2r", "r2d")
                 and self.builtin(expr) is not None):
-            value = self.number(expr.args[0])
+            value = self._number(expr.args[0])
             if value is None:
                 return None
             return math.radians(value) if expr.func.id == "d2r" else math.degrees(value)

@@ -79,16 +79,18 @@ def _block_terminates(items: tuple) -> bool:
 
 def _blocks(items: tuple) -> Iterator[tuple]:
     """``items`` and every block nested in it (if/elif/else, while, definitions)."""
-    yield items
-    for item in items:
-        if isinstance(item, (n.FunctionDef, n.ThreadDef, n.SecDef, n.While)):
-            yield from _blocks(item.body)
-        elif isinstance(item, n.If):
-            yield from _blocks(item.body)
-            for branch in item.elifs:
-                yield from _blocks(branch.body)
-            if item.orelse:
-                yield from _blocks(item.orelse)
+    pending = [items]
+    while pending:
+        block = pending.pop()
+        yield block
+        for item in block:
+            if isinstance(item, (n.FunctionDef, n.ThreadDef, n.SecDef, n.While)):
+                pending.append(item.body)
+            elif isinstance(item, n.If):
+                pending.append(item.body)
+                pending.extend(branch.body for branch in item.elifs)
+                if item.orelse:
+                    pending.append(item.orelse)
 
 
 @rule(

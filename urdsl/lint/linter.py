@@ -14,7 +14,7 @@ from ..script.parser import parse
 from . import calls, flow, motion, names  # noqa: F401 - importing registers the rules
 from .config import LintSettings, build_settings
 from .context import LintContext
-from .registry import RULES
+from .registry import DEPTH_RULE, RULES
 from .scope import analyse
 
 __all__ = ["lint_text", "lint_tree"]
@@ -41,12 +41,27 @@ def lint_tree(tree: n.Module, settings: LintSettings | None = None) -> list[Diag
     """All findings for a parsed file (its nodes must carry spans)."""
     settings = settings or build_settings()
     source = tree.span.source or n.Source("", "<generated>")
-    ctx = LintContext(source, tree, analyse(tree), settings.model, settings.version)
     found: list[Diagnostic] = []
-    for code, rule in sorted(RULES.items()):
-        if rule.check is None or code not in settings.codes:
-            continue
-        found.extend(rule.check(ctx))
+    skipped: list[str] = []
+    try:
+        analysis = analyse(tree)
+    except RecursionError:
+        analysis = None
+        skipped.append("all")
+    if analysis is not None:
+        ctx = LintContext(source, tree, analysis, settings.model, settings.version)
+        for code, rule in sorted(RULES.items()):
+            if rule.check is None or code not in settings.codes:
+                continue
+            try:
+                found.extend(rule.check(ctx))
+            except RecursionError:
+                skipped.append(code)
+    if skipped and DEPTH_RULE.code in settings.codes:
+        found.append(Diagnostic.at(
+            n.Span(source, 0, 0), f"blocks nest too deeply to lint; skipped: "
+            f"{', '.join(skipped)}", code=DEPTH_RULE.code, severity=DEPTH_RULE.severity,
+            hint="split the deep nesting into functions"))
     found = _without_noqa(found, tree)
     unique = {(d.line, d.column, d.code, d.message): d for d in found}
     return sorted(unique.values(), key=lambda d: (d.line, d.column, d.code))

@@ -17,7 +17,7 @@ from ..script.diagnostics import Diagnostic
 if TYPE_CHECKING:  # pragma: no cover
     from .context import LintContext
 
-__all__ = ["Rule", "RULES", "rule", "SYNTAX_RULE", "expand_codes"]
+__all__ = ["Rule", "RULES", "rule", "SYNTAX_RULE", "DEPTH_RULE", "expand_codes"]
 
 Check = Callable[["LintContext"], Iterator[Diagnostic]]
 
@@ -63,6 +63,18 @@ No other rule runs on a file with a syntax error.""",
     fixed="p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3]",
 )
 RULES[SYNTAX_RULE.code] = SYNTAX_RULE
+
+DEPTH_RULE = Rule(
+    code="URS100", name="too-deep-to-lint", severity="info",
+    summary="Blocks or expressions nest deeper than the linter follows; some rules skipped.",
+    explanation="""
+urdsl's parser accepts blocks nested thousands deep (generated programs do this), but some
+rules walk the tree recursively and stop at Python's recursion limit. They are skipped for
+that file, and this note says which; every other rule still runs.""",
+    example="if a:\n  if a:\n    ... (2000 levels) ...\n  end\nend",
+    fixed="split the deep nesting into functions",
+)
+RULES[DEPTH_RULE.code] = DEPTH_RULE
 
 
 def rule(

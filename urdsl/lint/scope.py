@@ -114,19 +114,24 @@ class Analysis:
 
 def statements(items: tuple) -> Iterator[n.Stmt]:
     """Every statement in ``items`` and in the blocks of its ``if`` and ``while`` statements,
-    in source order; nested definitions are yielded but not entered."""
-    for item in items:
+    in source order; nested definitions are yielded but not entered. (Iterative: generated
+    programs nest blocks deeper than Python's recursion limit.)"""
+    stack: list[Iterator] = [iter(items)]
+    while stack:
+        item = next(stack[-1], None)
+        if item is None:
+            stack.pop()
+            continue
         if not isinstance(item, n.Stmt):
             continue
         yield item
         if isinstance(item, n.If):
-            yield from statements(item.body)
-            for branch in item.elifs:
-                yield from statements(branch.body)
+            blocks = [item.body, *(branch.body for branch in item.elifs)]
             if item.orelse:
-                yield from statements(item.orelse)
+                blocks.append(item.orelse)
+            stack.append(iter([s for block in blocks for s in block]))
         elif isinstance(item, n.While):
-            yield from statements(item.body)
+            stack.append(iter(item.body))
 
 
 class _Builder:
