@@ -55,6 +55,8 @@ TRIGGERS = [
      [(2, 12)], {}),
     ("URS111", "def prog():\n  q = [0, 0, 0, 0, 0, 0]\n  movej(q, r=0.1)\nend\n", [(3, 14)],
      {}),
+    ("URS111", "a = p[0.1, 0.2, 0.3, 0, 0, 0]\nmovel(a, r=0.05)\n"
+     "while not get_standard_digital_in(0):\n  sync()\nend\nmovel(a)\n", [(2, 12)], {}),
     ("URS112", "def pick():\n  grip_force = 40\n  set_tool_digital_out(0, True)\nend\n",
      [(2, 3)], {}),
     ("URS112", "def prog():\n  unused = 1\n  textmsg(2)\nend\n", [(2, 3)], {}),

@@ -10,7 +10,7 @@ from ..script import nodes as n
 from ..script.diagnostics import Diagnostic
 from .context import BLOCKING_CALLS, MOTION_CALLS, LintContext
 from .registry import rule
-from .scope import Scope
+from .scope import Scope, statements
 
 # Parameters that take joint positions [rad] (6 values) when given a list.
 _JOINT_POSITIONS: dict[str, tuple[str, ...]] = {
@@ -224,12 +224,19 @@ def _stops(ctx: LintContext, item: n.Node) -> str | None:
                 return f"{name}()"
             if name in ("stopj", "stopl"):
                 return f"{name}()"
-    if isinstance(item, n.While) and not any(
-        _is_move(ctx, s) or isinstance(s, n.ExprStmt) and isinstance(s.expr, n.Call)
-        and not ctx.builtin_call(s) for s in item.body
-    ):
-        if any(ctx.builtin_call(s) and ctx.builtin_call(s)[0] in ("sleep", "sync")  # type: ignore[index]
-               for s in item.body):
+    if isinstance(item, n.While):
+        waits = moves = False
+        for statement in statements(item.body):
+            for node in n.walk(statement):
+                if isinstance(node, n.Call):
+                    found = ctx.builtin_call(node)
+                    if found is None:
+                        moves = True  # a user function or a method: it may move
+                    elif found[0] in ("sleep", "sync"):
+                        waits = True
+                    elif found[0] in MOTION_CALLS:
+                        moves = True
+        if waits and not moves:
             return "a waiting loop"
     return None
 
