@@ -95,7 +95,7 @@ def test_language_server_over_stdio():
     assert "def approach(target)" in results["hover_def"].contents.value
 
     function = results["definition_function"]
-    assert function.range.start.line == 1 and function.range.start.character == 0
+    assert function.range.start.line == 1 and function.range.start.character == 4
     assert results["definition_global"].range.start.line == 0
 
     (edit,) = results["format"]

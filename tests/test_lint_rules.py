@@ -61,7 +61,7 @@ TRIGGERS = [
      [(2, 3)], {}),
     ("URS112", "def prog():\n  unused = 1\n  textmsg(2)\nend\n", [(2, 3)], {}),
     ("URS113", "def approach(target, speed):\n  movel(target, v=0.25)\nend\n", [(1, 22)], {}),
-    ("URS114", "def sleep(t):\n  textmsg(t)\nend\n", [(1, 1)], {}),
+    ("URS114", "def sleep(t):\n  textmsg(t)\nend\n", [(1, 5)], {}),
     ("URS114", "sleep = 0.5\nsync()\nsleep(sleep)\n", [(1, 1)], {}),
     ("URS115", "count = 1\ncount == 0\n", [(2, 1)], {}),
     ("URS115", "globl x = 1\n", [(1, 1)], {}),
@@ -78,7 +78,7 @@ TRIGGERS = [
     ("URS119", 'b = 2\nx = f"a {b}"\n', [(2, 5)], {}),
     ("URS119", "import math\n", [(1, 1), (1, 8)], {}),
     ("URS120", "def main():\n  local count = 0\n  textmsg(count)\nend\n", [(2, 3)], {}),
-    ("URS121", "def home():\n  textmsg(1)\nend\ndef home():\n  textmsg(2)\nend\n", [(4, 1)],
+    ("URS121", "def home():\n  textmsg(1)\nend\ndef home():\n  textmsg(2)\nend\n", [(4, 5)],
      {}),
 ]
 

@@ -4,6 +4,7 @@ small helpers to find a call's arguments and the constant value of an expression
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
@@ -52,6 +53,19 @@ class LintContext:
         """A finding of rule ``code`` at a node (or span), with the rule's severity."""
         span = at if isinstance(at, n.Span) else at.span  # type: ignore[attr-defined]
         return Diagnostic.at(span, message, code=code, severity=RULES[code].severity, hint=hint)
+
+    def name_span(self, node: n.Node) -> n.Span:
+        """The span of the name in a ``def``/``thread``/``sec`` line (or ``global x`` /
+        ``local x``), so that a finding points at the name, not at a whole block."""
+        span = node.span  # type: ignore[attr-defined]
+        name = getattr(node, "name", None)
+        if span.source is None or not name:
+            return span
+        text = span.source.text
+        match = re.compile(rf"\b{re.escape(name)}\b").search(text, span.start, span.end)
+        if match is None:
+            return span
+        return n.Span(span.source, match.start(), match.end())
 
     # -- walking -----------------------------------------------------------------------------
 

@@ -176,7 +176,8 @@ def sec_blocking(ctx: LintContext) -> Iterator[Diagnostic]:
         if not ctx.in_sec(scope):
             continue
         if scope.kind == "thread":
-            yield ctx.diagnostic("URS117", scope.node, "a thread inside a sec program",
+            yield ctx.diagnostic("URS117", ctx.name_span(scope.node),
+                                 "a thread inside a sec program",
                                  "sec programs must not use threads")
         for call in scope.calls:
             name = call.func.id  # type: ignore[union-attr]

@@ -141,7 +141,8 @@ def definition_of(text: str, word: str) -> n.Span | None:
     analysis = analyse(tree)
     for table in (analysis.functions, analysis.threads, analysis.secs):
         if word in table:
-            return table[word][0].span
+            node = table[word][0]
+            return _name_span(node)
     for scope in analysis.scopes:
         if word in scope.declared_global:
             return scope.declared_global[word].span
@@ -151,6 +152,13 @@ def definition_of(text: str, word: str) -> n.Span | None:
     if word in top.declared_local:
         return top.declared_local[word].span
     return None
+
+
+def _name_span(node: n.Node) -> n.Span:
+    span = node.span  # type: ignore[attr-defined]
+    match = re.compile(rf"\b{re.escape(node.name)}\b").search(  # type: ignore[attr-defined]
+        span.source.text, span.start, span.end) if span.source else None
+    return n.Span(span.source, match.start(), match.end()) if match else span
 
 
 def _range(span: n.Span) -> types.Range:

@@ -272,8 +272,9 @@ def builtin_shadowed(ctx: LintContext) -> Iterator[Diagnostic]:
                 kind = {n.FunctionDef: "function", n.ThreadDef: "thread",
                         n.SecDef: "sec program"}[type(statement)]
                 yield ctx.diagnostic(
-                    "URS114", statement, f"{kind} '{statement.name}' hides the builtin "
-                    f"{statement.name}()", "choose another name")
+                    "URS114", ctx.name_span(statement),
+                    f"{kind} '{statement.name}' hides the builtin {statement.name}()",
+                    "choose another name")
             if isinstance(statement, n.FunctionDef):
                 for param in statement.params:
                     if shadows(param.name, True):
@@ -366,5 +367,5 @@ def duplicate_definition(ctx: LintContext) -> Iterator[Diagnostic]:
         first = nodes[0].span.line  # type: ignore[attr-defined]
         for node in nodes[1:]:
             yield ctx.diagnostic(
-                "URS121", node, f"'{name}' is defined again (first at line {first})",
+                "URS121", ctx.name_span(node), f"'{name}' is defined again (first at line {first})",
                 "rename one of them or delete the unused one")
