@@ -158,7 +158,7 @@ def unknown_function(ctx: LintContext) -> Iterator[Diagnostic]:
                     f"'{name}' is a command of the interpreter socket (port 30020), not a "
                     "function", f"send `{name}` alone on a line to port 30020")
             continue
-        if name in scope.local_names() or name in analysis.globals:
+        if scope.binds(name) or name in analysis.globals:
             yield ctx.diagnostic("URS102", call.func, f"'{name}' is a variable, not a function")
             continue
         if name in methods():

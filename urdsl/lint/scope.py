@@ -58,6 +58,11 @@ class Scope:
     def name(self) -> str:
         return getattr(self.node, "name", "<top>")
 
+    def binds(self, name: str) -> bool:
+        """Whether this scope itself binds ``name`` (parameter, assignment, declaration)."""
+        return (name in self.assigned or name in self.params or name in self.declared_local
+                or name in self.declared_global)
+
     def local_names(self) -> set[str]:
         """Names bound in this scope itself (parameters, assignments, declarations)."""
         return (set(self.params) | set(self.assigned) | set(self.declared_local)
@@ -97,7 +102,7 @@ class Analysis:
         """Whether reading ``name`` in ``scope`` finds a variable, function or thread."""
         current: Scope | None = scope
         while current is not None:
-            if name in current.local_names():
+            if current.binds(name):
                 return True
             current = current.parent
         return (name in self.globals or name in self.functions or name in self.threads
