@@ -158,8 +158,11 @@ class _Stdin:
 def test_rules_lists_every_rule_and_explains_one(capsys):
     assert main(["rules"]) == 0
     out = capsys.readouterr().out
-    for code in RULES:
-        assert code in out
+    for code, rule in RULES.items():
+        assert f"{code} {rule.name} ({rule.severity})" in out
+    assert out.count("Example:") == len(RULES) and out.count("Write instead:") == len(RULES)
+    assert main(["rules", "--short"]) == 0
+    assert len(capsys.readouterr().out.splitlines()) == len(RULES) + 2
     assert main(["rules", "URS105"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("URS105 too-many-arguments (error)")

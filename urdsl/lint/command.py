@@ -82,12 +82,15 @@ def add_commands(commands) -> None:
 
     p = commands.add_parser(
         "rules", help="list the lint rules, or explain one",
-        description="List every lint rule with its code, severity and summary, or explain "
-        "one rule with an example and its fix.",
-        epilog="examples:\n  urdsl rules\n  urdsl rules URS108\n  urdsl rules --json",
+        description="Explain every lint rule (code, severity, what it checks and why, an "
+        "example and its fix), or only the one named.",
+        epilog="examples:\n  urdsl rules | less\n  urdsl rules --short\n  urdsl rules URS108\n"
+        "  urdsl rules unused-variable\n  urdsl rules --json",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("code", nargs="?", metavar="CODE", help="a rule code or name")
     p.add_argument("--json", action="store_true", help="print the rules as JSON")
+    p.add_argument("--short", action="store_true",
+                   help="one line per rule: code, severity, name, summary")
     p.set_defaults(run=cmd_rules)
 
     p = commands.add_parser(
@@ -172,9 +175,12 @@ def cmd_rules(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps([_rule_dict(r) for r in _sorted()], indent=2, ensure_ascii=False))
         return EXIT_OK
-    for rule in _sorted():
-        print(f"{rule.code}  {rule.severity:<8} {rule.name:<26} {rule.summary}")
-    print("\nRun 'urdsl rules CODE' for the explanation of a rule with an example.")
+    if args.short:
+        for rule in _sorted():
+            print(f"{rule.code}  {rule.severity:<8} {rule.name:<26} {rule.summary}")
+        print("\nRun 'urdsl rules CODE' for the explanation of a rule with an example.")
+        return EXIT_OK
+    print("\n\n".join(rule.describe() for rule in _sorted()))
     return EXIT_OK
 
 

@@ -58,7 +58,8 @@ expected. Habits from other languages are named with the URScript way in the hin
 `for` loops (count with while), `+=` (write x = x + 1), `**` (pow(b, e)), `is`
 (compare with ==), `else if` (elif), f-strings (str_cat and to_str), `=` in a condition
 (compare with ==), a stray or missing bracket (with the place where it was opened).
-No other rule runs on a file with a syntax error.""",
+No other rule runs on a file with a syntax error, and it is reported whatever --select and
+--ignore say.""",
     example="p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3])",
     fixed="p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3]",
 )
