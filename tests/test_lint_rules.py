@@ -161,7 +161,9 @@ def test_hints_say_what_to_write():
     assert "`global on`" in finding(blink, "URS101").hint
     assert "textmsg" in finding('print("x")\n', "URS119").hint
     assert "str_cat" in finding('b = 1\nx = f"{b}"\n', "URS119").hint
-    assert "'=='" in finding("if a = 1:\nend\n", "URS001").hint
+    assignment = finding("a = 0\nif a = 1:\nend\n", "URS001")
+    assert (assignment.line, assignment.column) == (2, 6)
+    assert "'=' in a condition" in assignment.message and "'=='" in assignment.hint
     assert "set_standard_digital_out" in finding("set_digital_out(2, True)\n", "URS104").hint
     assert "`v`" in finding("movej([0, 0, 0, 0, 0, 0], vel=1)\n", "URS106").hint
     assert "5.15" in finding("l = make_list(3, 0, 10)\n", "URS103", version="3.15").message

@@ -156,6 +156,8 @@ def explain(source: Source, token: Token, expected: list[str], lexer: Lexer) -> 
             )
         if "COLON" in expected or "RPAR" in expected or "COMMA" in expected:
             hint = "to compare, write '=='; '=' only assigns"
+            if line_text.startswith(("if", "elif", "while")) and "COLON" in expected:
+                return fail("'=' in a condition: '=' assigns, it does not compare", hint)
     if (kind == "STRING" and previous is not None and previous[0] == "NAME"
             and previous[3] == start and previous[1].lower() in ("f", "rf", "fr")):
         return fail("URScript has no f-strings",
