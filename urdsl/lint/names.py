@@ -113,8 +113,7 @@ def undefined_name(ctx: LintContext) -> Iterator[Diagnostic]:
             hint = None
             owner = _owner(ctx, name.id)
             if owner is not None:
-                kind = owner.kind if owner.kind != "function" else "function"
-                hint = (f"`{name.id}` is local to {kind} {owner.name}(); declare it "
+                hint = (f"`{name.id}` is local to {owner.kind} {owner.name}(); declare it "
                         f"`global {name.id}` there, or assign it at the first level")
             elif lookup(name.id) is not None:
                 hint = f"{name.id} is a builtin function: call it, {name.id}(...)"
