@@ -413,11 +413,11 @@ def test_urdsl_protocol_decoders_read_the_simulators_realtime_and_primary_stream
     realtime = pytest.importorskip("urdsl.protocol.realtime")
     primary = pytest.importorskip("urdsl.protocol.primary")
     sock = connect(sim, "realtime")
-    state = realtime.decode(realtime_packet(sock))
+    state = realtime.decode_realtime(realtime_packet(sock), "5.15")
     sock.close()
     assert state.size == 1220 and state.robot_mode == 7 and state.safety_mode == 1
     assert np.allclose(state.q_actual, sim.snapshot().q)
-    assert np.allclose(state.tcp_pose, sim.snapshot().tcp)
+    assert np.allclose(state.tool_vector_actual, sim.snapshot().tcp)
 
     sock = connect(sim, "primary")
     decoder = primary.PrimaryDecoder()
@@ -430,7 +430,7 @@ def test_urdsl_protocol_decoders_read_the_simulators_realtime_and_primary_stream
     sock.close()
     version = decoded[0]
     assert isinstance(version, primary.VersionMessage)
-    assert (version.project, version.major, version.minor) == ("URControl", 5, 15)
+    assert (version.project_name, version.major, version.minor) == ("URControl", 5, 15)
     robot_state = next(m for m in decoded if isinstance(m, primary.RobotState))
     assert robot_state.get(primary.RobotModeData).robot_mode == 7
     assert np.allclose(robot_state.get(primary.JointData).q_actual, sim.snapshot().q)
