@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import textwrap
+import time
 from types import SimpleNamespace
 
 import pytest
 from _robot_fakes import LOOPBACK, FakeController, FakeServer, free_port, version_message
 
-import urdsl.robot.sender as sender_module
 from urdsl.cli import main
 from urdsl.robot.errors import CheckFailedError, ConnectError, ConnectionLost
-from urdsl.robot.sender import send, send_program
+from urdsl.robot.sender import run_program, send, send_program
 
 BARE = """\
 # wave hello
@@ -49,8 +49,8 @@ def controller(behaviour, **kw):
 def test_send_success_reports_started_and_finished():
     fake, server = controller(runs(5, "hello from the robot"))
     with server:
-        result = send_program("def wave():\n  textmsg(\"hi\")\nend\n", LOOPBACK, server.port,
-                              timeout=5, check=False)
+        result = run_program("def wave():\n  textmsg(\"hi\")\nend\n", LOOPBACK, server.port,
+                             primary_port=server.port, timeout=5)
     assert result.status == "finished" and result.ok
     assert result.started and result.error is None
     assert result.duration is not None and result.duration > 0
@@ -63,8 +63,8 @@ def test_send_success_reports_started_and_finished():
 def test_runtime_exception_is_mapped_to_the_users_line_through_the_wrapper():
     fake, server = controller(fails_at("1 / 0", "division by zero"))
     with server:
-        result = send_program(BARE, LOOPBACK, server.port, timeout=5, check=False,
-                              filename="wave.script")
+        result = run_program(BARE, LOOPBACK, server.port, primary_port=server.port, timeout=5,
+                             filename="wave.script")
     assert result.status == "failed" and not result.ok
     sent = fake.programs[0]
     assert sent.splitlines()[0] == "def urdsl_program():"
@@ -83,8 +83,8 @@ def test_runtime_exception_is_mapped_to_the_users_line_through_the_wrapper():
 def test_script_port_and_monitor_port_can_differ():
     fake = FakeController(runs(3))
     with FakeServer(fake.primary) as primary, FakeServer(fake.script_port) as secondary:
-        result = send_program("movej([0, -1.57, 0, -1.57, 0, 0])\n", LOOPBACK, secondary.port,
-                              timeout=5, check=False, monitor_port=primary.port)
+        result = run_program("movej([0, -1.57, 0, -1.57, 0, 0])\n", LOOPBACK, secondary.port,
+                             timeout=5, primary_port=primary.port)
     assert result.status == "finished"
     assert fake.programs == ["def urdsl_program():\n  movej([0, -1.57, 0, -1.57, 0, 0])\nend\n"]
 
@@ -100,7 +100,7 @@ def test_check_refusal_sends_nothing():
     # nothing listens on this port: a send attempt would raise ConnectError instead
     with pytest.raises(CheckFailedError) as caught:
         send_program(BARE, LOOPBACK, free_port(), filename="wave.script", robot="ur10e",
-                     checker=checker)
+                     check=True, checker=checker)
     assert calls == [("wave.script", "ur10e")]
     assert caught.value.report is report
     assert "nothing was sent" in str(caught.value)
@@ -110,8 +110,9 @@ def test_passing_check_then_send(monkeypatch):
     fake, server = controller(runs(2))
     report = SimpleNamespace(has_errors=False)
     with server:
-        result = send_program(BARE.replace("1 / 0", "1"), LOOPBACK, server.port, timeout=5,
-                              checker=lambda tree, name, robot: report)
+        result = run_program(BARE.replace("1 / 0", "1"), LOOPBACK, server.port,
+                             primary_port=server.port, timeout=5, check=True,
+                             checker=lambda tree, name, robot: report)
     assert result.report is report and result.status == "finished"
 
 
@@ -120,8 +121,8 @@ def test_protective_stop_fails_the_program():
         return [("run", 2), ("safety", 3)]
     fake, server = controller(behaviour)
     with server:
-        result = send_program("def p():\n  movej([0,0,0,0,0,0])\nend\n", LOOPBACK,
-                              server.port, timeout=5, check=False)
+        result = run_program("def p():\n  movej([0,0,0,0,0,0])\nend\n", LOOPBACK,
+                             server.port, primary_port=server.port, timeout=5)
     assert result.status == "failed"
     assert result.error.kind == "protective stop"
     assert "PROTECTIVE_STOP" in result.error.render()
@@ -130,19 +131,30 @@ def test_protective_stop_fails_the_program():
 def test_still_running_when_the_wait_ends_is_not_a_failure():
     fake, server = controller(runs(10_000))
     with server:
-        result = send_program("def p():\n  sleep(100)\nend\n", LOOPBACK, server.port,
-                              timeout=0.5, check=False)
-    assert result.status == "running" and result.ok
+        result = run_program("def p():\n  sleep(100)\nend\n", LOOPBACK, server.port,
+                             primary_port=server.port, timeout=0.5)
+    assert result.status == "timeout" and result.ok
     assert "still running" in result.summary()
 
 
-def test_no_sign_of_a_start(monkeypatch):
-    monkeypatch.setattr(sender_module, "START_WINDOW", 0.3)
+def test_no_sign_of_a_start():
     fake, server = controller(lambda program: [])
     with server:
-        result = send_program("def p():\n  x = 1\nend\n", LOOPBACK, server.port, timeout=5,
-                              check=False)
-    assert result.status == "sent" and not result.started
+        result = run_program("def p():\n  x = 1\nend\n", LOOPBACK, server.port,
+                             primary_port=server.port, timeout=5, start_timeout=0.3)
+    assert result.status == "not observed" and not result.started and result.ok
+
+
+def test_send_program_sends_and_returns_at_once():
+    fake, server = controller(runs(1000))
+    with server:
+        result = send_program("textmsg(\"x\")", LOOPBACK, server.port)
+        assert result.status == "sent" and not result.started
+        assert result.bytes_sent == len('def urdsl_program():\n  textmsg("x")\nend\n')
+        deadline = time.monotonic() + 5
+        while not fake.programs and time.monotonic() < deadline:
+            time.sleep(0.01)
+    assert fake.programs == ['def urdsl_program():\n  textmsg("x")\nend\n']
 
 
 def test_disconnect_while_following_is_a_clear_error():
@@ -158,8 +170,8 @@ def test_disconnect_while_following_is_a_clear_error():
 
     with FakeServer(handler) as server:
         with pytest.raises(ConnectionLost) as caught:
-            send_program("def p():\n  x = 1\nend\n", LOOPBACK, server.port, timeout=5,
-                         check=False)
+            run_program("def p():\n  x = 1\nend\n", LOOPBACK, server.port,
+                        primary_port=server.port, timeout=5)
     assert "the program was sent, but" in str(caught.value)
     assert f"{LOOPBACK}:{server.port}" in str(caught.value)
 

@@ -9,7 +9,7 @@ from urdsl.sim import demo_story
 
 
 def test_demo_story_records_the_program_it_sent(tmp_path):
-    result = demo_story(tmp_path, speed=8.0)
+    result = demo_story(tmp_path, speed=4.0)
     assert result.sent and all(path.exists() for path in result.paths())
     header, *rows = result.csv.read_text().splitlines()
     assert header.split()[:2] == ["timestamp", "actual_q_0"]

@@ -213,6 +213,7 @@ _COMMAND_MODULES: list[str] = [
     "urdsl.verify.command",
     "urdsl.robot.command",
     "urdsl.sim.command",
+    "urdsl.lint.command",
 ]
 """Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""
 

@@ -30,11 +30,11 @@ from .errors import (
     RobotTimeout,
 )
 from .recorder import RecordResult, record
-from .sender import SendResult, send, send_program
+from .sender import SendResult, run_program, send, send_program
 from .state import RobotState, StateReader, read_state
 
 __all__ = [
-    "Robot", "connect", "send", "send_program", "SendResult", "read_state", "StateReader",
-    "RobotState", "record", "RecordResult", "RobotError", "ConnectError", "ConnectionLost",
-    "RobotTimeout", "ControllerProtocolError", "CheckFailedError",
+    "Robot", "connect", "send", "send_program", "run_program", "SendResult", "read_state",
+    "StateReader", "RobotState", "record", "RecordResult", "RobotError", "ConnectError",
+    "ConnectionLost", "RobotTimeout", "ControllerProtocolError", "CheckFailedError",
 ]

@@ -350,7 +350,7 @@ def cmd_send(args: argparse.Namespace) -> int:
     if result.error is not None:
         print(result.error.render(), file=sys.stderr)
     print(result.summary(), file=sys.stderr)
-    if result.status == "sent" and not args.no_follow:
+    if result.status == "not observed":
         print("  (no start was seen: a program that runs in under 0.1 s leaves no trace in "
               "the 10 Hz robot state; on e-Series the robot must be in Remote Control)",
               file=sys.stderr)

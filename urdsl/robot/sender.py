@@ -15,7 +15,11 @@ fails silently. :func:`send_program` does it properly:
    mapped back to the user's file, through the wrapping) or a protective stop ends it.
 
 Waiting is bounded by ``timeout``: a program still running then is reported as
-``"running"`` (it goes on on the robot; urdsl only stops watching).
+``"timeout"`` (it goes on on the robot; urdsl only stops watching).
+
+Three entry points: :func:`send` (check, send, follow — what ``urdsl send`` and
+``Robot.send`` do), :func:`send_program` (send the text and return; check and follow on
+request) and :func:`run_program` (send and follow).
 """
 
 from __future__ import annotations
@@ -36,7 +40,7 @@ from .program import Location, PreparedProgram, prepare_text, prepare_tree
 
 __all__ = [
     "send_program", "send", "send_prepared", "SendResult", "ControllerError", "Checker",
-    "default_checker", "monitor_port_for", "START_WINDOW", "END_GRACE",
+    "default_checker", "monitor_port_for", "START_WINDOW", "END_GRACE", "run_program",
 ]
 
 START_WINDOW = 2.0
@@ -109,11 +113,12 @@ class ControllerError:
 class SendResult:
     """What happened to a sent program.
 
-    ``status``: ``"finished"`` (ran and stopped without an error), ``"failed"`` (``error``
-    says why), ``"running"`` (still running when the wait ended), ``"sent"`` (not followed,
-    or no sign of a start was seen: a program that runs in under 0.1 s leaves none in the
-    10 Hz state). ``duration`` (s) from the start seen to the end seen; ``messages`` are
-    the texts the program printed (``textmsg``) and other controller texts, in order.
+    ``status``: ``"sent"`` (not followed), ``"finished"`` (ran and stopped without an
+    error), ``"failed"`` (``error`` says why), ``"timeout"`` (still running when the wait
+    ended), ``"not observed"`` (followed, but no sign of a start was seen: a program that
+    runs in under 0.1 s leaves none in the 10 Hz state). ``duration`` (s) from the start
+    seen to the end seen; ``messages`` are the texts the program printed (``textmsg``) and
+    other controller texts, in order.
     """
 
     host: str
@@ -142,11 +147,11 @@ class SendResult:
             return f"{self.program}: finished{took} on {place}"
         if self.status == "failed":
             return f"{self.program}: failed on {place}"
-        if self.status == "running":
+        if self.status == "timeout":
             return (f"{self.program}: still running on {place} when urdsl stopped waiting "
                     "(it goes on; use --timeout to wait longer)")
-        if self.started:
-            return f"{self.program}: started on {place}"
+        if self.status == "not observed":
+            return f"{self.program}: sent to {place}; no start was seen"
         return f"{self.program}: sent to {place} ({self.bytes_sent} bytes)"
 
 
@@ -234,7 +239,7 @@ class _Follower:
                     "error", f"{message.text} (C{message.code}A{message.argument})".strip())
                 self._message(message.text)
 
-    def follow(self, timeout: float) -> None:
+    def follow(self, timeout: float, start_timeout: float = START_WINDOW) -> None:
         """Read until the program ended or failed, or ``timeout`` s passed."""
         result = self.result
         begin = time.monotonic()
@@ -246,7 +251,7 @@ class _Follower:
             if self.stop_time is not None:
                 left = min(left, self.stop_time + END_GRACE - now)
             elif not result.started:
-                left = min(left, begin + min(START_WINDOW, timeout) - now)
+                left = min(left, begin + min(start_timeout, timeout) - now)
             if left <= 0:
                 break
             try:
@@ -272,9 +277,9 @@ class _Follower:
             else:
                 result.status = "finished"
         elif result.started:
-            result.status = "running"
+            result.status = "timeout"
         else:
-            result.status = "sent"
+            result.status = "not observed"
         if result.started and self.start_time is not None:
             end = self.stop_time if self.stop_time is not None else time.monotonic()
             result.duration = max(end - self.start_time, 0.0)
@@ -288,14 +293,15 @@ def _clean(text: str) -> str:
 
 def send_prepared(prepared: PreparedProgram, host: str, port: int = 30002, *,
                   timeout: float = 5.0, follow: bool = True, monitor_port: int | None = None,
-                  connect_timeout: float = 5.0,
+                  connect_timeout: float = 5.0, start_timeout: float | None = None,
                   report: Callable[[str, str], None] | None = None) -> SendResult:
     """Send an already prepared (and checked) program; follow it unless ``follow=False``.
 
     ``timeout`` (s) bounds the wait for the program to finish; ``connect_timeout`` (s) each
     connect and the wait for the first robot state. ``monitor_port`` is the primary port to
-    follow on (default :func:`monitor_port_for`). ``report(kind, text)`` is told as things
-    happen: ``"sent"``, ``"started"``, ``"message"`` (a text from the controller).
+    follow on (default :func:`monitor_port_for`); ``start_timeout`` (s, default
+    :data:`START_WINDOW`) how long to wait for a sign of the start. ``report(kind, text)``
+    is told as things happen: ``"sent"``, ``"started"``, ``"message"`` (a text from the controller).
     """
     data = prepared.text.encode("utf-8")
     result = SendResult(host, port, prepared.name, len(data), prepared=prepared)
@@ -322,7 +328,8 @@ def send_prepared(prepared: PreparedProgram, host: str, port: int = 30002, *,
             sender.close()
         if follow:
             try:
-                follower.follow(timeout)
+                follower.follow(timeout, START_WINDOW if start_timeout is None
+                                else start_timeout)
             except ConnectionLost as error:
                 raise ConnectionLost(f"the program was sent, but {error.message} while urdsl "
                                      "followed it", host=error.host, port=error.port,
@@ -362,7 +369,8 @@ def _checked(tree: n.Module, filename: str, check: bool, robot: str,
 def send(program: Any, host: str, port: int = 30002, *, timeout: float = 5.0,
          filename: str | None = None, check: bool = True, robot: str = "ur5e",
          checker: Checker | None = None, follow: bool = True,
-         monitor_port: int | None = None, connect_timeout: float = 5.0) -> SendResult:
+         monitor_port: int | None = None, connect_timeout: float = 5.0,
+         start_timeout: float | None = None) -> SendResult:
     """Check, send and follow ``program``: URScript text, a parsed
     :class:`urdsl.script.nodes.Module`, or a DSL :class:`urdsl.dsl.Program` (whose
     statements keep the lines of the Python file that built them, so controller errors
@@ -387,21 +395,42 @@ def send(program: Any, host: str, port: int = 30002, *, timeout: float = 5.0,
                         "syntax tree or a urdsl.dsl.Program")
     report = _checked(prepared.tree, name, check, robot, checker)
     result = send_prepared(prepared, host, port, timeout=timeout, follow=follow,
-                           monitor_port=monitor_port, connect_timeout=connect_timeout)
+                           monitor_port=monitor_port, connect_timeout=connect_timeout,
+                           start_timeout=start_timeout)
     result.report = report
     return result
 
 
 def send_program(text: str, host: str, port: int = 30002, *, timeout: float = 5.0,
-                 filename: str = "<program>", check: bool = True, robot: str = "ur5e",
-                 checker: Checker | None = None, follow: bool = True,
-                 monitor_port: int | None = None, connect_timeout: float = 5.0) -> SendResult:
-    """Check, send and follow the URScript ``text`` (see :func:`send`).
+                 filename: str = "<program>", check: bool = False, robot: str = "ur5e",
+                 checker: Checker | None = None, follow: bool = False,
+                 monitor_port: int | None = None) -> SendResult:
+    """Send the URScript ``text`` (printed, wrapped if bare statements) and return
+    (``status == "sent"``); ``timeout`` (s) bounds the connect and the write.
 
-    >>> result = send_program(program.script(), "127.0.0.1")   # doctest: +SKIP
-    >>> result.status, result.error
-    ('finished', None)
+    ``check=True`` checks it first (raises :class:`CheckFailedError`, nothing sent);
+    ``follow=True`` follows it as :func:`run_program` does, ``timeout`` then bounding the
+    wait for its end.
+
+    >>> send_program(program.script(), "127.0.0.1").status      # doctest: +SKIP
+    'sent'
     """
     return send(text, host, port, timeout=timeout, filename=filename, check=check,
                 robot=robot, checker=checker, follow=follow, monitor_port=monitor_port,
-                connect_timeout=connect_timeout)
+                connect_timeout=timeout)
+
+
+def run_program(text: str, host: str, port: int = 30002, *, timeout: float = 60.0,
+                primary_port: int = 30001, start_timeout: float = START_WINDOW,
+                filename: str = "<program>", check: bool = False, robot: str = "ur5e",
+                checker: Checker | None = None, connect_timeout: float = 5.0) -> SendResult:
+    """Send ``text`` and follow it on ``primary_port`` until it finished or failed, at most
+    ``timeout`` s (``start_timeout`` s for a sign that it started). A runtime exception's
+    place is mapped to ``filename``'s lines (``result.error.location``).
+
+    >>> run_program(program.script(), "127.0.0.1").status       # doctest: +SKIP
+    'finished'
+    """
+    return send(text, host, port, timeout=timeout, filename=filename, check=check,
+                robot=robot, checker=checker, follow=True, monitor_port=primary_port,
+                connect_timeout=connect_timeout, start_timeout=start_timeout)

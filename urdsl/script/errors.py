@@ -156,6 +156,18 @@ def explain(source: Source, token: Token, expected: list[str], lexer: Lexer) -> 
             )
         if "COLON" in expected or "RPAR" in expected or "COMMA" in expected:
             hint = "to compare, write '=='; '=' only assigns"
+            if line_text.startswith(("if", "elif", "while")) and "COLON" in expected:
+                return fail("'=' in a condition: '=' assigns, it does not compare", hint)
+    if (kind == "STRING" and previous is not None and previous[0] == "NAME"
+            and previous[3] == start and previous[1].lower() in ("f", "rf", "fr")):
+        return fail("URScript has no f-strings",
+                    'build the text with str_cat and to_str: str_cat("x = ", to_str(x))',
+                    (previous[2], end))
+    if (kind == "STRING" and previous is not None and previous[0] == "NAME"
+            and previous[3] == start and previous[1].lower() in ("r", "b", "u", "rb", "br")):
+        return fail(f"URScript strings have no '{previous[1]}' prefix",
+                    "write the string without it: URScript has no escape sequences anyway",
+                    (previous[2], end))
     if kind == "STAR" and previous is not None and previous[0] == "STAR":
         return fail("URScript has no '**' operator", "use pow(base, exponent)",
                     (previous[2], end))

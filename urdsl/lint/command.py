@@ -1,0 +1,203 @@
+"""``urdsl lint``, ``urdsl rules`` and ``urdsl lsp``: the linter on the command line and in
+an editor."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+from .registry import RULES
+
+__all__ = ["add_commands", "cmd_lint", "cmd_rules", "cmd_lsp"]
+
+_SUFFIXES = (".script", ".urscript", ".urs")
+
+_LINT_DESCRIPTION = """\
+Check URScript files without running them: syntax (URS001), names that are not defined in
+the controller's scoping, builtins that are unknown, missing in the target controller
+version or deprecated, arguments that do not fit, joint vectors that are not 6 long,
+degrees where radians belong, speeds beyond the arm, blends that cannot happen, unused
+variables, unreachable code, what a sec program must not do, loops that never yield, and
+habits from Python. 'urdsl rules' explains every rule.
+
+Settings come from [tool.urdsl.lint] in the nearest pyproject.toml (select, ignore, robot,
+version); options given here win. '# noqa' or '# noqa: URS112' at the end of a line
+silences findings on it.
+
+Exit status: 0 no error-severity finding (warnings allowed), 1 errors found, 2 usage errors.
+"""
+
+_LINT_EPILOG = """\
+examples:
+  urdsl lint pick.script
+  urdsl lint programs/ --robot ur10e --version 5.15
+  urdsl lint *.script --select URS1 --ignore URS112,URS113
+  urdsl lint pick.script --format json | jq '.[] | .code'
+  urdsl lint . --format sarif > urdsl.sarif       # GitHub code scanning
+  urdsl lint . --format github                    # annotations in a GitHub Actions step
+
+pyproject.toml:
+  [tool.urdsl.lint]
+  select = ["URS0", "URS1"]
+  ignore = ["URS113"]
+  robot = "ur5e"
+  version = "5.15"
+"""
+
+
+def _codes(text: str) -> list[str]:
+    return [part.strip() for part in text.split(",") if part.strip()]
+
+
+def add_commands(commands) -> None:
+    p = commands.add_parser(
+        "lint", help="check URScript files for mistakes without running them",
+        description=_LINT_DESCRIPTION, epilog=_LINT_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("files", nargs="+", metavar="FILE",
+                   help="URScript file or folder (searched for *.script, *.urscript); "
+                   "'-' reads stdin")
+    p.add_argument("--select", action="append", type=_codes, metavar="CODES",
+                   help="run only these rules: codes, prefixes (URS1) or names, "
+                   "comma-separated (default: all, or the configured selection)")
+    p.add_argument("--ignore", action="append", type=_codes, metavar="CODES",
+                   help="skip these rules (added to the configured ignores)")
+    p.add_argument("--robot", metavar="MODEL",
+                   help="robot model whose joint speed limits URS110 uses, e.g. ur5e "
+                   "(default: the fastest UR arm)")
+    p.add_argument("--version", dest="target_version", metavar="VERSION",
+                   help="controller software version for URS103, e.g. 5.15 or 3.15 "
+                   "(default: no version check)")
+    p.add_argument("--format", choices=("text", "json", "sarif", "github"), default="text",
+                   help="output format (default: text)")
+    p.add_argument("--no-config", action="store_true",
+                   help="ignore pyproject.toml files")
+    p.add_argument("--stdin-filename", metavar="NAME",
+                   help="the name to report for '-' (also where the configuration is "
+                   "looked for)")
+    p.set_defaults(run=cmd_lint)
+
+    p = commands.add_parser(
+        "rules", help="list the lint rules, or explain one",
+        description="Explain every lint rule (code, severity, what it checks and why, an "
+        "example and its fix), or only the one named.",
+        epilog="examples:\n  urdsl rules | less\n  urdsl rules --short\n  urdsl rules URS108\n"
+        "  urdsl rules unused-variable\n  urdsl rules --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("code", nargs="?", metavar="CODE", help="a rule code or name")
+    p.add_argument("--json", action="store_true", help="print the rules as JSON")
+    p.add_argument("--short", action="store_true",
+                   help="one line per rule: code, severity, name, summary")
+    p.set_defaults(run=cmd_rules)
+
+    p = commands.add_parser(
+        "lsp", help="run the URScript language server (for editors) on stdin/stdout",
+        description="A Language Server Protocol server over stdio: diagnostics from the "
+        "linter as you type, hover with builtin signatures, go to the definition of functions, "
+        "threads and globals, and formatting with 'urdsl fmt'. Point your editor's LSP "
+        "client at the command 'urdsl lsp' for *.script files.",
+        epilog="example (Neovim):\n  vim.lsp.start({ name = 'urdsl', cmd = { 'urdsl', 'lsp' } })",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.set_defaults(run=cmd_lsp)
+
+
+def _expand(names: list[str]) -> list[str]:
+    """Files named on the command line; folders are searched for URScript files."""
+    from ..cli import UsageError
+
+    files: list[str] = []
+    for name in names:
+        if name != "-" and os.path.isdir(name):
+            found = sorted(
+                str(path) for path in Path(name).rglob("*")
+                if path.suffix in _SUFFIXES and path.is_file()
+                and not any(part.startswith(".") for part in path.parts[len(Path(name).parts):])
+            )
+            if not found:
+                raise UsageError(f"no URScript files (*.script, *.urscript) in {name}")
+            files.extend(found)
+        else:
+            files.append(name)
+    return files
+
+
+def cmd_lint(args: argparse.Namespace) -> int:
+    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
+    from . import report
+    from .config import ConfigError, settings_for
+    from .linter import lint_text
+
+    select = [c for group in args.select or [] for c in group] or None
+    ignore = [c for group in args.ignore or [] for c in group]
+    files = _expand(args.files)
+    found = []
+    ran: set[str] = set()
+    for name in files:
+        source = read_input(name)
+        label = args.stdin_filename if name == "-" and args.stdin_filename else source.name
+        where = source.path if source.path is not None else args.stdin_filename
+        try:
+            settings = settings_for(where, select=select, ignore=ignore, robot=args.robot,
+                                    version=args.target_version,
+                                    use_config=not args.no_config)
+        except ConfigError as error:
+            raise UsageError(str(error)) from None
+        ran |= settings.codes
+        found.extend(lint_text(source.text, label, settings))
+    if args.format == "json":
+        sys.stdout.write(report.render_json(found))
+    elif args.format == "sarif":
+        sys.stdout.write(report.render_sarif(found, ran))
+    elif args.format == "github":
+        sys.stdout.write(report.render_github(found))
+    else:
+        sys.stdout.write(report.render_text(found, len(files)))
+    return EXIT_PROBLEMS if any(d.severity == "error" for d in found) else EXIT_OK
+
+
+def cmd_rules(args: argparse.Namespace) -> int:
+    from ..cli import EXIT_OK, UsageError
+    from . import linter  # noqa: F401 - registers the rules
+
+    if args.code:
+        by_name = {rule.name: rule for rule in RULES.values()}
+        rule = RULES.get(args.code.upper()) or by_name.get(args.code)
+        if rule is None:
+            raise UsageError(f"unknown rule {args.code!r}; 'urdsl rules' lists them")
+        if args.json:
+            print(json.dumps(_rule_dict(rule), indent=2, ensure_ascii=False))
+        else:
+            print(rule.describe())
+        return EXIT_OK
+    if args.json:
+        print(json.dumps([_rule_dict(r) for r in _sorted()], indent=2, ensure_ascii=False))
+        return EXIT_OK
+    if args.short:
+        for rule in _sorted():
+            print(f"{rule.code}  {rule.severity:<8} {rule.name:<26} {rule.summary}")
+        print("\nRun 'urdsl rules CODE' for the explanation of a rule with an example.")
+        return EXIT_OK
+    print("\n\n".join(rule.describe() for rule in _sorted()))
+    return EXIT_OK
+
+
+def _sorted():
+    return sorted(RULES.values(), key=lambda rule: rule.code)
+
+
+def _rule_dict(rule) -> dict:
+    return {
+        "code": rule.code, "name": rule.name, "severity": rule.severity,
+        "summary": rule.summary, "explanation": " ".join(rule.explanation.split()),
+        "example": rule.example, "fixed": rule.fixed,
+    }
+
+
+def cmd_lsp(args: argparse.Namespace) -> int:
+    from .lsp import serve
+
+    serve()
+    return 0

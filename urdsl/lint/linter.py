@@ -1,0 +1,90 @@
+"""Run the rules over one text: parse, analyse the scopes once, call every selected rule.
+
+A syntax error (URS001) stops there: the rules need a tree. A comment ``# noqa`` on a line
+silences every finding on it, ``# noqa: URS112, URS113`` only those codes (as in ruff).
+"""
+
+from __future__ import annotations
+
+import re
+
+from ..script import nodes as n
+from ..script.diagnostics import Diagnostic, ScriptError
+from ..script.parser import parse
+from . import calls, flow, motion, names  # noqa: F401 - importing registers the rules
+from .config import LintSettings, build_settings
+from .context import LintContext
+from .registry import DEPTH_RULE, RULES
+from .scope import analyse
+
+__all__ = ["lint_text", "lint_tree"]
+
+_NOQA = re.compile(r"\s*noqa\b(?:\s*:\s*(?P<codes>[A-Za-z0-9_, \-]+))?", re.IGNORECASE)
+_SEVERITY_ORDER = {"error": 0, "warning": 1, "info": 2}
+
+
+def lint_text(text: str, filename: str = "<string>",
+              settings: LintSettings | None = None) -> list[Diagnostic]:
+    """All findings for URScript ``text``, sorted by place.
+
+    >>> [d.code for d in lint_text("movej([0, 0, 0, 0, 0])")]
+    ['URS108']
+    """
+    try:
+        tree = parse(text, filename)
+    except ScriptError as error:
+        return [error.diagnostic]
+    return lint_tree(tree, settings)
+
+
+def lint_tree(tree: n.Module, settings: LintSettings | None = None) -> list[Diagnostic]:
+    """All findings for a parsed file (its nodes must carry spans)."""
+    settings = settings or build_settings()
+    source = tree.span.source or n.Source("", "<generated>")
+    found: list[Diagnostic] = []
+    skipped: list[str] = []
+    try:
+        analysis = analyse(tree)
+    except RecursionError:
+        analysis = None
+        skipped.append("all")
+    if analysis is not None:
+        ctx = LintContext(source, tree, analysis, settings.model, settings.version)
+        for code, rule in sorted(RULES.items()):
+            if rule.check is None or code not in settings.codes:
+                continue
+            try:
+                found.extend(rule.check(ctx))
+            except RecursionError:
+                skipped.append(code)
+    if skipped and DEPTH_RULE.code in settings.codes:
+        found.append(Diagnostic.at(
+            n.Span(source, 0, 0), f"blocks nest too deeply to lint; skipped: "
+            f"{', '.join(skipped)}", code=DEPTH_RULE.code, severity=DEPTH_RULE.severity,
+            hint="split the deep nesting into functions"))
+    found = _without_noqa(found, tree)
+    unique = {(d.line, d.column, d.code, d.message): d for d in found}
+    return sorted(unique.values(), key=lambda d: (d.line, d.column, d.code))
+
+
+def _without_noqa(found: list[Diagnostic], tree: n.Module) -> list[Diagnostic]:
+    silenced: dict[int, set[str] | None] = {}
+    for node in n.walk(tree):
+        if isinstance(node, n.Comment):
+            match = _NOQA.match(node.text)
+            if match is None:
+                continue
+            codes = match.group("codes")
+            silenced[node.span.line] = (
+                None if codes is None
+                else {c.strip().upper() for c in codes.split(",") if c.strip()}
+            )
+    if not silenced:
+        return found
+    kept = []
+    for diagnostic in found:
+        line = silenced.get(diagnostic.line, set())
+        if line is None or diagnostic.code in line:
+            continue
+        kept.append(diagnostic)
+    return kept

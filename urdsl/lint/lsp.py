@@ -1,0 +1,240 @@
+"""``urdsl lsp``: a Language Server Protocol server for URScript over stdio (pygls).
+
+What an editor gets:
+
+* diagnostics from the linter when a document is opened, changed or saved (the settings of
+  the nearest ``pyproject.toml`` apply, as for ``urdsl lint``);
+* hover: the signature of a builtin (with its first controller version, deprecation and
+  remarks from the catalog), or the ``def`` line of a function of the file;
+* go to definition of functions, threads and global variables;
+* formatting of the whole document with the printer of ``urdsl fmt``.
+
+Positions: LSP counts characters in UTF-16 code units, urdsl in code points; the two agree
+for every character of the Basic Multilingual Plane, which is all URScript ever holds.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from lsprotocol import types
+
+from .. import __version__
+from ..script import nodes as n
+from ..script.builtins import lookup, methods
+from ..script.diagnostics import Diagnostic, ScriptError
+from ..script.parser import parse
+from ..script.printer import format as format_tree
+from .config import ConfigError, LintSettings, build_settings, settings_for
+from .linter import lint_tree
+from .scope import analyse
+
+__all__ = ["build_server", "serve", "to_lsp_diagnostic", "word_at"]
+
+_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_SEVERITY = {
+    "error": types.DiagnosticSeverity.Error,
+    "warning": types.DiagnosticSeverity.Warning,
+    "info": types.DiagnosticSeverity.Information,
+}
+
+
+def to_lsp_diagnostic(diagnostic: Diagnostic) -> types.Diagnostic:
+    """A urdsl finding as an LSP diagnostic (0-based positions, the hint in the message)."""
+    line = max(diagnostic.line - 1, 0)
+    start = max(diagnostic.column - 1, 0)
+    end = (diagnostic.end_column - 1 if diagnostic.end_column and diagnostic.end_column >
+           diagnostic.column else start + 1)
+    message = diagnostic.message if not diagnostic.hint else \
+        f"{diagnostic.message}\nhint: {diagnostic.hint}"
+    return types.Diagnostic(
+        range=types.Range(types.Position(line, start), types.Position(line, end)),
+        message=message, severity=_SEVERITY.get(diagnostic.severity),
+        code=diagnostic.code, source="urdsl",
+    )
+
+
+def word_at(text: str, line: int, character: int) -> str | None:
+    """The name under a 0-based position, or None."""
+    lines = text.split("\n")
+    if not 0 <= line < len(lines):
+        return None
+    for match in _WORD.finditer(lines[line]):
+        if match.start() <= character <= match.end():
+            return match.group(0)
+    return None
+
+
+def _path(uri: str) -> str | None:
+    if not uri.startswith("file:"):
+        return None
+    from urllib.parse import unquote, urlparse
+
+    return unquote(urlparse(uri).path)
+
+
+def _settings(uri: str) -> LintSettings:
+    try:
+        return settings_for(_path(uri))
+    except ConfigError:
+        return build_settings()
+
+
+def lint_document(uri: str, text: str) -> list[types.Diagnostic]:
+    """The LSP diagnostics of a document."""
+    path = _path(uri)
+    name = Path(path).name if path else uri
+    try:
+        tree = parse(text, name)
+    except ScriptError as error:
+        return [to_lsp_diagnostic(error.diagnostic)]
+    return [to_lsp_diagnostic(d) for d in lint_tree(tree, _settings(uri))]
+
+
+def hover_text(text: str, word: str) -> str | None:
+    """Markdown for the name ``word`` in a document: a user ``def`` wins over a builtin."""
+    try:
+        tree = parse(text)
+    except ScriptError:
+        tree = None
+    if tree is not None:
+        analysis = analyse(tree)
+        if word in analysis.functions:
+            definition = analysis.functions[word][-1]
+            params = ", ".join(p.name if p.default is None else f"{p.name}={_source(p.default)}"
+                               for p in definition.params)
+            return f"```urscript\ndef {word}({params})\n```\nfunction defined at line " \
+                   f"{definition.span.line}"
+        if word in analysis.threads:
+            return f"```urscript\nthread {word}()\n```\nthread defined at line " \
+                   f"{analysis.threads[word][-1].span.line}; start it with `run {word}()`"
+    builtin = lookup(word) or methods().get(word)
+    if builtin is None:
+        return None
+    lines = [f"```urscript\n{builtin.signature}\n```"]
+    returns = " | ".join(builtin.returns) if builtin.returns else "None"
+    from .calls import where_available
+
+    lines.append(f"builtin ({builtin.module}), returns {returns}; on {where_available(builtin)}")
+    if builtin.deprecated:
+        replaced = ", ".join(builtin.replaced_by) or "see the manual"
+        lines.append(f"**deprecated**: use {replaced}")
+    if builtin.remarks:
+        lines.append(builtin.remarks)
+    return "\n\n".join(lines)
+
+
+def _source(expr: n.Expr) -> str:
+    span = getattr(expr, "span", n.NO_SPAN)
+    if span.source is None:
+        return "..."
+    return span.source.text[span.start:span.end]
+
+
+def definition_of(text: str, word: str) -> n.Span | None:
+    """Where ``word`` (a function, thread or global variable) is defined in ``text``."""
+    try:
+        tree = parse(text)
+    except ScriptError:
+        return None
+    analysis = analyse(tree)
+    for table in (analysis.functions, analysis.threads, analysis.secs):
+        if word in table:
+            node = table[word][0]
+            return _name_span(node)
+    for scope in analysis.scopes:
+        if word in scope.declared_global:
+            return scope.declared_global[word].span
+    top = analysis.top
+    if word in top.assigned:
+        return top.assigned[word][0].span
+    if word in top.declared_local:
+        return top.declared_local[word].span
+    return None
+
+
+def _name_span(node: n.Node) -> n.Span:
+    span = node.span  # type: ignore[attr-defined]
+    match = re.compile(rf"\b{re.escape(node.name)}\b").search(  # type: ignore[attr-defined]
+        span.source.text, span.start, span.end) if span.source else None
+    return n.Span(span.source, match.start(), match.end()) if match else span
+
+
+def _range(span: n.Span) -> types.Range:
+    """The first line of a span (a definition's name line is what an editor should show)."""
+    line = span.line - 1
+    if span.end_line == span.line:
+        end = span.end_column - 1
+    else:
+        end = len(span.source.line_text(span.line)) if span.source else span.column
+    return types.Range(types.Position(line, span.column - 1), types.Position(line, end))
+
+
+def build_server():
+    """A pygls server with urdsl's features registered (not started)."""
+    from pygls.lsp.server import LanguageServer
+
+    server = LanguageServer("urdsl", __version__,
+                            text_document_sync_kind=types.TextDocumentSyncKind.Full)
+
+    def publish(ls, uri: str) -> None:
+        document = ls.workspace.get_text_document(uri)
+        ls.text_document_publish_diagnostics(types.PublishDiagnosticsParams(
+            uri=uri, version=document.version, diagnostics=lint_document(uri, document.source)))
+
+    @server.feature(types.TEXT_DOCUMENT_DID_OPEN)
+    def did_open(ls, params: types.DidOpenTextDocumentParams) -> None:
+        publish(ls, params.text_document.uri)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
+    def did_change(ls, params: types.DidChangeTextDocumentParams) -> None:
+        publish(ls, params.text_document.uri)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_SAVE)
+    def did_save(ls, params: types.DidSaveTextDocumentParams) -> None:
+        publish(ls, params.text_document.uri)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
+    def did_close(ls, params: types.DidCloseTextDocumentParams) -> None:
+        ls.text_document_publish_diagnostics(types.PublishDiagnosticsParams(
+            uri=params.text_document.uri, diagnostics=[]))
+
+    @server.feature(types.TEXT_DOCUMENT_HOVER)
+    def hover(ls, params: types.HoverParams) -> types.Hover | None:
+        document = ls.workspace.get_text_document(params.text_document.uri)
+        word = word_at(document.source, params.position.line, params.position.character)
+        text = hover_text(document.source, word) if word else None
+        if text is None:
+            return None
+        return types.Hover(contents=types.MarkupContent(types.MarkupKind.Markdown, text))
+
+    @server.feature(types.TEXT_DOCUMENT_DEFINITION)
+    def definition(ls, params: types.DefinitionParams) -> types.Location | None:
+        document = ls.workspace.get_text_document(params.text_document.uri)
+        word = word_at(document.source, params.position.line, params.position.character)
+        span = definition_of(document.source, word) if word else None
+        if span is None or span.source is None:
+            return None
+        return types.Location(params.text_document.uri, _range(span))
+
+    @server.feature(types.TEXT_DOCUMENT_FORMATTING)
+    def formatting(ls, params: types.DocumentFormattingParams) -> list[types.TextEdit] | None:
+        document = ls.workspace.get_text_document(params.text_document.uri)
+        indent = " " * (params.options.tab_size if params.options.insert_spaces else 2)
+        try:
+            formatted = format_tree(parse(document.source), indent=indent)
+        except ScriptError:
+            return None  # the diagnostics already show the syntax error
+        if formatted == document.source:
+            return []
+        lines = document.source.split("\n")
+        end = types.Position(len(lines) - 1, len(lines[-1]))
+        return [types.TextEdit(types.Range(types.Position(0, 0), end), formatted)]
+
+    return server
+
+
+def serve() -> None:
+    """Run the language server on stdin/stdout until the client says exit."""
+    build_server().start_io()

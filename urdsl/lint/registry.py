@@ -1,0 +1,115 @@
+"""The rule registry: every lint rule with its stable code, severity and explanation.
+
+A rule is a small function ``check(ctx) -> Iterator[Diagnostic]`` registered with
+:func:`rule`. Codes never change meaning once published (as in ruff): ``URS001`` is a syntax
+error (raised by the parser, see :mod:`urdsl.script.diagnostics`), ``URS1xx`` are lint rules,
+``URS2xx`` runtime errors of the interpreter and ``URS3xx`` findings of the verifier.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from ..script.diagnostics import Diagnostic
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .context import LintContext
+
+__all__ = ["Rule", "RULES", "rule", "SYNTAX_RULE", "DEPTH_RULE", "expand_codes"]
+
+Check = Callable[["LintContext"], Iterator[Diagnostic]]
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One lint rule. ``example`` triggers it, ``fixed`` is the same code written right."""
+
+    code: str
+    name: str
+    severity: str
+    summary: str
+    explanation: str
+    example: str
+    fixed: str
+    check: Check | None = field(default=None, compare=False, repr=False)
+
+    def describe(self) -> str:
+        """The text of ``urdsl rules CODE``."""
+        lines = [f"{self.code} {self.name} ({self.severity})", "", self.summary, ""]
+        lines += [self.explanation.strip(), "", "Example:"]
+        lines += ["    " + line for line in self.example.strip().splitlines()]
+        lines += ["", "Write instead:"]
+        lines += ["    " + line for line in self.fixed.strip().splitlines()]
+        return "\n".join(lines)
+
+
+RULES: dict[str, Rule] = {}
+"""Every rule by code, in code order (filled as the rule modules are imported)."""
+
+
+SYNTAX_RULE = Rule(
+    code="URS001", name="syntax-error", severity="error",
+    summary="The text is not URScript; the controller rejects the whole program.",
+    explanation="""
+The parser stops at the first token that cannot stand where it is and says what was
+expected. Habits from other languages are named with the URScript way in the hint:
+`for` loops (count with while), `+=` (write x = x + 1), `**` (pow(b, e)), `is`
+(compare with ==), `else if` (elif), f-strings (str_cat and to_str), `=` in a condition
+(compare with ==), a stray or missing bracket (with the place where it was opened).
+No other rule runs on a file with a syntax error, and it is reported whatever --select and
+--ignore say.""",
+    example="p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3])",
+    fixed="p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3]",
+)
+RULES[SYNTAX_RULE.code] = SYNTAX_RULE
+
+DEPTH_RULE = Rule(
+    code="URS100", name="too-deep-to-lint", severity="info",
+    summary="Blocks or expressions nest deeper than the linter follows; some rules skipped.",
+    explanation="""
+urdsl's parser accepts blocks nested thousands deep (generated programs do this), but some
+rules walk the tree recursively and stop at Python's recursion limit. They are skipped for
+that file, and this note says which; every other rule still runs.""",
+    example="if a:\n  if a:\n    ... (2000 levels) ...\n  end\nend",
+    fixed="split the deep nesting into functions",
+)
+RULES[DEPTH_RULE.code] = DEPTH_RULE
+
+
+def rule(
+    code: str, name: str, severity: str, summary: str, explanation: str, example: str,
+    fixed: str,
+) -> Callable[[Check], Check]:
+    """Register the decorated function as the check of rule ``code``."""
+
+    def register(check: Check) -> Check:
+        if code in RULES:  # pragma: no cover - programming error
+            raise ValueError(f"rule {code} registered twice")
+        RULES[code] = Rule(code, name, severity, summary, explanation, example, fixed, check)
+        return check
+
+    return register
+
+
+def expand_codes(selectors: list[str]) -> set[str]:
+    """Rule codes matched by ``selectors``: exact codes, prefixes (``URS1``, ``URS11``), rule
+    names (``unused-variable``) or ``ALL``. Raises ValueError naming an unknown selector."""
+    codes: set[str] = set()
+    by_name = {r.name: r.code for r in RULES.values()}
+    for selector in selectors:
+        text = selector.strip()
+        if not text:
+            continue
+        if text.upper() == "ALL":
+            codes.update(RULES)
+            continue
+        if text in by_name:
+            codes.add(by_name[text])
+            continue
+        matched = {c for c in RULES if c.startswith(text.upper())}
+        if not matched:
+            raise ValueError(f"unknown rule {text!r} (see 'urdsl rules')")
+        codes.update(matched)
+    return codes
