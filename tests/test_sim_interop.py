@@ -93,10 +93,11 @@ def standard_sim(tmp_path_factory):
 
 
 def _send_script(text: str) -> None:
-    """Send a program with urdsl's sender (``urdsl send`` uses the same function)."""
+    """Send a program with urdsl's sender (``urdsl send`` uses the same function); do not
+    follow it: the test watches the arm itself."""
     from urdsl.robot.sender import send_program
 
-    send_program(text, "127.0.0.1")
+    send_program(text, "127.0.0.1", follow=False)
 
 
 def _eventually(condition, timeout: float = 2.0) -> None:

@@ -413,11 +413,11 @@ def test_urdsl_protocol_decoders_read_the_simulators_realtime_and_primary_stream
     realtime = pytest.importorskip("urdsl.protocol.realtime")
     primary = pytest.importorskip("urdsl.protocol.primary")
     sock = connect(sim, "realtime")
-    state = realtime.decode_realtime(realtime_packet(sock))
+    state = realtime.decode_realtime(realtime_packet(sock), "5.15")
     sock.close()
     assert state.size == 1220 and state.robot_mode == 7 and state.safety_mode == 1
     assert np.allclose(state.q_actual, sim.snapshot().q)
-    assert np.allclose(state.tcp_pose, sim.snapshot().tcp)
+    assert np.allclose(state.tool_vector_actual, sim.snapshot().tcp)
 
     sock = connect(sim, "primary")
     decoder = primary.PrimaryDecoder()

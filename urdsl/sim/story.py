@@ -157,7 +157,8 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
         recorder = threading.Thread(target=run_recorder, name="urdsl-story-rtde", daemon=True)
         recorder.start()
         time.sleep(0.3)  # the recorder is streaming before the program starts
-        send_program(text, "127.0.0.1", servers.ports["secondary"])
+        # checked above; the recording watches it, so the sender need not follow it
+        send_program(text, "127.0.0.1", servers.ports["secondary"], check=False, follow=False)
         result.sent = True
         recorder.join(duration + 10)
         result.messages = [f"{m.kind}: {m.text}" for m in sim.messages]
