@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from urdsl.motion.geometry import rotation_matrix
+from urdsl.kinematics.pose import matrix_to_rotvec, rotvec_to_matrix
 from urdsl.motion.planner import MotionPlanner
 from urdsl.motion.profiles import Trapezoid
 from urdsl.motion.trace import sample
@@ -36,16 +36,14 @@ class Gantry:
 
     def fk(self, q, tcp=None):
         matrix = np.eye(4)
-        matrix[:3, :3] = rotation_matrix(q[3:])
+        matrix[:3, :3] = rotvec_to_matrix(q[3:])
         matrix[:3, 3] = q[:3]
         return matrix
 
     def ik(self, pose, q_near, tcp=None):
-        from urdsl.motion.geometry import _log
-
         if not self.reachable(pose[:3, 3]):
             raise OutOfReach(pose[:3, 3])
-        return np.concatenate([pose[:3, 3], _log(pose[:3, :3])])
+        return np.concatenate([pose[:3, 3], matrix_to_rotvec(pose[:3, :3])])
 
     def ik_many(self, poses, q_near, tcp=None):
         result = np.array([self.ik(p, None) if self.reachable(p[:3, 3]) else np.full(6, np.nan)

@@ -17,7 +17,6 @@ import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from ..script import build
 from ..script import nodes as n
 from ..script.builtins import lookup
 from ..script.printer import format as format_tree
@@ -345,27 +344,16 @@ class Program:
             return
         row = lookup(name)
         if row is None:
+            import difflib
+
+            from ..script.builtins import catalog
+
+            close = difflib.get_close_matches(name, list(catalog()) + sorted(self._functions))
             raise DslError(f"{name!r} is not a URScript builtin or a function of this program",
-                           "see `urdsl parse --help` or the builtin catalog for the names")
-        if not row.callable:
-            raise DslError(f"{name} is a command of the interpreter socket, not a function")
-        if row.variadic_keywords:
-            return
-        names = [p.name for p in row.params]
-        if len(args) > row.max_args:
-            raise DslError(f"{row.signature} takes at most {row.max_args} arguments, "
-                           f"{len(args)} given")
-        for key in keywords:
-            if key not in names:
-                raise DslError(f"{name}() has no parameter {key!r}",
-                               f"the signature is {row.signature}")
-            if names.index(key) < len(args):
-                raise DslError(f"{name}() got {key!r} twice", f"the signature is {row.signature}")
-        given = set(names[:len(args)]) | set(keywords)
-        missing = [p.name for p in row.params if not p.optional and p.name not in given]
-        if missing:
-            raise DslError(f"{name}() needs argument {missing[0]!r}",
-                           f"the signature is {row.signature}")
+                           f"did you mean {', '.join(close)}?" if close else None)
+        problem = row.argument_problem(len(args), keywords)
+        if problem is not None:
+            raise DslError(*problem)
 
     # ---- variables -------------------------------------------------------------------------
 
@@ -529,6 +517,3 @@ class Program:
         if '"' in text:
             raise DslError("a marker text cannot contain '\"'")
         self._append(n.Marker(number, text, flag))
-
-    # builder helpers kept public for power users
-    literal = staticmethod(build.literal)

@@ -380,7 +380,7 @@ class MotionPlanner:
 
     def speedl(self, xd: np.ndarray, a: float, t: float, span: Span, now: float) -> float:
         """Tool speed ``xd`` (m/s, rad/s in Base) like :meth:`speedj`, as a straight line."""
-        from .geometry import rotation_matrix
+        from ..kinematics.pose import rotvec_to_matrix
 
         xd = np.asarray(xd, dtype=float)
         linear = float(np.linalg.norm(xd[:3]))
@@ -392,7 +392,7 @@ class MotionPlanner:
         pose_from = self._end_matrix()
         pose = pose_from.copy()
         pose[:3, 3] += xd[:3] * t
-        pose[:3, :3] = rotation_matrix(xd[3:] * t) @ pose_from[:3, :3]
+        pose[:3, :3] = rotvec_to_matrix(xd[3:] * t) @ pose_from[:3, :3]
         end = self.movel(pose, a, speed, 0.0, 0.0, span, now, kind="speedl")
         return end - min(speed / a, end - now)
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Trace", "sample", "joints_at"]
+__all__ = ["Trace", "sample", "joints_at", "tcp_groups"]
 
 
 @dataclass
@@ -49,7 +49,6 @@ def _displacements(planner, times: np.ndarray):
     profiles and straight TCP paths vectorised, and one batched inverse-kinematics call for
     every Cartesian sample of the program.
     """
-    from .geometry import _exp_many, _log
     from .planner import JOINT_SPACE
     from .profiles import positions as profile_positions
     from .profiles import speeds as profile_speeds
@@ -94,15 +93,15 @@ def _displacements(planner, times: np.ndarray):
             knots = _knots(planner, segments, seg_rows, local, lengths, times[1] - times[0]
                            if count > 1 else 1.0, phase)
             knot_rows = rows[knots]
-            moved[knot_rows] = _cartesian(planner, segments, entry_segment[knot_rows],
-                                          fraction[knot_rows], q_start, moved[knot_rows],
-                                          _exp_many, _log)
+            paths = _Paths(segments)
+            moved[knot_rows] = _cartesian(planner, paths, entry_segment[knot_rows],
+                                          fraction[knot_rows], q_start, moved[knot_rows])
             if not knots.all():
                 speed = profile_speeds(local_t[knot_rows], p[knot_rows, 0], p[knot_rows, 1],
                                        p[knot_rows, 2], p[knot_rows, 3], p[knot_rows, 4])
-                velocity = _joint_velocities(planner, segments, entry_segment[knot_rows],
-                                             q_start, moved[knot_rows], fraction[knot_rows],
-                                             speed / p[knot_rows, 0], _exp_many, _log)
+                velocity = _joint_velocities(planner, paths, entry_segment[knot_rows],
+                                             q_start, moved[knot_rows],
+                                             speed / p[knot_rows, 0])
                 _hermite(moved, times[entry_sample], rows, knots, velocity)
             gaps = np.isnan(moved[rows]).any(axis=1)
             if gaps.any():
@@ -145,8 +144,7 @@ def _knots(planner, segments, seg_rows, local, lengths, dt, phase) -> np.ndarray
             | change)
 
 
-def _joint_velocities(planner, segments, which, q_start, moved, fraction, fraction_rate,
-                      exp_many, log) -> np.ndarray:
+def _joint_velocities(planner, paths, which, q_start, moved, fraction_rate) -> np.ndarray:
     """Joint speeds (M, 6) rad/s at solved samples of straight TCP paths: the twist of the
     path (linear ``(p1 − p0)·ḟ``, angular ``R0·w·ḟ`` with ``w = log(R0ᵀR1)``) through the
     damped inverse of the TCP Jacobian. ``fraction_rate`` is ḟ in 1/s."""
@@ -158,16 +156,15 @@ def _joint_velocities(planner, segments, which, q_start, moved, fraction, fracti
     if not good.any():
         return velocity
     q, which, rate = q[good], which[good], fraction_rate[good]
-    linear = np.array([s.pose_end[:3, 3] - s.pose_start[:3, 3] for s in segments])
-    angular = np.array([s.pose_start[:3, :3] @ log(s.pose_start[:3, :3].T @ s.pose_end[:3, :3])
-                        for s in segments])
-    twist = np.concatenate([linear[which], angular[which]], axis=1) * rate[:, None]
+    angular = (paths.r0 @ paths.w[:, :, None])[:, :, 0]
+    twist = np.concatenate([paths.p1[which] - paths.p0[which], angular[which]],
+                           axis=1) * rate[:, None]
     block = 4096  # rows per pass: the (block, 7, 4, 4) frames stay in the CPU's cache
+    rows_good = np.flatnonzero(good)
     for begin in range(0, len(q), block):
         rows = slice(begin, begin + block)
-        velocity_rows = _damped_solve(planner, segments, which[rows], q[rows], twist[rows],
-                                      posemath)
-        velocity[np.flatnonzero(good)[rows]] = velocity_rows
+        velocity[rows_good[rows]] = _damped_solve(planner, paths.segments, which[rows],
+                                                  q[rows], twist[rows], posemath)
     return velocity
 
 
@@ -205,41 +202,63 @@ def _hermite(moved, entry_time, rows, knots, velocity) -> None:
                           + (s3 - s2) * h * velocity[right])
 
 
-def _cartesian(planner, segments, which, fraction, q_start, linear, exp_many, log):
-    """Joint displacements of samples on TCP paths: poses along each path, then one batched
-    IK call; each sample takes the solution closest to the joint-space interpolation of its
-    move's ends (``linear``), which keeps the arm on the branch of its end points."""
+class _Paths:
+    """What the sampling needs of every move, as arrays indexed by move: path ends ``p0``,
+    ``p1`` (m), start rotation ``r0``, rotation step ``w = log(R0ᵀR1)`` (rad), whether it is an
+    arc, and a TCP group number (moves with the same TCP share one)."""
+
+    def __init__(self, segments) -> None:
+        from ..kinematics.pose import matrix_to_rotvec
+
+        self.segments = segments
+        starts = np.array([s.pose_start for s in segments])
+        ends = np.array([s.pose_end for s in segments])
+        self.p0, self.p1 = starts[:, :3, 3], ends[:, :3, 3]
+        self.r0 = starts[:, :3, :3]
+        self.w = matrix_to_rotvec(np.swapaxes(self.r0, 1, 2) @ ends[:, :3, :3])
+        self.arc = np.array([s.kind == "movec" and s.via is not None for s in segments])
+        self.tcp_group, self.tcps = tcp_groups(segments)
+
+
+def tcp_groups(segments) -> tuple[np.ndarray, list]:
+    """Moves grouped by their TCP: the group number of each move (an int array) and each
+    group's TCP (a pose in the flange frame, or None for the flange)."""
+    groups: dict = {}
+    tcps: list = []
+    numbers = []
+    for segment in segments:
+        key = None if segment.tcp is None else tuple(segment.tcp)
+        if key not in groups:
+            groups[key] = len(groups)
+            tcps.append(None if key is None else np.array(key))
+        numbers.append(groups[key])
+    return np.array(numbers, dtype=np.int64), tcps
+
+
+def _cartesian(planner, paths, which, fraction, q_start, linear):
+    """Joint displacements of samples on TCP paths: poses along each path, then batched IK
+    (one call per TCP); each sample takes the solution closest to the joint-space
+    interpolation of its move's ends (``linear``), which keeps the arm on the branch of its
+    end points."""
+    from ..kinematics.pose import rotvec_to_matrix
+
     poses = np.repeat(np.eye(4)[None], len(which), axis=0)
-    for index in np.unique(which):
-        segment = segments[index]
+    arc = paths.arc[which]
+    for index in np.unique(which[arc]):  # arcs (rare): one call per move
         rows = np.flatnonzero(which == index)
-        if segment.kind == "movec" and segment.via is not None:
-            poses[rows] = segment.path_poses(fraction[rows])
-    plain = np.array([segments[i].kind != "movec" or segments[i].via is None for i in which])
-    if plain.any():
-        unique = np.unique(which[plain])
-        p0 = np.zeros((len(segments), 3))
-        p1 = np.zeros((len(segments), 3))
-        r0 = np.zeros((len(segments), 3, 3))
-        w = np.zeros((len(segments), 3))
-        for index in unique:
-            segment = segments[index]
-            p0[index], p1[index] = segment.pose_start[:3, 3], segment.pose_end[:3, 3]
-            r0[index] = segment.pose_start[:3, :3]
-            w[index] = log(segment.pose_start[:3, :3].T @ segment.pose_end[:3, :3])
-        rows = np.flatnonzero(plain)
+        poses[rows] = paths.segments[index].path_poses(fraction[rows])
+    rows = np.flatnonzero(~arc)
+    if len(rows):
         seg, f = which[rows], fraction[rows][:, None]
-        poses[rows, :3, 3] = p0[seg] + f * (p1[seg] - p0[seg])
-        poses[rows, :3, :3] = r0[seg] @ exp_many(f * w[seg])
+        poses[rows, :3, 3] = paths.p0[seg] + f * (paths.p1[seg] - paths.p0[seg])
+        poses[rows, :3, :3] = paths.r0[seg] @ rotvec_to_matrix(f * paths.w[seg])
     near = q_start[which] + linear
     solutions = np.empty((len(which), 6))
-    tcps = [None if s.tcp is None else tuple(s.tcp) for s in segments]
-    keys = np.array([hash(tcps[i]) for i in which])
-    for key in np.unique(keys):
-        rows = np.flatnonzero(keys == key)
-        tcp = tcps[which[rows[0]]]
-        solutions[rows] = planner.kinematics.ik_many(
-            poses[rows], near[rows], tcp=None if tcp is None else np.array(tcp))
+    groups = paths.tcp_group[which]
+    for group in np.unique(groups):
+        rows = np.flatnonzero(groups == group)
+        solutions[rows] = planner.kinematics.ik_many(poses[rows], near[rows],
+                                                     tcp=paths.tcps[group])
     return solutions - q_start[which]
 
 

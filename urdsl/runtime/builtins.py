@@ -72,30 +72,14 @@ class BuiltinTable:
 
     def bind(self, row: Builtin, args: list, named: dict, node: Node) -> dict[str, Any]:
         rt = self.rt
-        if not row.callable:
-            raise rt.error("call", f"'{row.name}' is a command of the interpreter socket, "
-                           "not a function", node)
+        problem = row.argument_problem(len(args), named)
+        if problem is not None:
+            message, hint = problem
+            raise rt.error("call" if not row.callable else "arguments", message, node, hint)
         if row.variadic_keywords:
-            if args:
-                raise rt.error("arguments", f"{row.name}() takes only name=value arguments",
-                               node)
             return {"__members__": named}
-        params = row.params
-        if len(args) > len(params):
-            raise rt.error("arguments", f"{row.signature} takes at most {len(params)} "
-                           f"arguments, {len(args)} given", node)
-        bound = {param.name: value for param, value in zip(params, args, strict=False)}
-        for key, value in named.items():
-            if row.param(key) is None:
-                raise rt.error("arguments", f"{row.name}() has no parameter '{key}'", node,
-                               f"the signature is {row.signature}")
-            if key in bound:
-                raise rt.error("arguments", f"{row.name}() got '{key}' twice", node)
-            bound[key] = value
-        for param in params:
-            if param.name not in bound and not param.optional:
-                raise rt.error("arguments", f"{row.name}() needs argument '{param.name}'",
-                               node, f"the signature is {row.signature}")
+        bound = {param.name: value for param, value in zip(row.params, args, strict=False)}
+        bound.update(named)
         return bound
 
     def unsupported(self, row: Builtin, node: Node) -> Any:

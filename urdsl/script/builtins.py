@@ -108,6 +108,34 @@ class Builtin:
         """The parameter called ``name``, if there is one."""
         return next((p for p in self.params if p.name == name), None)
 
+    def argument_problem(self, positional: int, keywords) -> tuple[str, str | None] | None:
+        """What is wrong with a call giving ``positional`` arguments and the ``keywords``
+        names, as ``(message, hint)``; None when the call fits the signature. The one rule
+        for the interpreter and the DSL."""
+        if not self.callable:
+            return (f"'{self.name}' is a command of the interpreter socket, not a function",
+                    None)
+        if self.variadic_keywords:
+            if positional:
+                return f"{self.name}() takes only name=value arguments", None
+            return None
+        names = [p.name for p in self.params]
+        if positional > len(names):
+            return (f"{self.signature} takes at most {len(names)} arguments, {positional} "
+                    "given"), None
+        for key in keywords:
+            if key not in names:
+                return (f"{self.name}() has no parameter '{key}'",
+                        f"the signature is {self.signature}")
+            if names.index(key) < positional:
+                return f"{self.name}() got '{key}' twice", f"the signature is {self.signature}"
+        given = set(names[:positional]) | set(keywords)
+        for param in self.params:
+            if param.name not in given and not param.optional:
+                return (f"{self.name}() needs argument '{param.name}'",
+                        f"the signature is {self.signature}")
+        return None
+
     def first_versions(self) -> dict[str, Version | None]:
         """First version per series (``"cb"``, ``"e"``, ``"x"``) that has this builtin;
         a series missing from the dict does not have it; ``None`` means "from the first

@@ -21,13 +21,9 @@ JOINTS = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
 def _per_segment(trace: Trace, mask: np.ndarray):
     """(segment index, first sample index) for each move with a flagged sample."""
     flagged = np.flatnonzero(mask.any(axis=1) if mask.ndim == 2 else mask)
-    seen: set[int] = set()
-    for sample in flagged:
-        segment = int(trace.segment[sample])
-        if segment in seen:
-            continue
-        seen.add(segment)
-        yield segment, int(sample)
+    segments, first = np.unique(trace.segment[flagged], return_index=True)
+    for order in np.argsort(first):  # in time order, one per move
+        yield int(segments[order]), int(flagged[first[order]])
 
 
 def _span(trace: Trace, segment: int):
@@ -179,16 +175,16 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
 def _tcp_positions(trace: Trace, robot, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """TCP positions (M, 3) in m for every ``stride``-th sample, with the sample indices;
     each sample uses the TCP that was active for its move."""
+    from ..motion.trace import tcp_groups
+
     index = np.arange(0, len(trace.times), stride)
     positions = np.empty((len(index), 3))
-    tcps = [None if s.tcp is None else tuple(s.tcp) for s in trace.segments]
-    segment_of = trace.segment[index]
-    tcp_of = np.array([hash(tcps[i]) if i >= 0 else hash(None) for i in segment_of])
-    for key in np.unique(tcp_of):
-        rows = tcp_of == key
-        first = segment_of[rows][0]
-        tcp = None if first < 0 or tcps[first] is None else np.array(tcps[first])
-        positions[rows] = robot.fk_many(trace.q[index[rows]], tcp=tcp)[:, :3, 3]
+    group_of_move, tcps = tcp_groups(trace.segments)
+    # samples at rest before the first move (-1) use the first move's TCP
+    group = np.append(group_of_move, group_of_move[:1])[trace.segment[index]]
+    for number in np.unique(group):
+        rows = group == number
+        positions[rows] = robot.fk_many(trace.q[index[rows]], tcp=tcps[number])[:, :3, 3]
     return positions, index
 
 
