@@ -233,3 +233,47 @@ def test_duplicate_obstacle_names_and_bad_joints():
         model.add_box((1, 1, 1), (0, 0, 0, 0, 0, 0), "floor")
     with pytest.raises(KinematicsError, match=r"\(N, 6\)"):
         model.check(np.zeros((2, 5)))
+
+
+@pytest.mark.parametrize("name", ["ur5", "ur5e", "ur20"])
+def test_levers_bound_how_fast_clearances_change(name, tmp_path):
+    """The sweep's premise: between two joint vectors, no clearance (link-link or
+    link-obstacle) changes by more than twice the joints' travel weighted by the levers."""
+    cell = tmp_path / "cell.toml"
+    cell.write_text('[floor]\nheight = -0.05\n[[box]]\nname = "b"\nsize = [0.2, 0.2, 0.2]\n'
+                    'pose = [0.5, 0.2, 0.3, 0, 0, 0]\n[tool]\nradius = 0.03\n')
+    model = CollisionModel(Robot.model(name))
+    model.load_cell(cell)
+    tcp = [0.0, 0.0, 0.15, 0.0, 0.0, 0.0]
+    rng = np.random.default_rng(7)
+    q = rng.uniform(-np.pi, np.pi, (300, 6))
+    step = rng.normal(0.0, 0.05, (300, 6))
+    model.check(q[:1], tcp=tcp)  # builds the geometry with the tool
+    levers = model.levers()
+    for a, b in zip(q, q + step, strict=True):
+        before, after = model.distances(a, tcp=tcp), model.distances(b, tcp=tcp)
+        bound = 2.0 * float(np.abs(b - a) @ levers)
+        change = max(abs(after[pair] - before[pair]) for pair in before)
+        assert change <= bound + 1e-9
+
+
+def test_sweep_finds_what_checking_every_sample_finds():
+    """A path that dips into a box and rises again: the sweep skips the free stretches but
+    finds the contact, and agrees with checking every sample about where it is."""
+    robot = Robot.model("ur5e")
+    model = CollisionModel(robot)
+    t = np.linspace(0.0, 1.0, 2001)[:, None]
+    path = HOME + np.array([0.0, 1.0, 0.5, 0.0, 0.0, 0.0]) * np.sin(np.pi * t)
+    lowest = robot.fk_many(path[1000:1001])[0, :3, 3]   # the flange at the bottom of the dip
+    model.add_box([0.3, 0.3, 0.1], [lowest[0], lowest[1], lowest[2] - 0.02, 0, 0, 0], "box")
+    dense = model.check(path)
+    assert not dense.colliding[0] and not dense.colliding[-1]
+    index, result = model.sweep(path, stride=5)
+    assert len(index) < len(path) / 5   # fewer checks than every 5th sample
+    assert dense.colliding.any() and result.colliding.any()
+    first_dense = int(np.argmax(dense.colliding))
+    first_sweep = int(index[np.argmax(result.colliding)])
+    assert first_dense <= first_sweep < first_dense + 5
+    np.testing.assert_array_equal(result.distance, dense.distance[index])
+    at_rest = np.repeat(HOME[None], 500, axis=0)
+    assert len(model.sweep(at_rest)[0]) == 1   # nothing moves: one check

@@ -201,3 +201,46 @@ def test_same_solutions_as_ur_analytic_ik(name):
         assert len(ours) == len(theirs), q
         for solution in theirs:
             assert np.min(np.max(np.abs(wrap(ours - solution)), axis=1)) < 1e-7
+
+
+def _choose_one_by_one(solutions, q_first, q_min, q_max):
+    from urdsl.kinematics.ik import choose_nearest
+
+    chosen = np.full((len(solutions), 6), np.nan)
+    found = np.zeros(len(solutions), dtype=bool)
+    near = np.asarray(q_first, dtype=float)
+    for row in range(len(solutions)):
+        q, ok = choose_nearest(solutions[row:row + 1], near[None], q_min, q_max)
+        if not ok[0]:
+            break
+        chosen[row], found[row], near = q[0], True, q[0]
+    return chosen, found
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.floats(0.0, 0.3),
+       st.integers(1, 8))
+def test_choose_sequence_is_the_row_by_row_choice(seed, count, missing, rounds):
+    """Batched rounds give exactly the controller's move-by-move choice, also when branches
+    are missing, a target has no solution at all, or the rounds run out."""
+    from urdsl.kinematics.ik import choose_sequence
+
+    rng = np.random.default_rng(seed)
+    robot = Robot.model("ur5e")
+    # a wandering path of nearby solutions: every branch stays close to its neighbours,
+    # and other branches lie about π away, so the choice can change branch
+    walk = np.cumsum(rng.normal(0.0, 0.4, (count, 1, 6)), axis=0)
+    solutions = walk + rng.choice([0.0, np.pi, -np.pi], (count, 8, 6)) \
+        + rng.normal(0.0, 0.3, (count, 8, 6))
+    scattered = rng.random(count) < rng.random()  # or anywhere: every choice depends on near
+    solutions[scattered] = rng.uniform(-np.pi, np.pi, (int(scattered.sum()), 8, 6))
+    solutions[rng.random((count, 8)) < missing] = np.nan
+    if rng.random() < 0.3:
+        solutions[rng.integers(count)] = np.nan  # a target out of reach
+    q_first = rng.uniform(-3.0, 3.0, 6)
+    expected, expected_found = _choose_one_by_one(solutions, q_first, robot.q_min,
+                                                  robot.q_max)
+    chosen, found = choose_sequence(solutions, q_first, robot.q_min, robot.q_max,
+                                    rounds=rounds)
+    np.testing.assert_array_equal(found, expected_found)
+    np.testing.assert_array_equal(chosen, expected)

@@ -330,15 +330,20 @@ class CollisionModel:
         self._geometry_data = pin.GeometryData(geometry)
         self._pair_names = names
 
-    def check(self, Q, tcp=None, margin: float = 0.0) -> CollisionResult:
-        """Check joint vectors ``Q`` (N, 6) [rad]: the smallest signed distance [m] per
-        sample and, where it is ≤ ``margin`` [m], the pairs involved. ``tcp`` (pose in the
-        flange frame) places the tool capsule when a tool radius is set."""
+    @staticmethod
+    def _joint_vectors(Q) -> np.ndarray:
         Q = np.asarray(Q, dtype=float)
         if Q.ndim == 1:
             Q = Q[None]
         if Q.ndim != 2 or Q.shape[1] != 6 or not np.all(np.isfinite(Q)):
             raise KinematicsError(f"Q must be finite joint vectors of shape (N, 6), got {Q.shape}")
+        return Q
+
+    def check(self, Q, tcp=None, margin: float = 0.0) -> CollisionResult:
+        """Check joint vectors ``Q`` (N, 6) [rad]: the smallest signed distance [m] per
+        sample and, where it is ≤ ``margin`` [m], the pairs involved. ``tcp`` (pose in the
+        flange frame) places the tool capsule when a tool radius is set."""
+        Q = self._joint_vectors(Q)
         self._build(tcp)
         model, data = self.model, self.data
         geometry, geometry_data, names = self._geometry, self._geometry_data, self._pair_names
@@ -357,6 +362,66 @@ class CollisionModel:
                 pairs[i] = [names[j] for j, result in enumerate(results)
                             if result.min_distance <= margin]
         return CollisionResult(distance, closest, pairs, margin)
+
+    def sweep(self, Q, tcp=None, stride: int = 1, margin: float = 0.0
+              ) -> tuple[np.ndarray, CollisionResult]:
+        """Check a sampled path ``Q`` (N, 6) [rad] every ``stride``-th sample, or further
+        apart where no contact is possible in between (conservative advancement): with a
+        clearance ``d`` [m] at one sample, no point of the arm can have
+        moved ``d / 2`` before the joints have travelled ``Σ_k |Δq_k|·R_k = d / 2``, where
+        ``R_k`` bounds how far from joint k's axis anything it moves reaches
+        (:meth:`levers`); two links close in on each other at most twice as fast as one
+        moves. An arm at rest is checked once.
+
+        Returns the indices of the checked samples and their :class:`CollisionResult`.
+        """
+        Q = self._joint_vectors(Q)
+        self._build(tcp)
+        stride = max(int(stride), 1)
+        levers = self.levers()
+        travel = np.zeros(len(Q))
+        if len(Q) > 1:
+            np.cumsum(np.abs(np.diff(Q, axis=0)) @ levers, out=travel[1:])
+        model, data = self.model, self.data
+        geometry, geometry_data, names = self._geometry, self._geometry_data, self._pair_names
+        results = geometry_data.distanceResults
+        index: list[int] = []
+        distance: list[float] = []
+        closest: list[tuple[str, str]] = []
+        pairs: dict[int, list[tuple[str, str]]] = {}
+        i, n = 0, len(Q)
+        while i < n:
+            k = pin.computeDistances(model, data, geometry, geometry_data, Q[i])
+            value = results[k].min_distance
+            if value <= margin:
+                pairs[len(index)] = [names[j] for j, result in enumerate(results)
+                                     if result.min_distance <= margin]
+            index.append(i)
+            distance.append(value)
+            closest.append(names[k])
+            ahead = i + stride
+            if value > margin:  # samples before `safe` moved the arm by less than half of it
+                safe = int(np.searchsorted(travel, travel[i] + 0.5 * (value - margin),
+                                           side="left"))
+                ahead = max(ahead, safe)
+            i = ahead
+        return np.array(index, dtype=np.int64), CollisionResult(
+            np.array(distance), closest, pairs, margin)
+
+    def levers(self) -> np.ndarray:
+        """(6,) [m]: for each joint, a bound on the distance from its axis of every point
+        that it moves (the bodies after it in the chain, and the tool): the lengths of the
+        joint placements in between plus the body's bounding sphere seen from its joint."""
+        placements = [float(np.linalg.norm(p.translation)) for p in self.model.jointPlacements]
+        levers = np.zeros(6)
+        for body in self._links + self._tool:
+            body.shape.computeLocalAABB()
+            centre = body.placement.act(np.asarray(body.shape.aabb_center, dtype=float))
+            radius = float(np.linalg.norm(centre)) + float(body.shape.aabb_radius)
+            for joint in range(1, body.joint + 1):
+                reach = sum(placements[joint + 1:body.joint + 1]) + radius
+                levers[joint - 1] = max(levers[joint - 1], reach)
+        return levers
 
     def distances(self, q, tcp=None) -> dict[tuple[str, str], float]:
         """Every checked pair's signed distance [m] at one joint vector ``q`` (6,) (the

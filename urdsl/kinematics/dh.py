@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["fk_ur", "dh_frames", "dh_transforms"]
+__all__ = ["fk_ur", "ur_axes", "dh_frames", "dh_transforms"]
 
 
 #: Joint vectors per block: the temporaries stay in the CPU cache (1.8x faster than one
@@ -78,6 +78,49 @@ def _fk_ur_block(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: 
     out[:, 2, 3] = d1 + v - d5 * cc + d6 * z6z
     out[:, 3, :3] = 0.0
     out[:, 3, 3] = 1.0
+
+
+def ur_axes(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
+            d6: float) -> tuple[np.ndarray, np.ndarray]:
+    """Joint axes and origins of a nominal UR arm in closed form (the same structure as
+    :func:`fk_ur`): axes ``z_0…z_5`` (N, 6, 3) — unit vectors, joint ``i + 1`` turns about
+    ``z_i`` — and the origins ``o_0…o_6`` (N, 7, 3) [m] of DH frames 0…6 (``o_6`` is the
+    flange). With ``n1 = (s1, −c1, 0)`` (the shoulder axis, shared by joints 2, 3 and 4)::
+
+        z_0 = (0, 0, 1),  z_1 = z_2 = z_3 = n1,  z_4 = z5 of fk_ur,  z_5 = z6 of fk_ur
+        o_1 = (0, 0, d1),  o_2 = o_1 + a2·(c1·c2, s1·c2, s2),  o_3 = (c1·u, s1·u, d1 + v)
+        o_4 = o_3 + d4·n1,  o_5 = o_4 + d5·z_4,  o_6 = o_5 + d6·z_5
+
+    These are the columns of the geometric Jacobian without any 4x4 product (much faster
+    than :func:`dh_frames` for many joint vectors).
+    """
+    q = np.asarray(q, dtype=float)
+    n = q.shape[0]
+    c, s = np.cos(q), np.sin(q)
+    c1, s1, c2, s2, c5, s5 = c[:, 0], s[:, 0], c[:, 1], s[:, 1], c[:, 4], s[:, 4]
+    q23 = q[:, 1] + q[:, 2]
+    q234 = q23 + q[:, 3]
+    c23, s23 = np.cos(q23), np.sin(q23)
+    cc, ss = np.cos(q234), np.sin(q234)
+    u = a2 * c2 + a3 * c23
+    v = a2 * s2 + a3 * s23
+    axes = np.zeros((n, 6, 3))
+    axes[:, 0, 2] = 1.0
+    axes[:, 1:4, 0] = s1[:, None]
+    axes[:, 1:4, 1] = -c1[:, None]
+    axes[:, 4, 0], axes[:, 4, 1], axes[:, 4, 2] = c1 * ss, s1 * ss, -cc
+    axes[:, 5, 0] = s1 * c5 - c1 * cc * s5
+    axes[:, 5, 1] = -c1 * c5 - s1 * cc * s5
+    axes[:, 5, 2] = -ss * s5
+    origins = np.zeros((n, 7, 3))
+    origins[:, 1, 2] = d1
+    origins[:, 2, 0], origins[:, 2, 1], origins[:, 2, 2] = a2 * c1 * c2, a2 * s1 * c2, \
+        d1 + a2 * s2
+    origins[:, 3, 0], origins[:, 3, 1], origins[:, 3, 2] = c1 * u, s1 * u, d1 + v
+    origins[:, 4] = origins[:, 3] + d4 * axes[:, 1]
+    origins[:, 5] = origins[:, 4] + d5 * axes[:, 4]
+    origins[:, 6] = origins[:, 5] + d6 * axes[:, 5]
+    return axes, origins
 
 
 def dh_transforms(q: np.ndarray, theta_offset: np.ndarray, a: np.ndarray, d: np.ndarray,

@@ -33,7 +33,7 @@ import numpy as np
 from . import pose as _pose
 from .dh import dh_frames
 
-__all__ = ["solve_ur", "wrap", "choose_nearest", "refine"]
+__all__ = ["solve_ur", "wrap", "choose_nearest", "choose_sequence", "refine"]
 
 #: Poses out of reach by less than this [m] are treated as on the boundary (rounding).
 REACH_TOLERANCE = 1e-9
@@ -221,6 +221,61 @@ def choose_nearest(solutions: np.ndarray, q_near: np.ndarray, q_min: np.ndarray,
         block = slice(start, start + BLOCK)
         chosen[block], found[block] = _choose_block(solutions[block], q_near[block], q_min,
                                                     q_max)
+    return chosen, found
+
+
+def choose_sequence(solutions: np.ndarray, q_first: np.ndarray, q_min: np.ndarray,
+                    q_max: np.ndarray, rounds: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """The controller's choices along a sequence of targets (N, K, 6): target 0 takes the
+    solution closest to ``q_first`` (6,), each later target the one closest to the choice
+    before it — as :func:`choose_nearest` row by row, but in batches.
+
+    Every round chooses all rows at once, each from the previous round's choice of the row
+    before it. A prefix on which two rounds agree is consistent and therefore final (row 0 is
+    always right, and a row chosen from a final row is final); the next round starts at the
+    first row that changed. Toolpaths settle in two or three rounds; after ``rounds`` the
+    rest is chosen row by row. Rows after the first row without a solution are NaN.
+
+    Returns ``(q, found)`` like :func:`choose_nearest`.
+    """
+    n = solutions.shape[0]
+    chosen = np.full((n, 6), np.nan)
+    found = np.zeros(n, dtype=bool)
+    if n == 0:
+        return chosen, found
+    first = np.asarray(q_first, dtype=float)
+    start = 0  # rows before it are final
+    guess, _ = choose_nearest(solutions, np.broadcast_to(first, (n, 6)), q_min, q_max)
+    for _ in range(rounds):
+        near = np.empty((n - start, 6))
+        near[0] = first if start == 0 else chosen[start - 1]
+        near[1:] = guess[start:-1]
+        new, ok = choose_nearest(solutions[start:], near, q_min, q_max)
+        same = ((new == guess[start:]) | (np.isnan(new) & np.isnan(guess[start:]))).all(axis=1)
+        # row 0 of a round is final; row j + 1 is, if row j is and did not change
+        changed = np.flatnonzero(~same)
+        settled = n - start if len(changed) == 0 else int(changed[0]) + 1
+        chosen[start:start + settled] = new[:settled]
+        found[start:start + settled] = ok[:settled]
+        missing = np.flatnonzero(~ok[:settled])
+        if len(missing):  # nothing after a target without a solution is chosen
+            return _cut_after(chosen, found, start + int(missing[0]))
+        guess[start:] = new
+        start += settled
+        if start == n:
+            return chosen, found
+    for row in range(start, n):
+        near = first if row == 0 else chosen[row - 1]
+        q, ok = _choose_block(solutions[row:row + 1], near[None], q_min, q_max)
+        chosen[row], found[row] = q[0], ok[0]
+        if not ok[0]:
+            return _cut_after(chosen, found, row)
+    return chosen, found
+
+
+def _cut_after(chosen: np.ndarray, found: np.ndarray, row: int):
+    chosen[row:] = np.nan
+    found[row:] = False
     return chosen, found
 
 

@@ -24,6 +24,8 @@ Conventions (``UR_FACTS.md`` §2 and the URScript manual):
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = [
@@ -166,12 +168,30 @@ def matrix_to_rpy(rotation) -> np.ndarray:
 
 def to_matrix(pose) -> np.ndarray:
     """Homogeneous matrices (..., 4, 4) of URScript poses (..., 6)."""
+    if type(pose) is not np.ndarray and len(pose) == 6:  # one pose: scalar maths is faster
+        return _one_matrix(*(float(v) for v in pose))
     p = _array(pose, 6, "a pose")
     out = np.zeros(p.shape[:-1] + (4, 4))
     out[..., :3, :3] = rotvec_to_matrix(p[..., 3:])
     out[..., :3, 3] = p[..., :3]
     out[..., 3, 3] = 1.0
     return out
+
+
+def _one_matrix(x: float, y: float, z: float, rx: float, ry: float, rz: float) -> np.ndarray:
+    """:func:`to_matrix` of one pose, with the same formula as :func:`rotvec_to_matrix`
+    (``b = 2·sin²(θ/2)/θ²``, exact at θ = 0)."""
+    theta = math.sqrt(rx * rx + ry * ry + rz * rz)
+    if theta > 0.0:
+        half = math.sin(0.5 * theta) / (0.5 * theta)
+        a, b = math.sin(theta) / theta, 0.5 * half * half
+    else:
+        a, b = 1.0, 0.5
+    xx, yy, zz, xy, xz, yz = rx * rx, ry * ry, rz * rz, rx * ry, rx * rz, ry * rz
+    return np.array([[1.0 - b * (yy + zz), b * xy - a * rz, b * xz + a * ry, x],
+                     [b * xy + a * rz, 1.0 - b * (xx + zz), b * yz - a * rx, y],
+                     [b * xz - a * ry, b * yz + a * rx, 1.0 - b * (xx + yy), z],
+                     [0.0, 0.0, 0.0, 1.0]])
 
 
 def from_matrix(matrix) -> np.ndarray:

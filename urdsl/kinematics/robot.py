@@ -29,7 +29,7 @@ import pinocchio as pin
 from . import ik as _ik
 from . import pose as _pose
 from .calibration import Calibration
-from .dh import dh_frames, fk_ur
+from .dh import dh_frames, fk_ur, ur_axes
 from .errors import KinematicsError
 from .models import ModelSpec, model_spec
 from .pinmodel import URDF_MODELS, build_dh_model, load_urdf_model
@@ -225,6 +225,28 @@ class Robot:
         """DH frames 0…6 (N, 7, 4, 4) in Base for joint vectors ``Q`` (N, 6)."""
         return dh_frames(_joint_batch(Q), *self._dh)
 
+    def axes_many(self, Q) -> tuple[np.ndarray, np.ndarray]:
+        """Joint axes (N, 6, 3) and origins of DH frames 0…6 (N, 7, 3) [m] in Base for joint
+        vectors ``Q`` (N, 6): closed form for a nominal arm, the DH product for a calibrated
+        one."""
+        Q = _joint_batch(Q)
+        if self.calibration is None:
+            return ur_axes(Q, *self._nominal)
+        frames = dh_frames(Q, *self._dh)
+        return frames[:, :6, :3, 2], frames[:, :, :3, 3]
+
+    def jacobian_many(self, Q, tcp=None) -> np.ndarray:
+        """Geometric Jacobians (N, 6, 6) of the TCP at joint vectors ``Q`` (N, 6): rows
+        (v [m/s], ω [rad/s]) in Base axes at the TCP point, columns per joint speed [rad/s].
+        Column i is ``(z_i × (p − o_i), z_i)``."""
+        axes, origins = self.axes_many(Q)
+        tcp = _tcp(tcp)
+        point = origins[:, 6]
+        if tcp is not None and np.any(tcp[:3, 3] != 0.0):
+            point = self.fk_many(Q, tcp)[:, :3, 3]
+        linear = np.cross(axes, point[:, None] - origins[:, :6])
+        return np.concatenate([linear, axes], axis=2).transpose(0, 2, 1)
+
     def jacobian(self, q) -> np.ndarray:
         """The geometric Jacobian (6, 6) of the flange at ``q``: rows (v [m/s], ω [rad/s]) in
         Base axes at the flange origin, columns per joint speed [rad/s] (Pinocchio)."""
@@ -380,11 +402,15 @@ class Robot:
           [0, π/2] (``|θ5|`` away from 0 or π on a nominal arm). 0: those axes are parallel.
         * ``"manipulability"`` [m³]: ``sqrt(det(J·Jᵀ)) = |det J|`` of the 6x6 flange
           Jacobian (rows m/s and rad/s); 0 at every singularity.
+
+        On a nominal arm all four are closed forms of the joints (with ``u`` and ``S`` as in
+        :mod:`urdsl.kinematics.dh`): shoulder ``|u + d5·S|``, ``L = |a2 + a3·e^{iθ3}|``,
+        wrist ``asin|s5|`` and ``|det J| = |a2·a3·s3·s5·(u + d5·S)|``.
         """
         Q = _joint_batch(Q)
-        frames = dh_frames(Q, *self._dh)
-        origins = frames[:, :, :3, 3]
-        axes = frames[:, :, :3, 2]
+        if self.calibration is None:
+            return _nominal_singularity(Q, *self._nominal)
+        axes, origins = self.axes_many(Q)
         wrist = origins[:, 5]
         d4 = float(self._dh[2][3])
         r2 = wrist[:, 0] ** 2 + wrist[:, 1] ** 2
@@ -401,3 +427,19 @@ class Robot:
             manipulability = np.abs(np.linalg.det(jacobian))
         return {"shoulder": shoulder, "elbow": elbow, "wrist": wrist_angle,
                 "manipulability": manipulability}
+
+
+def _nominal_singularity(Q: np.ndarray, d1: float, a2: float, a3: float, d4: float,
+                         d5: float, d6: float) -> dict[str, np.ndarray]:
+    """:meth:`Robot.singularity` of a nominal arm, in closed form."""
+    s3, s5 = np.sin(Q[:, 2]), np.sin(Q[:, 4])
+    q23 = Q[:, 1] + Q[:, 2]
+    u = a2 * np.cos(Q[:, 1]) + a3 * np.cos(q23)
+    v = a2 * np.sin(Q[:, 1]) + a3 * np.sin(q23)
+    sideways = u + d5 * np.sin(q23 + Q[:, 3])
+    length = np.sqrt(u * u + v * v)
+    reach, fold = abs(a2) + abs(a3), abs(abs(a2) - abs(a3))
+    return {"shoulder": np.abs(sideways),
+            "elbow": np.maximum(np.minimum(reach - length, length - fold), 0.0),
+            "wrist": np.arcsin(np.minimum(np.abs(s5), 1.0)),
+            "manipulability": np.abs(a2 * a3 * s3 * s5 * sideways)}

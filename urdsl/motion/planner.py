@@ -29,6 +29,7 @@ An offending move is skipped, with an "Overlapping Blends" warning, as the robot
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -216,23 +217,21 @@ class MotionPlanner:
         """
         if not self._unresolved:
             return
-        from ..kinematics.ik import choose_nearest
+        from ..kinematics.ik import choose_sequence
 
         pending, self._unresolved = self._unresolved, []
         model = self.kinematics
         targets = np.array([segment.pose_end for segment in pending])
         solutions, miss = model.ik_all_many(targets, tcp=pending[0].tcp)
-        previous = self._q_end
+        chosen, found = choose_sequence(solutions, self._q_end, model.q_min, model.q_max)
+        previous = self._q_end.copy()
         for index, segment in enumerate(pending):
-            chosen, found = choose_nearest(solutions[index:index + 1], previous[None],
-                                           model.q_min, model.q_max)
-            if not found[0]:
+            if not found[index]:
                 self._drop_from(segment)
                 distance = float(np.min(miss[index]))
                 raise UnreachableTarget(segment, distance)
-            segment.q_start = previous.copy()
-            segment.q_end = chosen[0]
-            previous = segment.q_end
+            segment.q_start = previous
+            segment.q_end = previous = chosen[index]
         self._q_end = previous.copy()
 
     def _drop_from(self, segment: Segment) -> None:
@@ -320,7 +319,7 @@ class MotionPlanner:
         from .geometry import rotation_angle
 
         pose_from = self._end_matrix()
-        length = float(np.linalg.norm(pose[:3, 3] - pose_from[:3, 3]))
+        length = _distance(pose, pose_from)
         if length < 1e-9:  # rotation only: time it on the angle
             length = rotation_angle(pose_from[:3, :3], pose[:3, :3])
         profile = Trapezoid.plan(length, v, a, t)
@@ -435,8 +434,7 @@ class MotionPlanner:
 
     def _add(self, segment: Segment, now: float) -> float:
         previous = self._pending
-        waypoint_from = segment.pose_start[:3, 3]
-        distance = float(np.linalg.norm(segment.pose_end[:3, 3] - waypoint_from))
+        distance = _distance(segment.pose_end, segment.pose_start)
         previous_radius = previous.radius if previous is not None else 0.0
         if segment.radius > 0 or previous_radius > 0:
             if previous_radius + segment.radius > distance + 1e-12:
@@ -477,10 +475,16 @@ class MotionPlanner:
         return segment.end
 
 
+def _distance(pose: np.ndarray, other: np.ndarray) -> float:
+    """Distance (m) between the positions of two 4x4 poses (scalar maths: one move at a time
+    is the planner's hot path)."""
+    return math.dist(pose[:3, 3].tolist(), other[:3, 3].tolist())
+
+
 def _tcp_length(segment: Segment) -> float:
     if segment.kind in ("movel", "movep", "movec"):
         return segment.profile.distance
-    return float(np.linalg.norm(segment.pose_end[:3, 3] - segment.pose_start[:3, 3]))
+    return _distance(segment.pose_end, segment.pose_start)
 
 
 def _path_fraction_for(segment: Segment, tcp_distance: float) -> float:

@@ -41,80 +41,119 @@ class Trace:
         return float(self.times[-1]) if len(self.times) else 0.0
 
 
+CHUNK_SAMPLES = 16384
+"""About how many (move, sample) entries :func:`_displacements` evaluates at once: the
+arrays of a chunk stay in the CPU's cache, which makes a long program sample several times
+faster than one pass over all of its samples would."""
+
+
 def _displacements(planner, times: np.ndarray):
     """Joint positions (N, 6) at sorted ``times``, the active segment per time, and which
     samples were out of reach.
 
-    All moves are evaluated together: one array entry per (move, sample inside the move),
-    profiles and straight TCP paths vectorised, and one batched inverse-kinematics call for
-    every Cartesian sample of the program.
+    A sample's joints are the start joints, plus the whole displacement of every move that
+    has ended, plus the part done so far of every move under way (moves overlap in blends).
+    The moves are evaluated in chunks of consecutive moves (:data:`CHUNK_SAMPLES`), each
+    chunk with one array entry per (move, sample inside the move): profiles and straight TCP
+    paths vectorised, one batched inverse-kinematics call for the Cartesian samples.
     """
-    from .planner import JOINT_SPACE
-    from .profiles import positions as profile_positions
-    from .profiles import speeds as profile_speeds
-
     count = len(times)
     segments = planner.segments
-    steps = np.zeros((count + 1, 6))
-    window = np.zeros((count, 6))
     active = np.full(count, -1, dtype=np.int64)
     unreachable = np.zeros(count, dtype=bool)
     if not segments or count == 0:
         return planner.q_start + np.zeros((count, 6)), active, unreachable
 
-    starts = np.array([s.start for s in segments])
-    durations = np.array([s.profile.duration for s in segments])
-    first = np.searchsorted(times, starts, side="left")
-    last = np.searchsorted(times, starts + durations, side="left")
-    q_start = np.array([s.q_start for s in segments])
-    q_delta = np.array([s.q_end for s in segments]) - q_start
-    np.add.at(steps, last, q_delta)
-
-    lengths = last - first
-    entry_segment = np.repeat(np.arange(len(segments)), lengths)
-    if len(entry_segment):
-        offsets = np.cumsum(lengths) - lengths
-        entry_sample = np.arange(len(entry_segment)) - np.repeat(offsets - first, lengths)
-        profile = np.array([(s.profile.distance, s.profile.accel, s.profile.peak,
-                             s.profile.t_acc, s.profile.t_flat) for s in segments])
-        p = profile[entry_segment]
-        covered = profile_positions(times[entry_sample] - starts[entry_segment],
-                                    p[:, 0], p[:, 1], p[:, 2], p[:, 3], p[:, 4])
-        fraction = np.divide(covered, p[:, 0], out=np.ones_like(covered), where=p[:, 0] > 0)
-        moved = fraction[:, None] * q_delta[entry_segment]
-        cartesian = np.array([s.kind not in JOINT_SPACE for s in segments])
-        rows = np.flatnonzero(cartesian[entry_segment] & (p[:, 0] > 0))
-        if len(rows):
-            local = rows - offsets[entry_segment[rows]]
-            seg_rows = entry_segment[rows]
-            local_t = times[entry_sample] - starts[entry_segment]
-            phase = (local_t[rows] >= p[rows, 3]).astype(np.int8) + (
-                local_t[rows] >= p[rows, 3] + p[rows, 4])
-            knots = _knots(planner, segments, seg_rows, local, lengths, times[1] - times[0]
-                           if count > 1 else 1.0, phase)
-            knot_rows = rows[knots]
-            paths = _Paths(segments)
-            moved[knot_rows] = _cartesian(planner, paths, entry_segment[knot_rows],
-                                          fraction[knot_rows], q_start, moved[knot_rows])
-            if not knots.all():
-                speed = profile_speeds(local_t[knot_rows], p[knot_rows, 0], p[knot_rows, 1],
-                                       p[knot_rows, 2], p[knot_rows, 3], p[knot_rows, 4])
-                velocity = _joint_velocities(planner, paths, entry_segment[knot_rows],
-                                             q_start, moved[knot_rows],
-                                             speed / p[knot_rows, 0])
-                _hermite(moved, times[entry_sample], rows, knots, velocity)
-            gaps = np.isnan(moved[rows]).any(axis=1)
-            if gaps.any():
-                unreachable[entry_sample[rows[gaps]]] = True
-                moved[rows[gaps]] = np.nan
-                moved = _fill_gaps(moved, entry_segment)
-        np.add.at(window, entry_sample, moved)
-        # the active move at a sample is the latest one started (blends overlap)
-        np.maximum.at(active, entry_sample, entry_segment)
-    positions = planner.q_start + np.cumsum(steps[:-1], axis=0) + window
-    # samples after a segment's end but before the next one starts keep the latest index
+    moves = _Moves(planner, segments, times)
+    steps = np.zeros((count + 1, 6))
+    np.add.at(steps, moves.last, moves.q_delta)
+    positions = planner.q_start + np.cumsum(steps[:-1], axis=0)
+    ends = np.cumsum(moves.lengths)
+    cuts = np.searchsorted(ends, np.arange(CHUNK_SAMPLES, ends[-1], CHUNK_SAMPLES),
+                           side="right")
+    bounds = np.unique(np.concatenate([[0], cuts, [len(segments)]]))
+    for begin, stop in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+        entry_sample, moved = moves.window(begin, stop, unreachable)
+        if len(entry_sample):
+            low, high = int(entry_sample[0]), int(entry_sample.max()) + 1
+            local = entry_sample - low
+            for joint in range(6):  # blends: two moves add up at one sample
+                positions[low:high, joint] += np.bincount(local, moved[:, joint],
+                                                          minlength=high - low)
+    # the active move at a sample is the latest one started (blends overlap); samples after
+    # a move's end but before the next one starts keep it
+    sampled = np.flatnonzero(moves.lengths > 0)
+    np.maximum.at(active, moves.first[sampled], sampled)
     np.maximum.accumulate(active, out=active)
     return positions, active, unreachable
+
+
+class _Moves:
+    """The moves of a program as arrays (index = move), and their sample windows."""
+
+    def __init__(self, planner, segments, times: np.ndarray) -> None:
+        from .planner import JOINT_SPACE
+
+        self.planner, self.segments, self.times = planner, segments, times
+        self.starts = np.array([s.start for s in segments])
+        durations = np.array([s.profile.duration for s in segments])
+        self.first = np.searchsorted(times, self.starts, side="left")
+        self.last = np.searchsorted(times, self.starts + durations, side="left")
+        self.lengths = self.last - self.first
+        self.q_start = np.array([s.q_start for s in segments])
+        self.q_delta = np.array([s.q_end for s in segments]) - self.q_start
+        self.profile = np.array([(s.profile.distance, s.profile.accel, s.profile.peak,
+                                  s.profile.t_acc, s.profile.t_flat) for s in segments])
+        self.cartesian = np.array([s.kind not in JOINT_SPACE for s in segments])
+        self.arcs = np.array([s.kind == "movec" for s in segments])
+        self.paths = _Paths(segments) if self.cartesian.any() else None
+        self.dt = times[1] - times[0] if len(times) > 1 else 1.0
+
+    def window(self, begin: int, stop: int, unreachable: np.ndarray):
+        """Entries of moves ``begin`` to ``stop`` − 1: the sample of each (sorted by move,
+        then time) and the joint displacement (M, 6) of its move since the move's start.
+        Marks samples out of reach in ``unreachable``."""
+        from .profiles import positions as profile_positions
+        from .profiles import speeds as profile_speeds
+
+        lengths = self.lengths[begin:stop]
+        entry_segment = np.repeat(np.arange(begin, stop), lengths)
+        if len(entry_segment) == 0:
+            return entry_segment, np.zeros((0, 6))
+        offsets = np.cumsum(lengths) - lengths
+        entry_sample = np.arange(len(entry_segment)) - np.repeat(
+            offsets - self.first[begin:stop], lengths)
+        local_t = self.times[entry_sample] - self.starts[entry_segment]
+        p = self.profile[entry_segment]
+        covered = profile_positions(local_t, p[:, 0], p[:, 1], p[:, 2], p[:, 3], p[:, 4])
+        fraction = np.divide(covered, p[:, 0], out=np.ones_like(covered), where=p[:, 0] > 0)
+        moved = fraction[:, None] * self.q_delta[entry_segment]
+        rows = np.flatnonzero(self.cartesian[entry_segment] & (p[:, 0] > 0))
+        if len(rows) == 0:
+            return entry_sample, moved
+        seg_rows = entry_segment[rows]
+        local = rows - offsets[seg_rows - begin]
+        phase = (local_t[rows] >= p[rows, 3]).astype(np.int8) + (
+            local_t[rows] >= p[rows, 3] + p[rows, 4])
+        knots = _knots(self.planner, self.arcs, seg_rows, local, self.lengths, self.dt,
+                       phase)
+        knot_rows = rows[knots]
+        which = entry_segment[knot_rows]
+        moved[knot_rows] = _cartesian(self.planner, self.paths, which, fraction[knot_rows],
+                                      self.q_start, moved[knot_rows])
+        if not knots.all():
+            pk = p[knot_rows]
+            speed = profile_speeds(local_t[knot_rows], pk[:, 0], pk[:, 1], pk[:, 2],
+                                   pk[:, 3], pk[:, 4])
+            velocity = _joint_velocities(self.planner, self.paths, which, self.q_start,
+                                         moved[knot_rows], speed / pk[:, 0])
+            _hermite(moved, local_t, rows, knots, velocity)
+        gaps = np.isnan(moved[rows]).any(axis=1)
+        if gaps.any():
+            unreachable[entry_sample[rows[gaps]]] = True
+            moved[rows[gaps]] = np.nan
+            moved = _fill_gaps(moved, entry_segment)
+        return entry_sample, moved
 
 
 KNOT_TIME = 0.032
@@ -127,15 +166,15 @@ solving every sample); near a singularity the Jacobian's speeds grow, which is w
 checks look for."""
 
 
-def _knots(planner, segments, seg_rows, local, lengths, dt, phase) -> np.ndarray:
+def _knots(planner, arcs, seg_rows, local, lengths, dt, phase) -> np.ndarray:
     """Which samples of TCP paths are solved by IK: every ``KNOT_TIME``, the first and last
     of each move, and those on either side of a change of the profile's phase (accelerating,
     cruising, braking: the joint accelerations jump there, which a cubic would smooth); all
-    of them for arcs and for models without DH frames (``frames_many``)."""
+    of them for arcs (``arcs``: per move) and for models without Jacobians
+    (``jacobian_many``)."""
     every = max(1, int(round(KNOT_TIME / dt)))
-    if every == 1 or not hasattr(planner.kinematics, "frames_many"):
+    if every == 1 or not hasattr(planner.kinematics, "jacobian_many"):
         return np.ones(len(local), dtype=bool)
-    arcs = np.array([s.kind == "movec" for s in segments])
     change = np.zeros(len(local), dtype=bool)
     switch = (phase[1:] != phase[:-1]) & (seg_rows[1:] == seg_rows[:-1])
     change[1:] |= switch
@@ -147,42 +186,28 @@ def _knots(planner, segments, seg_rows, local, lengths, dt, phase) -> np.ndarray
 def _joint_velocities(planner, paths, which, q_start, moved, fraction_rate) -> np.ndarray:
     """Joint speeds (M, 6) rad/s at solved samples of straight TCP paths: the twist of the
     path (linear ``(p1 − p0)·ḟ``, angular ``R0·w·ḟ`` with ``w = log(R0ᵀR1)``) through the
-    damped inverse of the TCP Jacobian. ``fraction_rate`` is ḟ in 1/s."""
-    from ..kinematics import pose as posemath
-
+    damped inverse of the TCP Jacobian,
+    ``q̇ = (JᵀJ + λ²I)⁻¹Jᵀ·twist`` (λ = 1e-6: exact away from singularities, finite at
+    them). ``fraction_rate`` is ḟ in 1/s."""
     q = q_start[which] + moved
     good = np.isfinite(q).all(axis=1)
     velocity = np.full_like(q, np.nan)
     if not good.any():
         return velocity
-    q, which, rate = q[good], which[good], fraction_rate[good]
-    angular = (paths.r0 @ paths.w[:, :, None])[:, :, 0]
-    twist = np.concatenate([paths.p1[which] - paths.p0[which], angular[which]],
-                           axis=1) * rate[:, None]
-    block = 4096  # rows per pass: the (block, 7, 4, 4) frames stay in the CPU's cache
-    rows_good = np.flatnonzero(good)
-    for begin in range(0, len(q), block):
-        rows = slice(begin, begin + block)
-        velocity[rows_good[rows]] = _damped_solve(planner, paths.segments, which[rows],
-                                                  q[rows], twist[rows], posemath)
+    rows = np.flatnonzero(good)
+    which = which[rows]
+    twist = np.concatenate([paths.p1[which] - paths.p0[which], paths.angular[which]],
+                           axis=1) * fraction_rate[rows, None]
+    groups = paths.tcp_group[which]
+    for group in np.unique(groups):
+        members = groups == group
+        jacobian = planner.kinematics.jacobian_many(q[rows[members]],
+                                                    tcp=paths.tcps[group])
+        transposed = jacobian.transpose(0, 2, 1)
+        normal = transposed @ jacobian + 1e-12 * np.eye(6)
+        velocity[rows[members]] = np.linalg.solve(
+            normal, transposed @ twist[members, :, None])[:, :, 0]
     return velocity
-
-
-def _damped_solve(planner, segments, which, q, twist, posemath) -> np.ndarray:
-    """``q̇ = (JᵀJ + λ²I)⁻¹Jᵀ·twist`` with the TCP Jacobian at ``q`` (λ = 1e-6: exact away from
-    singularities, finite at them)."""
-    frames = planner.kinematics.frames_many(q)
-    point = frames[:, 6, :3, 3].copy()
-    for index in np.unique(which):
-        tcp = segments[index].tcp
-        if tcp is not None:
-            rows = which == index
-            point[rows] = (frames[rows, 6] @ posemath.to_matrix(tcp))[:, :3, 3]
-    axes, origins = frames[:, :6, :3, 2], frames[:, :6, :3, 3]
-    jacobian = np.concatenate([np.cross(axes, point[:, None] - origins), axes], axis=2)
-    transposed = jacobian  # (M, 6 joints, 6 twist rows) = Jᵀ
-    normal = transposed @ transposed.transpose(0, 2, 1) + 1e-12 * np.eye(6)
-    return np.linalg.solve(normal, transposed @ twist[:, :, None])[:, :, 0]
 
 
 def _hermite(moved, entry_time, rows, knots, velocity) -> None:
@@ -216,6 +241,7 @@ class _Paths:
         self.p0, self.p1 = starts[:, :3, 3], ends[:, :3, 3]
         self.r0 = starts[:, :3, :3]
         self.w = matrix_to_rotvec(np.swapaxes(self.r0, 1, 2) @ ends[:, :3, :3])
+        self.angular = (self.r0 @ self.w[:, :, None])[:, :, 0]  # rotation step in Base
         self.arc = np.array([s.kind == "movec" and s.via is not None for s in segments])
         self.tcp_group, self.tcps = tcp_groups(segments)
 

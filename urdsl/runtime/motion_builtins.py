@@ -95,7 +95,7 @@ def _matrix(rt, node, value: Any, what: str) -> np.ndarray:
     controller accepts joint vectors as targets of movel/movep/movec)."""
     arm = _arm(rt, node, resolve=False)
     if type(value) is PoseValue:
-        return posemath.to_matrix(np.array(value, dtype=float))
+        return posemath.to_matrix(value)
     return arm.fk(_numbers(rt, node, value, 6, what))
 
 
@@ -104,7 +104,7 @@ def _joints_target(rt, node, value: Any) -> np.ndarray:
     the arm is going."""
     arm = _arm(rt, node)
     if type(value) is PoseValue:
-        return _solve(rt, node, arm, posemath.to_matrix(np.array(value, dtype=float)), None)
+        return _solve(rt, node, arm, posemath.to_matrix(value), None)
     return _numbers(rt, node, value, 6, "the joint target")
 
 

@@ -15,13 +15,13 @@ written in, so nothing written is lost.
 from __future__ import annotations
 
 import functools
-import gc
 import itertools
 import re
 from dataclasses import replace
 from importlib import resources
 from typing import Any
 
+from .._gc import gc_paused
 from .diagnostics import ScriptSyntaxError
 from .lexer import Lexer, Token
 from .nodes import (
@@ -455,13 +455,8 @@ class Parser:
         # The tree is acyclic and the parser makes no cycles: pausing the cyclic garbage
         # collector, which would otherwise rescan the growing tree again and again, makes
         # large files parse about a third faster.
-        collecting = gc.isenabled()
-        gc.disable()
-        try:
+        with gc_paused():
             return self._parse(text, filename)
-        finally:
-            if collecting:
-                gc.enable()
 
     def _parse(self, text: str, filename: str) -> Module:
         source = Source(text, filename)

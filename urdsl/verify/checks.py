@@ -254,8 +254,10 @@ _SINGULARITY_HINTS = {
 def collisions(trace: Trace, robot, cell, step: float = 0.02,
                self_collision: bool = True) -> list[Finding]:
     """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders, planes) or itself,
-    checked every ``step`` s of robot time while it moves. ``cell`` is a path of a cell TOML
-    or a ready :class:`urdsl.kinematics.collision.CollisionModel` (None: no obstacles)."""
+    checked every ``step`` s of robot time while it moves, or further apart where it cannot
+    come into contact in between (see :meth:`CollisionModel.sweep`). ``cell`` is a path of a
+    cell TOML or a ready :class:`urdsl.kinematics.collision.CollisionModel` (None: no
+    obstacles)."""
     if cell is None and not self_collision:
         return []
     from ..kinematics.collision import CollisionModel
@@ -267,12 +269,12 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
         if cell is not None:
             model.load_cell(cell)
     stride = max(1, int(round(step / trace.dt)))
-    index = np.arange(0, len(trace.times), stride)
-    index = index[trace.segment[index] >= 0]
-    if len(index) == 0:
+    moving = np.flatnonzero(trace.segment >= 0)  # from the first move on
+    if len(moving) == 0:
         return []
     tcp = trace.segments[-1].tcp if trace.segments else None
-    result = model.check(trace.q[index], tcp=tcp)
+    index, result = model.sweep(trace.q[moving[0]:], tcp=tcp, stride=stride)
+    index += moving[0]
     hit = np.zeros(len(trace.times), dtype=bool)
     hit[index] = result.colliding
     position = {int(sample): i for i, sample in enumerate(index)}

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._gc import gc_paused
 from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
 from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
@@ -101,6 +102,11 @@ def _robot_model(name: str):
 
 def check_tree(module, filename: str, options: CheckOptions) -> Report:
     """Run and check a parsed program (:class:`urdsl.script.nodes.Module`)."""
+    with gc_paused():  # the tree, closures and segments are long-lived and acyclic
+        return _check_tree(module, filename, options)
+
+
+def _check_tree(module, filename: str, options: CheckOptions) -> Report:
     robot = _robot_model(options.robot)
     cb3 = getattr(robot.spec, "generation", "") == "cb3"
     step = 0.008 if cb3 else 0.002
