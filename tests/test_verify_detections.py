@@ -225,3 +225,41 @@ def test_the_robot_stops_at_an_unreachable_target_even_when_solved_later():
     assert all(e.message != "after" for e in report.events)
     assert report.cycle_time == pytest.approx(report.moves[-1].start
                                               + report.moves[-1].duration)
+
+
+def test_blend_radius_over_half_a_neighbouring_segment():
+    """URS310 at the move whose radius is too large for the short segment after it (the
+    spheres do not overlap, so the robot does not skip it: a warning of the house rule)."""
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        movel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), r=0.03)
+        movel(pose_add(home, p[0.2, 0.05, 0, 0, 0, 0]), r=0.01)
+        movel(home)
+        """)
+    (finding,) = only(report, "URS310")
+    assert finding.span.line == 3 and "0.03 m" in finding.message
+    assert [f.code for f in report.findings if f.code == "URS309"] == []
+
+
+@pytest.mark.parametrize("at", [1, 32767, 32768, 32769, 40000 - 1])
+def test_a_jump_is_found_wherever_it_lies_in_a_long_trace(at):
+    """path_continuity works in blocks of samples: a jump on a block boundary counts too."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from urdsl.motion.trace import Trace
+    from urdsl.script.nodes import NO_SPAN
+    from urdsl.verify.checks import path_continuity
+
+    count, dt = 40000, 0.002
+    q = np.zeros((count, 6))
+    q[at:, 3] = math.pi  # wrist 1 flips half a turn between two samples
+    move = SimpleNamespace(kind="movel", span=NO_SPAN, start=0.0, duration=count * dt)
+    trace = Trace(np.arange(count) * dt, q, np.zeros_like(q), np.zeros_like(q),
+                  np.zeros(count, dtype=np.int64), dt, [move], np.zeros(count, dtype=bool))
+    found = path_continuity(trace, np.full(6, 3.14))
+    (finding,) = found.findings
+    assert f"t={at * dt:.3f} s" in finding.message and "wrist 1" in finding.message
+    assert found.samples[at] and not found.samples[at + 3 if at + 3 < count else at - 3]

@@ -108,6 +108,12 @@ class _Moves:
         self.arcs = np.array([s.kind == "movec" for s in segments])
         self.paths = _Paths(segments) if self.cartesian.any() else None
         self.dt = times[1] - times[0] if len(times) > 1 else 1.0
+        # samples between knots while cruising (see KNOT_PATH): at least KNOT_TIME's
+        every = max(1, int(round(KNOT_TIME / self.dt)))
+        peak = self.profile[:, 2]
+        path_steps = np.divide(KNOT_PATH, peak * self.dt, out=np.zeros_like(peak),
+                               where=peak > 0)
+        self.cruise_every = np.maximum(every, np.floor(path_steps)).astype(np.int64)
 
     def window(self, begin: int, stop: int, unreachable: np.ndarray):
         """Entries of moves ``begin`` to ``stop`` − 1: the sample of each (sorted by move,
@@ -135,19 +141,21 @@ class _Moves:
         local = rows - offsets[seg_rows - begin]
         phase = (local_t[rows] >= p[rows, 3]).astype(np.int8) + (
             local_t[rows] >= p[rows, 3] + p[rows, 4])
-        knots = _knots(self.planner, self.arcs, seg_rows, local, self.lengths, self.dt,
-                       phase)
+        knots = _knots(self.planner, self, seg_rows, local, phase)
         knot_rows = rows[knots]
         which = entry_segment[knot_rows]
-        moved[knot_rows] = _cartesian(self.planner, self.paths, which, fraction[knot_rows],
-                                      self.q_start, moved[knot_rows])
+        solved = _cartesian(self.planner, self.paths, which, fraction[knot_rows],
+                            self.q_start, moved[knot_rows])
+        moved[knot_rows] = solved
         if not knots.all():
             pk = p[knot_rows]
             speed = profile_speeds(local_t[knot_rows], pk[:, 0], pk[:, 1], pk[:, 2],
                                    pk[:, 3], pk[:, 4])
             velocity = _joint_velocities(self.planner, self.paths, which, self.q_start,
-                                         moved[knot_rows], speed / pk[:, 0])
+                                         solved, speed / pk[:, 0])
             _hermite(moved, local_t, rows, knots, velocity)
+        if not np.isnan(solved).any():  # samples between solved ones are NaN only next to one
+            return entry_sample, moved
         gaps = np.isnan(moved[rows]).any(axis=1)
         if gaps.any():
             unreachable[entry_sample[rows[gaps]]] = True
@@ -157,30 +165,39 @@ class _Moves:
 
 
 KNOT_TIME = 0.032
-"""Robot time (s) between the samples of a TCP path that are solved by inverse kinematics;
-the samples in between are cubic Hermite interpolations of the joints, with the joint
-speeds at the solved samples from the Jacobian (``q̇ = J⁻¹·twist``). Joint paths of
-straight-line moves are smooth away from singularities, where the error of this cubic is of
-the order of ``(h/2)⁴·q⁗`` — below a micro-radian at 32 ms (6e-7 rad measured against
-solving every sample); near a singularity the Jacobian's speeds grow, which is what the
-checks look for."""
+"""Robot time (s) between the samples of a TCP path that are solved by inverse kinematics
+while the move accelerates or brakes; the samples in between are cubic Hermite
+interpolations of the joints, with the joint speeds at the solved samples from the Jacobian
+(``q̇ = J⁻¹·twist``). Joint paths of straight-line moves are smooth away from singularities,
+where the error of this cubic is of the order of ``(h/2)⁴·q⁗`` — below a micro-radian at
+32 ms (6e-7 rad measured against solving every sample); near a singularity the Jacobian's
+speeds grow, which is what the checks look for."""
+
+KNOT_PATH = 0.008
+"""Path length (m, or rad for a rotation-only move) between solved samples while a move
+cruises, when that is longer than :data:`KNOT_TIME`: at constant path speed ``v`` the
+joints' fourth derivative is ``Q⁗(s)·v⁴`` (``Q`` the joints as a function of the path
+length ``s``), so the interpolation error depends on the path length between knots, not on
+their time. 8 mm is what :data:`KNOT_TIME` gives at the controller's default movel speed
+(0.25 m/s); a slow process move (a 0.1 m/s toolpath) is solved every 80 ms."""
 
 
-def _knots(planner, arcs, seg_rows, local, lengths, dt, phase) -> np.ndarray:
-    """Which samples of TCP paths are solved by IK: every ``KNOT_TIME``, the first and last
+def _knots(planner, moves, seg_rows, local, phase) -> np.ndarray:
+    """Which samples of TCP paths are solved by IK: every ``KNOT_TIME`` while accelerating
+    or braking and every ``KNOT_PATH`` of path while cruising (if longer), the first and last
     of each move, and those on either side of a change of the profile's phase (accelerating,
     cruising, braking: the joint accelerations jump there, which a cubic would smooth); all
-    of them for arcs (``arcs``: per move) and for models without Jacobians
-    (``jacobian_many``)."""
-    every = max(1, int(round(KNOT_TIME / dt)))
+    of them for arcs and for models without Jacobians (``jacobian_many``)."""
+    every = max(1, int(round(KNOT_TIME / moves.dt)))
     if every == 1 or not hasattr(planner.kinematics, "jacobian_many"):
         return np.ones(len(local), dtype=bool)
     change = np.zeros(len(local), dtype=bool)
     switch = (phase[1:] != phase[:-1]) & (seg_rows[1:] == seg_rows[:-1])
     change[1:] |= switch
     change[:-1] |= switch
-    return ((local % every == 0) | (local == lengths[seg_rows] - 1) | arcs[seg_rows]
-            | change)
+    spacing = np.where(phase == 1, moves.cruise_every[seg_rows], every)
+    return ((local % spacing == 0) | (local == moves.lengths[seg_rows] - 1)
+            | moves.arcs[seg_rows] | change)
 
 
 def _joint_velocities(planner, paths, which, q_start, moved, fraction_rate) -> np.ndarray:
@@ -212,19 +229,32 @@ def _joint_velocities(planner, paths, which, q_start, moved, fraction_rate) -> n
 
 def _hermite(moved, entry_time, rows, knots, velocity) -> None:
     """Fill the samples between solved ones (``rows[~knots]``) in place: cubic Hermite on the
-    joint displacements and speeds of the neighbouring solved samples of the same move."""
-    knot_positions = np.flatnonzero(knots)
-    inner = np.flatnonzero(~knots)
-    right = np.searchsorted(knot_positions, inner)  # index of the next solved sample
-    left = right - 1
-    r0, r1 = rows[knot_positions[left]], rows[knot_positions[right]]
-    t0, t1 = entry_time[r0], entry_time[r1]
-    h = (t1 - t0)[:, None]
-    s = ((entry_time[rows[inner]] - t0) / (t1 - t0))[:, None]
-    s2, s3 = s * s, s * s * s
-    moved[rows[inner]] = ((2 * s3 - 3 * s2 + 1) * moved[r0] + (s3 - 2 * s2 + s) * h
-                          * velocity[left] + (-2 * s3 + 3 * s2) * moved[r1]
-                          + (s3 - s2) * h * velocity[right])
+    joint displacements and speeds of the neighbouring solved samples of the same move.
+
+    ``rows`` runs move by move and the first and last sample of every move is solved, so
+    the samples between two consecutive solved ones are a run of ``rows``; each run's cubic
+    ``q0 + s·(c1 + s·(c2 + s·c3))`` (``s`` in [0, 1]) is set up once and repeated over it.
+    """
+    solved = rows[np.flatnonzero(knots)]
+    counts = np.diff(np.flatnonzero(knots)) - 1  # samples between knot j and knot j + 1
+    runs = np.flatnonzero(counts > 0)
+    counts = counts[runs]
+    q0, q1 = moved[solved[runs]], moved[solved[runs + 1]]
+    t0 = entry_time[solved[runs]]
+    h = entry_time[solved[runs + 1]] - t0
+    v0, v1 = h[:, None] * velocity[runs], h[:, None] * velocity[runs + 1]
+    c2 = 3.0 * (q1 - q0) - 2.0 * v0 - v1
+    c3 = 2.0 * (q0 - q1) + v0 + v1
+    inner = rows[~knots]
+    s = ((entry_time[inner] - np.repeat(t0, counts)) / np.repeat(h, counts))[:, None]
+    value = np.repeat(c3, counts, axis=0)
+    value *= s
+    value += np.repeat(c2, counts, axis=0)
+    value *= s
+    value += np.repeat(v0, counts, axis=0)
+    value *= s
+    value += np.repeat(q0, counts, axis=0)
+    moved[inner] = value
 
 
 class _Paths:

@@ -26,6 +26,15 @@ def _per_segment(trace: Trace, mask: np.ndarray):
         yield int(segments[order]), int(flagged[first[order]])
 
 
+def _rows_where(values: np.ndarray, predicate, block: int = 32768) -> np.ndarray:
+    """(N,) bool: rows of ``values`` (N, 6) where ``predicate`` (an elementwise test of a
+    block of rows) holds for some column; evaluated in cache-sized blocks of rows."""
+    flagged = np.empty(len(values), dtype=bool)
+    for start in range(0, len(values), block):
+        predicate(values[start:start + block]).any(axis=1, out=flagged[start:start + block])
+    return flagged
+
+
 def _span(trace: Trace, segment: int):
     from ..script.nodes import NO_SPAN
 
@@ -34,10 +43,11 @@ def _span(trace: Trace, segment: int):
 
 def joint_limits(trace: Trace, lower: np.ndarray, upper: np.ndarray) -> list[Finding]:
     """URS303: joint positions outside [lower, upper] (rad)."""
-    outside = (trace.q < lower - 1e-9) | (trace.q > upper + 1e-9)
+    low, high = lower - 1e-9, upper + 1e-9
+    outside = _rows_where(trace.q, lambda q: (q < low) | (q > high))
     findings = []
     for segment, sample in _per_segment(trace, outside):
-        joint = int(np.argmax(outside[sample]))
+        joint = int(np.argmax((trace.q[sample] < low) | (trace.q[sample] > high)))
         value = trace.q[sample, joint]
         bound = upper[joint] if value > upper[joint] else lower[joint]
         findings.append(Finding.of(
@@ -53,9 +63,10 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
                  ) -> list[Finding]:
     """URS304: joint speeds above the model's limits (rad/s); samples in ``exclude`` (jumps
     already reported by :func:`path_continuity`) are left out."""
-    over = np.abs(trace.qd) > limits * (1 + 1e-6)
+    bound = limits * (1 + 1e-6)
+    over = _rows_where(trace.qd, lambda qd: np.abs(qd) > bound)
     if exclude is not None:
-        over &= ~exclude[:, None]
+        over &= ~exclude
     findings = []
     for segment, sample in _per_segment(trace, over):
         ratio = np.abs(trace.qd[sample]) / limits
@@ -100,18 +111,20 @@ def blend_radii(segments) -> list[Finding]:
     """URS310: a blend radius larger than half of the segment before or after it (a
     conservative house rule: UR's own rule is the overlap of blend spheres, URS309)."""
     findings = []
-    for before, current in zip(segments, segments[1:], strict=False):
-        if before.radius <= 0:
-            continue
-        length_before = float(np.linalg.norm(before.pose_end[:3, 3] - before.pose_start[:3, 3]))
-        length_after = float(np.linalg.norm(current.pose_end[:3, 3] - current.pose_start[:3, 3]))
-        shortest = min(length_before, length_after)
-        if before.radius > shortest / 2 + 1e-9:
-            findings.append(Finding.of(
-                "URS310",
-                f"blend radius {before.radius:g} m is more than half of a neighbouring "
-                f"segment ({shortest:.4g} m): the blend may be cut short",
-                before.span, before.end, "use at most half the shorter segment"))
+    if len(segments) < 2:
+        return findings
+    radius = np.array([s.radius for s in segments[:-1]])
+    ends = np.array([s.pose_end[:3, 3] for s in segments])
+    starts = np.array([s.pose_start[:3, 3] for s in segments])
+    lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
+    shortest_all = np.minimum(lengths[:-1], lengths[1:])
+    for index in np.flatnonzero((radius > 0) & (radius > shortest_all / 2 + 1e-9)):
+        before, shortest = segments[index], float(shortest_all[index])
+        findings.append(Finding.of(
+            "URS310",
+            f"blend radius {before.radius:g} m is more than half of a neighbouring "
+            f"segment ({shortest:.4g} m): the blend may be cut short",
+            before.span, before.end, "use at most half the shorter segment"))
     return findings
 
 
@@ -137,9 +150,12 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
     flagged = np.zeros(count, dtype=bool)
     findings = []
     threshold = np.maximum(JUMP_MIN, 10.0 * speed_limits * trace.dt)
-    steps = np.abs(np.diff(trace.q, axis=0)) if count > 1 else np.zeros((0, 6))
     jumps = np.zeros(count, dtype=bool)
-    jumps[1:] = (steps > threshold).any(axis=1)
+    block = 32768
+    for start in range(0, count - 1, block):  # a step from the sample before over threshold
+        stop = min(start + block, count - 1)
+        step = np.abs(trace.q[start + 1:stop + 1] - trace.q[start:stop])
+        (step > threshold).any(axis=1, out=jumps[start + 1:stop + 1])
     reported: set[int] = set()
     for segment, sample in _per_segment(trace, trace.unreachable):
         reported.add(segment)
@@ -157,11 +173,12 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
         if segment in reported or segment < 0:
             continue
         move = trace.segments[segment]
-        joint = int(np.argmax(steps[sample - 1] / threshold))
+        step = np.abs(trace.q[sample] - trace.q[sample - 1])
+        joint = int(np.argmax(step / threshold))
         findings.append(Finding.of(
             "URS302",
             f"the {move.kind} path needs a change of IK solution: the {JOINTS[joint]} joint "
-            f"jumps by {np.degrees(steps[sample - 1, joint]):.0f}° at "
+            f"jumps by {np.degrees(step[joint]):.0f}° at "
             f"t={trace.times[sample]:.3f} s, which the robot cannot do on a straight line",
             _span(trace, segment), float(trace.times[sample]),
             "split the move, or reach the end with movej"))
