@@ -9,6 +9,7 @@ that fails at a sample can name the program line that commanded it.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,6 +42,9 @@ class Trace:
         return float(self.times[-1]) if len(self.times) else 0.0
 
 
+SAMPLING_THREADS = 2
+"""Threads that sample chunks of moves at once (the verifier's machines have two cores)."""
+
 CHUNK_SAMPLES = 16384
 """About how many (move, sample) entries :func:`_displacements` evaluates at once: the
 arrays of a chunk stay in the CPU's cache, which makes a long program sample several times
@@ -65,21 +69,28 @@ def _displacements(planner, times: np.ndarray):
         return planner.q_start + np.zeros((count, 6)), active, unreachable
 
     moves = _Moves(planner, segments, times)
-    steps = np.zeros((count + 1, 6))
-    np.add.at(steps, moves.last, moves.q_delta)
-    positions = planner.q_start + np.cumsum(steps[:-1], axis=0)
+    # what the moves that have ended add up to: constant from one move's end to the next
+    by_end = np.argsort(moves.last, kind="stable")
+    ends, first = np.unique(moves.last[by_end], return_index=True)
+    completed = planner.q_start + np.cumsum(moves.q_delta[by_end], axis=0)
+    reached = np.vstack([planner.q_start, completed[np.append(first[1:] - 1, -1)]])
+    runs = np.diff(np.concatenate([[0], np.minimum(ends, count), [count]]))
+    positions = np.repeat(reached, runs, axis=0)
     ends = np.cumsum(moves.lengths)
     cuts = np.searchsorted(ends, np.arange(CHUNK_SAMPLES, ends[-1], CHUNK_SAMPLES),
                            side="right")
     bounds = np.unique(np.concatenate([[0], cuts, [len(segments)]]))
-    for begin, stop in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
-        entry_sample, moved = moves.window(begin, stop, unreachable)
-        if len(entry_sample):
-            low, high = int(entry_sample[0]), int(entry_sample.max()) + 1
-            local = entry_sample - low
-            for joint in range(6):  # blends: two moves add up at one sample
-                positions[low:high, joint] += np.bincount(local, moved[:, joint],
-                                                          minlength=high - low)
+    # Two threads evaluate chunks side by side (NumPy lets go of the interpreter lock in
+    # its loops); the main thread adds their windows up in order.
+    chunks = zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True)
+    with ThreadPoolExecutor(SAMPLING_THREADS) as pool:
+        for entry_sample, moved in pool.map(lambda c: moves.window(*c, unreachable), chunks):
+            if len(entry_sample):
+                low, high = int(entry_sample[0]), int(entry_sample.max()) + 1
+                local = entry_sample - low
+                for joint in range(6):  # blends: two moves add up at one sample
+                    positions[low:high, joint] += np.bincount(local, moved[:, joint],
+                                                              minlength=high - low)
     # the active move at a sample is the latest one started (blends overlap); samples after
     # a move's end but before the next one starts keep it
     sampled = np.flatnonzero(moves.lengths > 0)
@@ -348,3 +359,4 @@ def sample(planner, dt: float | None = None) -> Trace:
     qd = np.gradient(q, dt, axis=0) if count > 1 else np.zeros_like(q)
     qdd = np.gradient(qd, dt, axis=0) if count > 1 else np.zeros_like(q)
     return Trace(times, q, qd, qdd, active, dt, planner.segments, unreachable)
+

@@ -198,6 +198,8 @@ class Interpreter:
         while not main.done and not self.halted:
             if self.critical is not None and not self.critical.done:
                 thread = self.critical
+            elif len(threads) == 1:  # the main thread alone (most programs)
+                thread = main
             else:
                 thread = min((t for t in threads if not t.done),
                              key=lambda t: (t.wake, t.order))
@@ -396,7 +398,7 @@ class _Compiler:
                       and not isinstance(s, (n.FunctionDef, n.ThreadDef, n.SecDef))]
         self.collect(module.body)
         if not statements and len(defs) == 1 and not defs[0].params:
-            body = self.block(defs[0].body)
+            body = rt.functions[defs[0].name].body  # compiled once, by collect()
         elif not statements and not defs:
             secs = [s for s in module.body if isinstance(s, n.SecDef)]
             body = self.block(secs[0].body) if secs else self.block(())
@@ -861,14 +863,20 @@ class _Compiler:
         if not isinstance(node.func, n.Name):
             raise rt.error("call", "only functions can be called", node)
         name = node.func.id
+        # a def of the same name (collected before it runs) takes precedence at run time
+        builtin = rt.builtins.prepare(name, len(args), tuple(k for k, _ in keywords))
+        if builtin is None:
+            def builtin(values, named, node):
+                return rt.builtins.call(name, values, named, node)
+        functions = rt.functions
 
         def call(frame):
             values = [a(frame) for a in args]
             named = {k: v(frame) for k, v in keywords} if keywords else {}
-            function = rt.functions.get(name)
+            function = functions.get(name)
             if function is not None:
                 return self.call_user(function, values, named, node)
-            return rt.builtins.call(name, values, named, node)
+            return builtin(values, named, node)
 
         return call
 

@@ -423,6 +423,8 @@ class Parser:
         # gotos[state][rule name]: the state after reducing to that rule.
         self.actions: dict[int, dict[str, Any]] = {}
         self.gotos: dict[int, dict[str, int]] = {}
+        # (state below, top state, token kind) -> state after a chain of `?rule` reductions
+        self.chains: dict[tuple[int, int, str], int] = {}
         for state, entries in table.states.items():
             actions: dict[str, Any] = {}
             gotos: dict[str, int] = {}
@@ -464,6 +466,7 @@ class Parser:
         set_aside: list[Token] = []
         actions = self.actions
         gotos = self.gotos
+        chains = self.chains
         stack = [self.start_state]
         values: list[Any] = []
         push_state = stack.append
@@ -486,8 +489,13 @@ class Parser:
                     push_value(token)
                     break
                 if kind_of_action is str:  # `?rule` passing its only child up
-                    del stack[-1]
-                    push_state(gotos[stack[-1]][action])
+                    # A chain of such reductions pops and pushes one state each, so where
+                    # it ends depends only on the state below, the top state and the token.
+                    key = (stack[-2], stack[-1], kind)
+                    target = chains.get(key)
+                    if target is None:
+                        target = chains[key] = self._unit_chain(stack[-2], action, kind)
+                    stack[-1] = target
                     continue
                 size, function, rule = action
                 if size:
@@ -504,6 +512,14 @@ class Parser:
                     return module
                 push_state(gotos[stack[-1]][rule])
         raise AssertionError("parser ran past the end of input")  # pragma: no cover
+
+    def _unit_chain(self, below: int, rule: str, kind: str) -> int:
+        """The state reached by reducing ``rule`` (a one-child ``?rule``) over ``below`` and
+        every one-child reduction that lookahead ``kind`` triggers after it."""
+        state = self.gotos[below][rule]
+        while type(action := self.actions[state].get(kind)) is str:
+            state = self.gotos[below][action]
+        return state
 
     def _accepts(self, stack: list[int], kind: str) -> bool:
         """Whether ``kind`` can be shifted after the reductions it would trigger (simulated on
