@@ -29,3 +29,28 @@ def test_interpolated_samples_match_solving_every_sample(robot, monkeypatch):
     assert np.abs(interpolated.q - dense.q).max() < 1e-6
     assert np.abs(interpolated.qd - dense.qd).max() < 1e-3
     assert np.abs(dense.qd).max() > 0.5  # the program moves fast enough to mean something
+
+
+SLOW = """movej([0, -1.9, 1.9, -1.57, -1.57, 0])
+home = get_actual_tcp_pose()
+movel(pose_add(home, p[0.15, 0, 0, 0, 0, 0]), v=0.03, r=0.01)
+movel(pose_add(home, p[0.15, 0.2, -0.1, 0.3, 0, 0]), v=0.06, r=0.01)
+movel(pose_add(home, p[-0.1, 0.1, 0.1, 0, -0.2, 0.4]), a=0.5, v=0.1)
+movel(home, v=0.02)
+"""
+
+
+@pytest.mark.parametrize("robot", ["ur5e", "ur10"])
+def test_slow_moves_solved_every_few_millimetres_match_solving_every_sample(robot,
+                                                                           monkeypatch):
+    """A slow move cruises with knots every KNOT_PATH of path (here up to 400 ms apart);
+    the joints still agree with solving every sample."""
+    options = CheckOptions(robot=robot, self_collision=False)
+    report = check_text(SLOW, "x.script", options=options)
+    assert not report.has_errors, report.render_text()
+    interpolated = report.trace
+    monkeypatch.setattr(trace_module, "KNOT_TIME", 0.0)
+    dense = check_text(SLOW, "x.script", options=options).trace
+    assert np.abs(interpolated.q - dense.q).max() < 1e-6
+    assert np.abs(interpolated.qd - dense.qd).max() < 1e-4
+    assert interpolated.duration > 15.0  # slow indeed
