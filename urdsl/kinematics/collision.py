@@ -335,7 +335,7 @@ class CollisionModel:
         Q = np.asarray(Q, dtype=float)
         if Q.ndim == 1:
             Q = Q[None]
-        if Q.ndim != 2 or Q.shape[1] != 6 or not np.all(np.isfinite(Q)):
+        if Q.ndim != 2 or Q.shape[1] != 6 or not np.isfinite(Q.sum()):
             raise KinematicsError(f"Q must be finite joint vectors of shape (N, 6), got {Q.shape}")
         return Q
 
@@ -367,11 +367,12 @@ class CollisionModel:
               ) -> tuple[np.ndarray, CollisionResult]:
         """Check a sampled path ``Q`` (N, 6) [rad] every ``stride``-th sample, or further
         apart where no contact is possible in between (conservative advancement): with a
-        clearance ``d`` [m] at one sample, no point of the arm can have
-        moved ``d / 2`` before the joints have travelled ``Σ_k |Δq_k|·R_k = d / 2``, where
-        ``R_k`` bounds how far from joint k's axis anything it moves reaches
-        (:meth:`levers`); two links close in on each other at most twice as fast as one
-        moves. An arm at rest is checked once.
+        clearance ``d`` [m] at one sample, no pair can touch before the joints have
+        travelled ``Σ_k |Δq_k|·R_k = d``, where ``R_k`` bounds how far from joint k's axis
+        anything it moves reaches (:meth:`levers`). A distance between two links does not
+        change with the joints before the first of them: seen from that link, only the other
+        one moves, by at most that travel; an obstacle stands still. An arm at rest is
+        checked once.
 
         Returns the indices of the checked samples and their :class:`CollisionResult`.
         """
@@ -380,8 +381,11 @@ class CollisionModel:
         stride = max(int(stride), 1)
         levers = self.levers()
         travel = np.zeros(len(Q))
-        if len(Q) > 1:
-            np.cumsum(np.abs(np.diff(Q, axis=0)) @ levers, out=travel[1:])
+        block = 32768  # rows per pass (cache-sized)
+        for begin in range(0, len(Q) - 1, block):
+            end = min(begin + block, len(Q) - 1)
+            travel[begin + 1:end + 1] = np.abs(Q[begin + 1:end + 1] - Q[begin:end]) @ levers
+        np.cumsum(travel, out=travel)
         model, data = self.model, self.data
         geometry, geometry_data, names = self._geometry, self._geometry_data, self._pair_names
         results = geometry_data.distanceResults
@@ -400,9 +404,8 @@ class CollisionModel:
             distance.append(value)
             closest.append(names[k])
             ahead = i + stride
-            if value > margin:  # samples before `safe` moved the arm by less than half of it
-                safe = int(np.searchsorted(travel, travel[i] + 0.5 * (value - margin),
-                                           side="left"))
+            if value > margin:  # before `safe`, nothing has moved by the clearance
+                safe = int(travel.searchsorted(travel[i] + (value - margin)))
                 ahead = max(ahead, safe)
             i = ahead
         return np.array(index, dtype=np.int64), CollisionResult(

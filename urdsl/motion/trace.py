@@ -51,7 +51,7 @@ arrays of a chunk stay in the CPU's cache, which makes a long program sample sev
 faster than one pass over all of its samples would."""
 
 
-def _displacements(planner, times: np.ndarray):
+def _displacements(planner, times: np.ndarray, pool: ThreadPoolExecutor):
     """Joint positions (N, 6) at sorted ``times``, the active segment per time, and which
     samples were out of reach.
 
@@ -80,17 +80,11 @@ def _displacements(planner, times: np.ndarray):
     cuts = np.searchsorted(ends, np.arange(CHUNK_SAMPLES, ends[-1], CHUNK_SAMPLES),
                            side="right")
     bounds = np.unique(np.concatenate([[0], cuts, [len(segments)]]))
-    # Two threads evaluate chunks side by side (NumPy lets go of the interpreter lock in
-    # its loops); the main thread adds their windows up in order.
+    # Threads evaluate chunks side by side (NumPy lets go of the interpreter lock in its
+    # loops); the main thread adds their windows up.
     chunks = zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True)
-    with ThreadPoolExecutor(SAMPLING_THREADS) as pool:
-        for entry_sample, moved in pool.map(lambda c: moves.window(*c, unreachable), chunks):
-            if len(entry_sample):
-                low, high = int(entry_sample[0]), int(entry_sample.max()) + 1
-                local = entry_sample - low
-                for joint in range(6):  # blends: two moves add up at one sample
-                    positions[low:high, joint] += np.bincount(local, moved[:, joint],
-                                                              minlength=high - low)
+    for low, window in pool.map(lambda c: moves.dense_window(*c, unreachable), chunks):
+        positions[low:low + len(window)] += window
     # the active move at a sample is the latest one started (blends overlap); samples after
     # a move's end but before the next one starts keep it
     sampled = np.flatnonzero(moves.lengths > 0)
@@ -106,17 +100,20 @@ class _Moves:
         from .planner import JOINT_SPACE
 
         self.planner, self.segments, self.times = planner, segments, times
-        self.starts = np.array([s.start for s in segments])
-        durations = np.array([s.profile.duration for s in segments])
+        # one pass over the moves: start, then the profile (distance, accel, peak, t_acc,
+        # t_flat), as in Trapezoid
+        table = np.array([(s.start, (p := s.profile).distance, p.accel, p.peak, p.t_acc,
+                            p.t_flat) for s in segments]).reshape(-1, 6)
+        self.starts, self.profile = table[:, 0], table[:, 1:]
+        durations = 2.0 * self.profile[:, 3] + self.profile[:, 4]
         self.first = np.searchsorted(times, self.starts, side="left")
         self.last = np.searchsorted(times, self.starts + durations, side="left")
         self.lengths = self.last - self.first
         self.q_start = np.array([s.q_start for s in segments])
         self.q_delta = np.array([s.q_end for s in segments]) - self.q_start
-        self.profile = np.array([(s.profile.distance, s.profile.accel, s.profile.peak,
-                                  s.profile.t_acc, s.profile.t_flat) for s in segments])
-        self.cartesian = np.array([s.kind not in JOINT_SPACE for s in segments])
-        self.arcs = np.array([s.kind == "movec" for s in segments])
+        kinds = [s.kind for s in segments]
+        self.cartesian = np.array([kind not in JOINT_SPACE for kind in kinds])
+        self.arcs = np.array([kind == "movec" for kind in kinds])
         self.paths = _Paths(segments) if self.cartesian.any() else None
         self.dt = times[1] - times[0] if len(times) > 1 else 1.0
         # samples between knots while cruising (see KNOT_PATH): at least KNOT_TIME's
@@ -125,6 +122,19 @@ class _Moves:
         path_steps = np.divide(KNOT_PATH, peak * self.dt, out=np.zeros_like(peak),
                                where=peak > 0)
         self.cruise_every = np.maximum(every, np.floor(path_steps)).astype(np.int64)
+
+    def dense_window(self, begin: int, stop: int, unreachable: np.ndarray):
+        """:meth:`window` summed per sample: the first sample and the joint displacements
+        (K, 6) of the moves at the K samples from there (blends: moves add up)."""
+        entry_sample, moved = self.window(begin, stop, unreachable)
+        if len(entry_sample) == 0:
+            return 0, moved
+        low, high = int(entry_sample[0]), int(entry_sample.max()) + 1
+        local = entry_sample - low
+        window = np.empty((high - low, 6))
+        for joint in range(6):
+            window[:, joint] = np.bincount(local, moved[:, joint], minlength=high - low)
+        return low, window
 
     def window(self, begin: int, stop: int, unreachable: np.ndarray):
         """Entries of moves ``begin`` to ``stop`` − 1: the sample of each (sorted by move,
@@ -343,7 +353,8 @@ def joints_at(planner, times: np.ndarray) -> np.ndarray:
     """Planned joint positions (N, 6) at robot times ``times`` (any order)."""
     times = np.asarray(times, dtype=float)
     order = np.argsort(times)
-    positions, _, _ = _displacements(planner, times[order])
+    with ThreadPoolExecutor(SAMPLING_THREADS) as pool:
+        positions, _, _ = _displacements(planner, times[order], pool)
     result = np.empty_like(positions)
     result[order] = positions
     return result
@@ -355,8 +366,35 @@ def sample(planner, dt: float | None = None) -> Trace:
     end = max(planner.end_time, max((s.end for s in planner.segments), default=0.0))
     count = int(np.floor(end / dt + 1e-9)) + 1
     times = np.arange(count) * dt
-    q, active, unreachable = _displacements(planner, times)
-    qd = np.gradient(q, dt, axis=0) if count > 1 else np.zeros_like(q)
-    qdd = np.gradient(qd, dt, axis=0) if count > 1 else np.zeros_like(q)
+    with ThreadPoolExecutor(SAMPLING_THREADS) as pool:
+        q, active, unreachable = _displacements(planner, times, pool)
+        qd = _derivative(q, dt, pool)
+        qdd = _derivative(qd, dt, pool)
     return Trace(times, q, qd, qdd, active, dt, planner.segments, unreachable)
+
+
+def _derivative(values: np.ndarray, dt: float, pool: ThreadPoolExecutor,
+                block: int = 65536) -> np.ndarray:
+    """``np.gradient(values, dt, axis=0)``: central differences inside, one-sided at both
+    ends (zeros for a single sample), in blocks of rows shared out to the threads."""
+    count = len(values)
+    out = np.zeros_like(values)
+    if count < 2:
+        return out
+
+    def rows(begin: int) -> None:
+        end = min(begin + block, count)
+        inner_begin, inner_end = max(begin, 1), min(end, count - 1)
+        if inner_end > inner_begin:
+            part = out[inner_begin:inner_end]
+            np.subtract(values[inner_begin + 1:inner_end + 1],
+                        values[inner_begin - 1:inner_end - 1], out=part)
+            part /= 2.0 * dt
+        if begin == 0:
+            out[0] = (values[1] - values[0]) / dt
+        if end == count:
+            out[-1] = (values[-1] - values[-2]) / dt
+
+    list(pool.map(rows, range(0, count, block)))
+    return out
 

@@ -52,6 +52,7 @@ class BuiltinTable:
 
     def __init__(self, rt: Any) -> None:
         self.rt = rt
+        self._prepared: dict[tuple, Any] = {}
 
     def call(self, name: str, args: list, named: dict, node: Node) -> Any:
         rt = self.rt
@@ -75,6 +76,12 @@ class BuiltinTable:
         ``name`` is a simulated builtin and the site's shape (``positional`` arguments and
         the ``keywords`` names) fits its signature; None otherwise (:meth:`call` then
         reports the problem when the call runs)."""
+        key = (name, positional, keywords)
+        if key not in self._prepared:  # a long program has few distinct call shapes
+            self._prepared[key] = self._prepare(name, positional, keywords)
+        return self._prepared[key]
+
+    def _prepare(self, name: str, positional: int, keywords: tuple[str, ...]):
         row = lookup(name)
         implementation = IMPLEMENTATIONS.get(name)
         if row is None or implementation is None or row.variadic_keywords \
