@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._threads import shared_pool
+
 __all__ = ["Trace", "sample", "joints_at", "tcp_groups"]
 
 
@@ -42,10 +44,7 @@ class Trace:
         return float(self.times[-1]) if len(self.times) else 0.0
 
 
-SAMPLING_THREADS = 2
-"""Threads that sample chunks of moves at once (the verifier's machines have two cores)."""
-
-CHUNK_SAMPLES = 16384
+CHUNK_SAMPLES = 32768
 """About how many (move, sample) entries :func:`_displacements` evaluates at once: the
 arrays of a chunk stay in the CPU's cache, which makes a long program sample several times
 faster than one pass over all of its samples would."""
@@ -353,8 +352,7 @@ def joints_at(planner, times: np.ndarray) -> np.ndarray:
     """Planned joint positions (N, 6) at robot times ``times`` (any order)."""
     times = np.asarray(times, dtype=float)
     order = np.argsort(times)
-    with ThreadPoolExecutor(SAMPLING_THREADS) as pool:
-        positions, _, _ = _displacements(planner, times[order], pool)
+    positions, _, _ = _displacements(planner, times[order], shared_pool())
     result = np.empty_like(positions)
     result[order] = positions
     return result
@@ -366,10 +364,10 @@ def sample(planner, dt: float | None = None) -> Trace:
     end = max(planner.end_time, max((s.end for s in planner.segments), default=0.0))
     count = int(np.floor(end / dt + 1e-9)) + 1
     times = np.arange(count) * dt
-    with ThreadPoolExecutor(SAMPLING_THREADS) as pool:
-        q, active, unreachable = _displacements(planner, times, pool)
-        qd = _derivative(q, dt, pool)
-        qdd = _derivative(qd, dt, pool)
+    pool = shared_pool()
+    q, active, unreachable = _displacements(planner, times, pool)
+    qd = _derivative(q, dt, pool)
+    qdd = _derivative(qd, dt, pool)
     return Trace(times, q, qd, qdd, active, dt, planner.segments, unreachable)
 
 

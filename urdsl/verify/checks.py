@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._threads import shared_pool
 from ..motion.planner import JOINT_SPACE
 from ..motion.trace import Trace
 from .findings import Finding
@@ -30,8 +31,11 @@ def _rows_where(values: np.ndarray, predicate, block: int = 32768) -> np.ndarray
     """(N,) bool: rows of ``values`` (N, 6) where ``predicate`` (an elementwise test of a
     block of rows) holds for some column; evaluated in cache-sized blocks of rows."""
     flagged = np.empty(len(values), dtype=bool)
-    for start in range(0, len(values), block):
+
+    def rows(start: int) -> None:
         predicate(values[start:start + block]).any(axis=1, out=flagged[start:start + block])
+
+    list(shared_pool().map(rows, range(0, len(values), block)))
     return flagged
 
 
@@ -152,10 +156,13 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
     threshold = np.maximum(JUMP_MIN, 10.0 * speed_limits * trace.dt)
     jumps = np.zeros(count, dtype=bool)
     block = 32768
-    for start in range(0, count - 1, block):  # a step from the sample before over threshold
+
+    def rows(start: int) -> None:  # a step from the sample before over the threshold
         stop = min(start + block, count - 1)
         step = np.abs(trace.q[start + 1:stop + 1] - trace.q[start:stop])
         (step > threshold).any(axis=1, out=jumps[start + 1:stop + 1])
+
+    list(shared_pool().map(rows, range(0, count - 1, block)))
     reported: set[int] = set()
     for segment, sample in _per_segment(trace, trace.unreachable):
         reported.add(segment)
