@@ -258,10 +258,12 @@ def singularities(trace: Trace, robot, scale: float | None = None,
         close &= cartesian
         for segment, sample in _per_segment(trace, close):
             move = trace.segments[segment]
+            distance = abs(float(measures[kind][sample // stride]))
+            distance = 0.0 if distance < 1e-12 else distance  # rounding: on the singularity
             findings.append(Finding.of(
                 "URS307",
                 f"{kind} singularity: the {move.kind} passes within "
-                f"{abs(float(measures[kind][sample // stride])):.3g} {_UNITS[kind]} of it at "
+                f"{distance:.3g} {_UNITS[kind]} of it at "
                 f"t={trace.times[sample]:.3f} s (joint speeds grow without bound there)",
                 _span(trace, segment), float(trace.times[sample]),
                 _SINGULARITY_HINTS[kind]))
