@@ -434,14 +434,15 @@ class MotionPlanner:
 
     def _add(self, segment: Segment, now: float) -> float:
         previous = self._pending
-        distance = _distance(segment.pose_end, segment.pose_start)
+        radius = segment.radius
         previous_radius = previous.radius if previous is not None else 0.0
-        if segment.radius > 0 or previous_radius > 0:
-            if previous_radius + segment.radius > distance + 1e-12:
+        if radius > 0 or previous_radius > 0:
+            distance = _distance(segment.pose_end, segment.pose_start)
+            if previous_radius + radius > distance + 1e-12:
                 self.warnings.append(MotionWarning(
                     "overlap",
                     f"Overlapping Blends: blend radii {previous_radius:g} m + "
-                    f"{segment.radius:g} m exceed the {distance:.4g} m to the previous "
+                    f"{radius:g} m exceed the {distance:.4g} m to the previous "
                     "waypoint; the robot skips this move",
                     segment.span, now))
                 self.skipped.append(segment)
@@ -449,30 +450,34 @@ class MotionPlanner:
         if previous is not None and segment.kind not in BLENDABLE_INTO:
             self.stop_blending(now)
             previous = None
+        profile = segment.profile
+        duration = profile.duration
         if previous is not None:
-            tail = _time_for_last(previous, min(previous.radius, _tcp_length(previous)))
-            head = segment.profile.time_at(_path_fraction_for(segment, previous.radius)
-                                           * segment.profile.distance)
-            overlap = min(tail, head, previous.duration, segment.duration)
+            previous_duration = previous.profile.duration
+            tail = _time_for_last(previous, previous_radius)
+            head = profile.time_at(_path_fraction_for(segment, previous_radius)
+                                   * profile.distance)
+            overlap = min(tail, head, previous_duration, duration)
             previous.blend_with_next = overlap
-            segment.start = max(previous.end - overlap, now)
+            start = max(previous.start + previous_duration - overlap, now)
         else:
-            segment.start = max(now, self._free_at)
+            start = max(now, self._free_at)
+        segment.start = start
+        end = start + duration
         self.segments.append(segment)
         if segment.q_end is None:
             self._unresolved.append(segment)
         else:
             self._q_end = segment.q_end.copy()
         self._end_pose = segment.pose_end
-        self.end_time = max(self.end_time, segment.end)
-        if segment.radius > 0:
+        if end > self.end_time:
+            self.end_time = end
+        if radius > 0:
             self._pending = segment
-            blend_start = segment.end - _time_for_last(segment, min(segment.radius,
-                                                                    _tcp_length(segment)))
-            return max(blend_start, now)
+            return max(end - _time_for_last(segment, radius), now)
         self._pending = None
-        self._free_at = segment.end
-        return segment.end
+        self._free_at = end
+        return end
 
 
 def _distance(pose: np.ndarray, other: np.ndarray) -> float:
@@ -495,7 +500,8 @@ def _path_fraction_for(segment: Segment, tcp_distance: float) -> float:
 
 
 def _time_for_last(segment: Segment, tcp_distance: float) -> float:
-    """Time the segment needs for its last ``tcp_distance`` metres of TCP travel."""
+    """Time the segment needs for its last ``tcp_distance`` metres of TCP travel (all of
+    it when ``tcp_distance`` is longer than the segment)."""
     fraction = _path_fraction_for(segment, tcp_distance)
     profile = segment.profile
     return profile.duration - profile.time_at((1.0 - fraction) * profile.distance)

@@ -18,6 +18,7 @@ the controller does not document this case [U], the verifier reports its speeds.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -70,7 +71,7 @@ class Trapezoid:
         accel = 4.0 * self.distance / (total * total)
         return Trapezoid(self.distance, accel, accel * total / 2, total / 2, 0.0)
 
-    @property
+    @functools.cached_property
     def duration(self) -> float:
         """Total time in s."""
         return 2.0 * self.t_acc + self.t_flat
