@@ -187,3 +187,13 @@ def test_wrong_shapes_are_rejected():
         pose.to_matrix([1, 2, 3])
     with pytest.raises(ValueError, match="4x4"):
         pose.from_matrix(np.eye(3))
+
+
+@settings(max_examples=300, deadline=None)
+@given(poses)
+def test_one_pose_as_a_sequence_matches_the_batched_formula(p):
+    """to_matrix of one pose given as a tuple or list (scalar maths, the interpreter's path)
+    equals the vectorised formula on an array, also at and near the angles 0 and π."""
+    batched = pose.to_matrix(np.asarray(p)[None])[0]
+    for one in (tuple(p), list(p)):
+        assert np.allclose(pose.to_matrix(one), batched, atol=1e-14, rtol=0)

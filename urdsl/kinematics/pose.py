@@ -169,7 +169,7 @@ def matrix_to_rpy(rotation) -> np.ndarray:
 def to_matrix(pose) -> np.ndarray:
     """Homogeneous matrices (..., 4, 4) of URScript poses (..., 6)."""
     if type(pose) is not np.ndarray and len(pose) == 6:  # one pose: scalar maths is faster
-        return _one_matrix(*(float(v) for v in pose))
+        return _one_matrix(*map(float, pose))
     p = _array(pose, 6, "a pose")
     out = np.zeros(p.shape[:-1] + (4, 4))
     out[..., :3, :3] = rotvec_to_matrix(p[..., 3:])
@@ -188,10 +188,10 @@ def _one_matrix(x: float, y: float, z: float, rx: float, ry: float, rz: float) -
     else:
         a, b = 1.0, 0.5
     xx, yy, zz, xy, xz, yz = rx * rx, ry * ry, rz * rz, rx * ry, rx * rz, ry * rz
-    return np.array([[1.0 - b * (yy + zz), b * xy - a * rz, b * xz + a * ry, x],
-                     [b * xy + a * rz, 1.0 - b * (xx + zz), b * yz - a * rx, y],
-                     [b * xz - a * ry, b * yz + a * rx, 1.0 - b * (xx + yy), z],
-                     [0.0, 0.0, 0.0, 1.0]])
+    return np.array([1.0 - b * (yy + zz), b * xy - a * rz, b * xz + a * ry, x,
+                     b * xy + a * rz, 1.0 - b * (xx + zz), b * yz - a * rx, y,
+                     b * xz - a * ry, b * yz + a * rx, 1.0 - b * (xx + yy), z,
+                     0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
 
 
 def from_matrix(matrix) -> np.ndarray:

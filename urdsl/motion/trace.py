@@ -115,12 +115,68 @@ class _Moves:
         self.arcs = np.array([kind == "movec" for kind in kinds])
         self.paths = _Paths(segments) if self.cartesian.any() else None
         self.dt = times[1] - times[0] if len(times) > 1 else 1.0
-        # samples between knots while cruising (see KNOT_PATH): at least KNOT_TIME's
-        every = max(1, int(round(KNOT_TIME / self.dt)))
-        peak = self.profile[:, 2]
-        path_steps = np.divide(KNOT_PATH, peak * self.dt, out=np.zeros_like(peak),
-                               where=peak > 0)
-        self.cruise_every = np.maximum(every, np.floor(path_steps)).astype(np.int64)
+        self.every_sample = (KNOT_TIME <= self.dt
+                             or not hasattr(planner.kinematics, "jacobian_many"))
+
+    def dense_rows(self, seg_rows: np.ndarray) -> np.ndarray:
+        """Which samples of TCP paths (moves ``seg_rows``) are all solved by IK: those of
+        arcs, and all of them for a model without Jacobians (``jacobian_many``) or a step
+        as long as :data:`KNOT_TIME`."""
+        if self.every_sample:
+            return np.ones(len(seg_rows), dtype=bool)
+        return self.arcs[seg_rows]
+
+    def knots(self, moves: np.ndarray) -> _Knots:
+        """The knots of straight-line moves ``moves`` (sorted move indices), solved: each
+        phase of the speed profile (accelerating, cruising, braking) split into equal steps
+        of at most :data:`KNOT_TIME` (cruising: of at most ``max(KNOT_TIME, KNOT_PATH / v)``),
+        so that no cubic spans a change of the acceleration. A move's first and last knot
+        are its ends, at rest: their joints and speeds (0) are known; the others are solved
+        by IK, with speeds from the Jacobian."""
+        from .profiles import positions as profile_positions
+        from .profiles import speeds as profile_speeds
+
+        p = self.profile[moves]
+        t_acc, t_flat = p[:, 3], p[:, 4]
+        ramp = np.where(t_acc > 0, np.ceil(t_acc / KNOT_TIME - 1e-9), 0).astype(np.int64)
+        cruise_step = np.maximum(KNOT_TIME, np.divide(KNOT_PATH, p[:, 2],
+                                                      out=np.full(len(p), np.inf),
+                                                      where=p[:, 2] > 0))
+        cruise = np.where(t_flat > 0, np.ceil(t_flat / cruise_step - 1e-9), 0).astype(np.int64)
+        ramp = np.maximum(ramp, np.where(cruise > 0, 0, 1))  # at least one step per move
+        steps = 2 * ramp + cruise
+        count = steps + 1  # knots per move
+        move_of = np.repeat(np.arange(len(moves)), count)
+        first = np.cumsum(count) - count
+        j = np.arange(len(move_of)) - first[move_of]  # knot number inside its move
+        r, c = ramp[move_of], cruise[move_of]
+        ta, tf = t_acc[move_of], t_flat[move_of]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rising = j * (ta / r)
+            flat = ta + (j - r) * (tf / np.maximum(c, 1))
+            falling = ta + tf + (j - r - c) * (ta / r)
+        t = np.where(j <= r, rising, np.where(j <= r + c, flat, falling))
+        last = first + count - 1
+        t[first] = 0.0
+        t[last] = 2.0 * t_acc + t_flat
+        segment = moves[move_of]
+        pk = p[move_of]
+        covered = profile_positions(t, pk[:, 0], pk[:, 1], pk[:, 2], pk[:, 3], pk[:, 4])
+        fraction = covered / pk[:, 0]
+        q = fraction[:, None] * self.q_delta[segment]  # displacement; ends exact, at rest
+        velocity = np.zeros_like(q)
+        inner = np.ones(len(t), dtype=bool)
+        inner[first] = inner[last] = False
+        inner = np.flatnonzero(inner)
+        if len(inner):
+            which = segment[inner]
+            q[inner] = _cartesian(self.planner, self.paths, which, fraction[inner],
+                                  self.q_start, q[inner])
+            speed = profile_speeds(t[inner], pk[inner, 0], pk[inner, 1], pk[inner, 2],
+                                   pk[inner, 3], pk[inner, 4])
+            velocity[inner] = _joint_velocities(self.planner, self.paths, which,
+                                                self.q_start, q[inner], speed / pk[inner, 0])
+        return _Knots(moves, first, t, q, velocity)
 
     def dense_window(self, begin: int, stop: int, unreachable: np.ndarray):
         """:meth:`window` summed per sample: the first sample and the joint displacements
@@ -140,7 +196,6 @@ class _Moves:
         then time) and the joint displacement (M, 6) of its move since the move's start.
         Marks samples out of reach in ``unreachable``."""
         from .profiles import positions as profile_positions
-        from .profiles import speeds as profile_speeds
 
         lengths = self.lengths[begin:stop]
         entry_segment = np.repeat(np.arange(begin, stop), lengths)
@@ -158,22 +213,18 @@ class _Moves:
         if len(rows) == 0:
             return entry_sample, moved
         seg_rows = entry_segment[rows]
-        local = rows - offsets[seg_rows - begin]
-        phase = (local_t[rows] >= p[rows, 3]).astype(np.int8) + (
-            local_t[rows] >= p[rows, 3] + p[rows, 4])
-        knots = _knots(self.planner, self, seg_rows, local, phase)
-        knot_rows = rows[knots]
-        which = entry_segment[knot_rows]
-        solved = _cartesian(self.planner, self.paths, which, fraction[knot_rows],
-                            self.q_start, moved[knot_rows])
-        moved[knot_rows] = solved
-        if not knots.all():
-            pk = p[knot_rows]
-            speed = profile_speeds(local_t[knot_rows], pk[:, 0], pk[:, 1], pk[:, 2],
-                                   pk[:, 3], pk[:, 4])
-            velocity = _joint_velocities(self.planner, self.paths, which, self.q_start,
-                                         solved, speed / pk[:, 0])
-            _hermite(moved, local_t, rows, knots, velocity)
+        dense = self.dense_rows(seg_rows)
+        solved = np.empty((0, 6))
+        if dense.any():  # arcs, and models without Jacobians: every sample solved
+            which = rows[dense]
+            solved = _cartesian(self.planner, self.paths, entry_segment[which],
+                                fraction[which], self.q_start, moved[which])
+            moved[which] = solved
+        if not dense.all():
+            lines = rows[~dense]
+            knots = self.knots(np.unique(entry_segment[lines]))
+            moved[lines] = knots.interpolate(entry_segment[lines], local_t[lines])
+            solved = np.concatenate([solved, knots.q])
         if not np.isnan(solved).any():  # samples between solved ones are NaN only next to one
             return entry_sample, moved
         gaps = np.isnan(moved[rows]).any(axis=1)
@@ -200,24 +251,6 @@ joints' fourth derivative is ``Q⁗(s)·v⁴`` (``Q`` the joints as a function o
 length ``s``), so the interpolation error depends on the path length between knots, not on
 their time. 8 mm is what :data:`KNOT_TIME` gives at the controller's default movel speed
 (0.25 m/s); a slow process move (a 0.1 m/s toolpath) is solved every 80 ms."""
-
-
-def _knots(planner, moves, seg_rows, local, phase) -> np.ndarray:
-    """Which samples of TCP paths are solved by IK: every ``KNOT_TIME`` while accelerating
-    or braking and every ``KNOT_PATH`` of path while cruising (if longer), the first and last
-    of each move, and those on either side of a change of the profile's phase (accelerating,
-    cruising, braking: the joint accelerations jump there, which a cubic would smooth); all
-    of them for arcs and for models without Jacobians (``jacobian_many``)."""
-    every = max(1, int(round(KNOT_TIME / moves.dt)))
-    if every == 1 or not hasattr(planner.kinematics, "jacobian_many"):
-        return np.ones(len(local), dtype=bool)
-    change = np.zeros(len(local), dtype=bool)
-    switch = (phase[1:] != phase[:-1]) & (seg_rows[1:] == seg_rows[:-1])
-    change[1:] |= switch
-    change[:-1] |= switch
-    spacing = np.where(phase == 1, moves.cruise_every[seg_rows], every)
-    return ((local % spacing == 0) | (local == moves.lengths[seg_rows] - 1)
-            | moves.arcs[seg_rows] | change)
 
 
 def _joint_velocities(planner, paths, which, q_start, moved, fraction_rate) -> np.ndarray:
@@ -247,34 +280,47 @@ def _joint_velocities(planner, paths, which, q_start, moved, fraction_rate) -> n
     return velocity
 
 
-def _hermite(moved, entry_time, rows, knots, velocity) -> None:
-    """Fill the samples between solved ones (``rows[~knots]``) in place: cubic Hermite on the
-    joint displacements and speeds of the neighbouring solved samples of the same move.
+class _Knots:
+    """Solved knots of straight-line moves: for move ``moves[m]``, knots ``first[m]`` on,
+    at local times ``t`` (s since the move's start), with joint displacements ``q`` (K, 6)
+    [rad] and speeds ``velocity`` (K, 6) [rad/s]."""
 
-    ``rows`` runs move by move and the first and last sample of every move is solved, so
-    the samples between two consecutive solved ones are a run of ``rows``; each run's cubic
-    ``q0 + s·(c1 + s·(c2 + s·c3))`` (``s`` in [0, 1]) is set up once and repeated over it.
-    """
-    solved = rows[np.flatnonzero(knots)]
-    counts = np.diff(np.flatnonzero(knots)) - 1  # samples between knot j and knot j + 1
-    runs = np.flatnonzero(counts > 0)
-    counts = counts[runs]
-    q0, q1 = moved[solved[runs]], moved[solved[runs + 1]]
-    t0 = entry_time[solved[runs]]
-    h = entry_time[solved[runs + 1]] - t0
-    v0, v1 = h[:, None] * velocity[runs], h[:, None] * velocity[runs + 1]
-    c2 = 3.0 * (q1 - q0) - 2.0 * v0 - v1
-    c3 = 2.0 * (q0 - q1) + v0 + v1
-    inner = rows[~knots]
-    s = ((entry_time[inner] - np.repeat(t0, counts)) / np.repeat(h, counts))[:, None]
-    value = np.repeat(c3, counts, axis=0)
-    value *= s
-    value += np.repeat(c2, counts, axis=0)
-    value *= s
-    value += np.repeat(v0, counts, axis=0)
-    value *= s
-    value += np.repeat(q0, counts, axis=0)
-    moved[inner] = value
+    def __init__(self, moves, first, t, q, velocity) -> None:
+        self.moves, self.first, self.t, self.q, self.velocity = moves, first, t, q, velocity
+
+    def interpolate(self, segment: np.ndarray, local_t: np.ndarray) -> np.ndarray:
+        """Joint displacements (M, 6) at samples of these moves (``segment``: move index,
+        ``local_t``: s since its start; sorted by move, then time): the cubic Hermite of the
+        two knots around each sample, ``q0 + s·(c1 + s·(c2 + s·c3))`` with ``s`` in [0, 1].
+        The samples of one interval are consecutive: each interval's cubic is set up once
+        and repeated over them."""
+        position = np.searchsorted(self.moves, segment)
+        end = np.append(self.first[1:], len(self.t)) - 1  # each move's last knot
+        # the knot at or before each sample: moves are in order and their knot times rise,
+        # so (move position, time) sorts like the knots
+        span = float(self.t.max()) + 1.0
+        knot_key = np.repeat(np.arange(len(self.moves)), np.diff(np.append(self.first,
+                                                                            len(self.t))))
+        knot_key = knot_key * span + self.t
+        left = np.searchsorted(knot_key, position * span + local_t, side="right") - 1
+        left = np.minimum(left, end[position] - 1)
+        intervals, counts = np.unique(left, return_counts=True)
+        t0 = self.t[intervals]
+        h = self.t[intervals + 1] - t0
+        q0, q1 = self.q[intervals], self.q[intervals + 1]
+        v0 = h[:, None] * self.velocity[intervals]
+        v1 = h[:, None] * self.velocity[intervals + 1]
+        c2 = 3.0 * (q1 - q0) - 2.0 * v0 - v1
+        c3 = 2.0 * (q0 - q1) + v0 + v1
+        s = ((local_t - np.repeat(t0, counts)) / np.repeat(h, counts))[:, None]
+        value = np.repeat(c3, counts, axis=0)
+        value *= s
+        value += np.repeat(c2, counts, axis=0)
+        value *= s
+        value += np.repeat(v0, counts, axis=0)
+        value *= s
+        value += np.repeat(q0, counts, axis=0)
+        return value
 
 
 class _Paths:
