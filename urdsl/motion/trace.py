@@ -57,8 +57,9 @@ def _displacements(planner, times: np.ndarray, pool: ThreadPoolExecutor):
     A sample's joints are the start joints, plus the whole displacement of every move that
     has ended, plus the part done so far of every move under way (moves overlap in blends).
     The moves are evaluated in chunks of consecutive moves (:data:`CHUNK_SAMPLES`), each
-    chunk with one array entry per (move, sample inside the move): profiles and straight TCP
-    paths vectorised, one batched inverse-kinematics call for the Cartesian samples.
+    chunk with one array entry per (move, sample inside the move): profiles vectorised,
+    straight TCP paths solved at their knots (:data:`KNOT_TIME`) in one batched
+    inverse-kinematics call and interpolated in between.
     """
     count = len(times)
     segments = planner.segments
@@ -236,20 +237,22 @@ class _Moves:
 
 
 KNOT_TIME = 0.032
-"""Robot time (s) between the samples of a TCP path that are solved by inverse kinematics
-while the move accelerates or brakes; the samples in between are cubic Hermite
-interpolations of the joints, with the joint speeds at the solved samples from the Jacobian
-(``q̇ = J⁻¹·twist``). Joint paths of straight-line moves are smooth away from singularities,
-where the error of this cubic is of the order of ``(h/2)⁴·q⁗`` — below a micro-radian at
-32 ms (6e-7 rad measured against solving every sample); near a singularity the Jacobian's
-speeds grow, which is what the checks look for."""
+"""Longest robot time (s) between the knots of a straight TCP path — the points solved by
+inverse kinematics — while the move accelerates or brakes; the samples in between are cubic
+Hermite interpolations of the joints, with the joint speeds at the knots from the Jacobian
+(``q̇ = J⁻¹·twist``). Knots also sit exactly at the changes of the speed profile's phase and
+at the move's ends, so that no cubic spans a jump of the acceleration. Joint paths of
+straight-line moves are smooth away from singularities, where the error of this cubic is of
+the order of ``(h/2)⁴·q⁗`` — below a micro-radian at 32 ms (3e-7 rad measured against
+solving every sample); near a singularity the Jacobian's speeds grow, which is what the
+checks look for."""
 
 KNOT_PATH = 0.008
-"""Path length (m, or rad for a rotation-only move) between solved samples while a move
-cruises, when that is longer than :data:`KNOT_TIME`: at constant path speed ``v`` the
-joints' fourth derivative is ``Q⁗(s)·v⁴`` (``Q`` the joints as a function of the path
-length ``s``), so the interpolation error depends on the path length between knots, not on
-their time. 8 mm is what :data:`KNOT_TIME` gives at the controller's default movel speed
+"""Longest path (m, or rad for a rotation-only move) between knots while a move cruises,
+when that takes longer than :data:`KNOT_TIME`: at constant path speed ``v`` the joints'
+fourth derivative is ``Q⁗(s)·v⁴`` (``Q`` the joints as a function of the path length
+``s``), so the interpolation error depends on the path length between knots, not on their
+time. 8 mm is what :data:`KNOT_TIME` gives at the controller's default movel speed
 (0.25 m/s); a slow process move (a 0.1 m/s toolpath) is solved every 80 ms."""
 
 
