@@ -116,16 +116,12 @@ class _Moves:
         self.arcs = np.array([kind == "movec" for kind in kinds])
         self.paths = _Paths(segments) if self.cartesian.any() else None
         self.dt = times[1] - times[0] if len(times) > 1 else 1.0
-        self.every_sample = (KNOT_TIME <= self.dt
-                             or not hasattr(planner.kinematics, "jacobian_many"))
-
-    def dense_rows(self, seg_rows: np.ndarray) -> np.ndarray:
-        """Which samples of TCP paths (moves ``seg_rows``) are all solved by IK: those of
-        arcs, and all of them for a model without Jacobians (``jacobian_many``) or a step
-        as long as :data:`KNOT_TIME`."""
-        if self.every_sample:
-            return np.ones(len(seg_rows), dtype=bool)
-        return self.arcs[seg_rows]
+        # straight TCP paths of non-zero length are interpolated between knots, unless the
+        # model has no Jacobians (``jacobian_many``) or a step is as long as KNOT_TIME; the
+        # samples of arcs are all solved
+        every_sample = KNOT_TIME <= self.dt or not hasattr(planner.kinematics, "jacobian_many")
+        self.interpolated = (self.cartesian & ~self.arcs & (self.profile[:, 0] > 0)
+                             & (not every_sample))
 
     def knots(self, moves: np.ndarray) -> _Knots:
         """The knots of straight-line moves ``moves`` (sorted move indices), solved: each
@@ -206,25 +202,34 @@ class _Moves:
         entry_sample = np.arange(len(entry_segment)) - np.repeat(
             offsets - self.first[begin:stop], lengths)
         local_t = self.times[entry_sample] - self.starts[entry_segment]
-        p = self.profile[entry_segment]
-        covered = profile_positions(local_t, p[:, 0], p[:, 1], p[:, 2], p[:, 3], p[:, 4])
-        fraction = np.divide(covered, p[:, 0], out=np.ones_like(covered), where=p[:, 0] > 0)
-        moved = fraction[:, None] * self.q_delta[entry_segment]
-        rows = np.flatnonzero(self.cartesian[entry_segment] & (p[:, 0] > 0))
-        if len(rows) == 0:
-            return entry_sample, moved
-        seg_rows = entry_segment[rows]
-        dense = self.dense_rows(seg_rows)
+        # samples of straight TCP paths come from their knots; the others from the profile
+        lines = self.interpolated[entry_segment]
+        moved = np.empty((len(entry_segment), 6))
         solved = np.empty((0, 6))
-        if dense.any():  # arcs, and models without Jacobians: every sample solved
-            which = rows[dense]
-            solved = _cartesian(self.planner, self.paths, entry_segment[which],
-                                fraction[which], self.q_start, moved[which])
-            moved[which] = solved
-        if not dense.all():
-            lines = rows[~dense]
-            knots = self.knots(np.unique(entry_segment[lines]))
-            moved[lines] = knots.interpolate(entry_segment[lines], local_t[lines])
+        if lines.all():
+            rows = np.arange(len(entry_segment))
+        else:
+            rows = np.flatnonzero(self.cartesian[entry_segment])
+            other = np.flatnonzero(~lines)
+            segment = entry_segment[other]
+            p = self.profile[segment]
+            covered = profile_positions(local_t[other], p[:, 0], p[:, 1], p[:, 2], p[:, 3],
+                                        p[:, 4])
+            fraction = np.divide(covered, p[:, 0], out=np.ones_like(covered),
+                                 where=p[:, 0] > 0)
+            moved[other] = fraction[:, None] * self.q_delta[segment]
+            # arcs, and every path of a model without Jacobians: every sample solved
+            solve = self.cartesian[segment] & (p[:, 0] > 0)
+            if solve.any():
+                which = other[solve]
+                solved = _cartesian(self.planner, self.paths, entry_segment[which],
+                                    fraction[solve], self.q_start, moved[which])
+                moved[which] = solved
+            lines = np.flatnonzero(lines)
+        if len(lines):
+            line_segment = entry_segment[lines]
+            knots = self.knots(np.unique(line_segment))
+            moved[lines] = knots.interpolate(line_segment, local_t[lines])
             solved = np.concatenate([solved, knots.q])
         if not np.isnan(solved).any():  # samples between solved ones are NaN only next to one
             return entry_sample, moved

@@ -276,6 +276,12 @@ class Interpreter:
     def wait_until(self, when: float) -> None:
         """Block the current thread until robot time ``when`` (s)."""
         thread = self.current
+        if (len(self._threads) == 1 and self.config.pace is None and not self.stop_requested
+                and when <= self.config.max_time):
+            # the main thread alone, unpaced: the scheduler would only move the clock on
+            thread.wake = self.time = max(when, self.time)
+            self.steps = 0
+            return
         thread.wake = max(when, self.time)
         self._order += 1
         thread.order = self._order
