@@ -310,12 +310,18 @@ class Robot:
             return _dedupe(candidates)
         solutions, _ = _ik.solve_ur(flange, *self._nominal, q6_hint=hint,
                                     reach_tolerance=CALIBRATED_REACH_SLACK)
-        refined = []
-        for guess in solutions[0][~np.isnan(solutions[0, :, 0])]:
+        guesses = solutions[0][~np.isnan(solutions[0, :, 0])]
+        # the batched solvers' damped Newton steps; where they do not converge (near a
+        # singularity of the nominal guess), Pinocchio's least-squares steps
+        refined, errors = _ik.refine(guesses, np.repeat(flange, len(guesses), axis=0),
+                                     *self._dh)
+        found = [q for q, error in zip(refined, errors, strict=True)
+                 if error < REFINE_TOLERANCE]
+        for guess in guesses[errors >= REFINE_TOLERANCE]:
             q, error = self._refine_pin(guess, flange[0])
             if error < REFINE_TOLERANCE:
-                refined.append(_ik.wrap(q))
-        return _dedupe(np.array(refined).reshape(-1, 6))
+                found.append(q)
+        return _dedupe(_ik.wrap(np.array(found).reshape(-1, 6)))
 
     def out_of_reach(self, T, tcp=None) -> np.ndarray:
         """How far (m) each pose (N, 4, 4) or (N, 6) lies outside the reach, 0 when some
