@@ -191,3 +191,31 @@ def test_models_are_readable_without_pinocchio():
             "assert len(MODELS) == 14; pose.to_matrix([0, 0, 0, 0, 0, 1]); "
             "assert 'pinocchio' not in sys.modules, 'pinocchio was imported'")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_closed_form_axes_and_origins_are_those_of_the_dh_chain(robots, name):
+    robot = robots[name]
+    Q = random_q(300, 11)
+    frames = robot.frames_many(Q)
+    axes, origins = robot.axes_many(Q)
+    assert np.allclose(axes, frames[:, :6, :3, 2], atol=1e-12)
+    assert np.allclose(origins, frames[:, :, :3, 3], atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["ur5e", "ur10", "ur30"])
+def test_batched_jacobians_match_pinocchio_at_the_flange_and_a_tcp(robots, name):
+    """jacobian_many (closed form) against Pinocchio's frame Jacobian; at a TCP the linear
+    rows gain ω × (p_tcp − p_flange)."""
+    robot = robots[name]
+    Q = random_q(40, 12)
+    tcp = np.array([0.02, -0.03, 0.15, 0.1, 0.2, 0.3])
+    at_flange = robot.jacobian_many(Q)
+    at_tcp = robot.jacobian_many(Q, tcp=tcp)
+    for q, flange, moved in zip(Q, at_flange, at_tcp, strict=True):
+        reference = robot.jacobian(q)
+        assert np.allclose(flange, reference, atol=1e-12)
+        lever = robot.fk(q, tcp=tcp)[:3, 3] - robot.fk(q)[:3, 3]
+        shifted = reference.copy()
+        shifted[:3] -= np.cross(lever, reference[3:].T).T
+        assert np.allclose(moved, shifted, atol=1e-12)

@@ -44,18 +44,21 @@ def fk_ur(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
     return out
 
 
-def _fk_ur_block(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
-                 d6: float, out: np.ndarray) -> None:
-    c = np.cos(q)
-    s = np.sin(q)
-    c1, s1, c2, s2, c5, s5, c6, s6 = (c[:, 0], s[:, 0], c[:, 1], s[:, 1], c[:, 4], s[:, 4],
-                                      c[:, 5], s[:, 5])
+def _arm_terms(q: np.ndarray, a2: float, a3: float):
+    """Cosines and sines (N, 6) of the joints, ``C``, ``S`` of θ2+θ3+θ4 and the arm-plane
+    coordinates ``u``, ``v`` of the wrist-1 point (see the module docstring)."""
+    c, s = np.cos(q), np.sin(q)
     q23 = q[:, 1] + q[:, 2]
     q234 = q23 + q[:, 3]
-    c23, s23 = np.cos(q23), np.sin(q23)
-    cc, ss = np.cos(q234), np.sin(q234)
-    u = a2 * c2 + a3 * c23
-    v = a2 * s2 + a3 * s23
+    u = a2 * c[:, 1] + a3 * np.cos(q23)
+    v = a2 * s[:, 1] + a3 * np.sin(q23)
+    return c, s, np.cos(q234), np.sin(q234), u, v
+
+
+def _fk_ur_block(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
+                 d6: float, out: np.ndarray) -> None:
+    c, s, cc, ss, u, v = _arm_terms(q, a2, a3)
+    c1, s1, c5, s5, c6, s6 = c[:, 0], s[:, 0], c[:, 4], s[:, 4], c[:, 5], s[:, 5]
 
     c1c = c1 * cc
     s1c = s1 * cc
@@ -96,14 +99,8 @@ def ur_axes(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float
     """
     q = np.asarray(q, dtype=float)
     n = q.shape[0]
-    c, s = np.cos(q), np.sin(q)
+    c, s, cc, ss, u, v = _arm_terms(q, a2, a3)
     c1, s1, c2, s2, c5, s5 = c[:, 0], s[:, 0], c[:, 1], s[:, 1], c[:, 4], s[:, 4]
-    q23 = q[:, 1] + q[:, 2]
-    q234 = q23 + q[:, 3]
-    c23, s23 = np.cos(q23), np.sin(q23)
-    cc, ss = np.cos(q234), np.sin(q234)
-    u = a2 * c2 + a3 * c23
-    v = a2 * s2 + a3 * s23
     axes = np.zeros((n, 6, 3))
     axes[:, 0, 2] = 1.0
     axes[:, 1:4, 0] = s1[:, None]
