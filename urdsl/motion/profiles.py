@@ -18,7 +18,6 @@ the controller does not document this case [U], the verifier reports its speeds.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -27,7 +26,7 @@ import numpy as np
 __all__ = ["Trapezoid", "positions", "speeds"]
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class Trapezoid:
     """A trapezoidal (or triangular) profile over ``distance`` ≥ 0.
 
@@ -71,7 +70,7 @@ class Trapezoid:
         accel = 4.0 * self.distance / (total * total)
         return Trapezoid(self.distance, accel, accel * total / 2, total / 2, 0.0)
 
-    @functools.cached_property
+    @property
     def duration(self) -> float:
         """Total time in s."""
         return 2.0 * self.t_acc + self.t_flat

@@ -24,20 +24,28 @@ class Trace:
     """Samples of a planned trajectory.
 
     ``times`` (N,) in s; ``q`` (N, 6) in rad; ``qd`` (N, 6) rad/s and ``qdd`` (N, 6) rad/s²
-    by finite differences; ``segment`` (N,) the index into ``segments`` of the move active at
-    each sample (-1 at rest before the first move); ``dt`` the sampling step in s;
-    ``unreachable`` (N,) marks samples of a TCP path that inverse kinematics could not reach
-    (their joints repeat the last reachable sample).
+    by finite differences (``qdd`` computed when first asked for, if given as None);
+    ``segment`` (N,) the index into ``segments`` of the move active at each sample (-1 at
+    rest before the first move); ``dt`` the sampling step in s; ``unreachable`` (N,) marks
+    samples of a TCP path that inverse kinematics could not reach (their joints repeat the
+    last reachable sample).
     """
 
     times: np.ndarray
     q: np.ndarray
     qd: np.ndarray
-    qdd: np.ndarray
+    accelerations: np.ndarray | None
     segment: np.ndarray
     dt: float
     segments: list
     unreachable: np.ndarray
+
+    @property
+    def qdd(self) -> np.ndarray:
+        """Joint accelerations (N, 6) in rad/s² (most checks need none: made on demand)."""
+        if self.accelerations is None:
+            self.accelerations = _derivative(self.qd, self.dt, shared_pool())
+        return self.accelerations
 
     @property
     def duration(self) -> float:
@@ -421,8 +429,7 @@ def sample(planner, dt: float | None = None) -> Trace:
     pool = shared_pool()
     q, active, unreachable = _displacements(planner, times, pool)
     qd = _derivative(q, dt, pool)
-    qdd = _derivative(qd, dt, pool)
-    return Trace(times, q, qd, qdd, active, dt, planner.segments, unreachable)
+    return Trace(times, q, qd, None, active, dt, planner.segments, unreachable)
 
 
 def _derivative(values: np.ndarray, dt: float, pool: ThreadPoolExecutor,

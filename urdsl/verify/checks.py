@@ -245,7 +245,10 @@ def singularities(trace: Trace, robot, scale: float | None = None,
     index = np.arange(0, len(trace.times), stride)
     if len(index) == 0:
         return []
-    measures = robot.singularity(trace.q[index])
+    joints = trace.q[index]
+    blocks = list(shared_pool().map(robot.singularity, [joints[start:start + 32768] for start
+                                                       in range(0, len(joints), 32768)]))
+    measures = {name: np.concatenate([block[name] for block in blocks]) for name in blocks[0]}
     # Joint moves pass singular configurations harmlessly; on a TCP path (and in blends into
     # one) the joint speeds needed near them grow without bound.
     kinds = np.array([s.kind not in JOINT_SPACE for s in trace.segments] + [False])
