@@ -855,8 +855,8 @@ class _Compiler:
     def e_Call(self, node: n.Call):
         rt = self.rt
         args = [self.expr(a) for a in node.args]
-        keywords = [(k.name, self.expr(k.value)) for k in node.keywords]
         if isinstance(node.func, n.Attribute):
+            keywords = [(k.name, self.expr(k.value)) for k in node.keywords]
             receiver = self.expr(node.func.value)
             method = node.func.attr
 
@@ -870,15 +870,21 @@ class _Compiler:
             raise rt.error("call", "only functions can be called", node)
         name = node.func.id
         # a def of the same name (collected before it runs) takes precedence at run time
-        builtin = rt.builtins.prepare(name, len(args), tuple(k for k, _ in keywords))
+        builtin = rt.builtins.prepare(name, len(args), tuple(k.name for k in node.keywords))
         if builtin is None:
             def builtin(values, named, node):
                 return rt.builtins.call(name, values, named, node)
         functions = rt.functions
+        # literal numbers given by name (a=1.2, v=0.25) are the same at every call
+        fixed = {k.name: value[0] for k in node.keywords
+                 if (value := _constants([k.value])) is not None}
+        keywords = [(k.name, self.expr(k.value)) for k in node.keywords if k.name not in fixed]
 
         def call(frame):
             values = [a(frame) for a in args]
-            named = {k: v(frame) for k, v in keywords} if keywords else {}
+            named = dict(fixed)
+            for k, v in keywords:
+                named[k] = v(frame)
             function = functions.get(name)
             if function is not None:
                 return self.call_user(function, values, named, node)
