@@ -320,7 +320,10 @@ class _Knots:
         knot_key = knot_key * span + self.t
         left = np.searchsorted(knot_key, position * span + local_t, side="right") - 1
         left = np.minimum(left, end[position] - 1)
-        intervals, counts = np.unique(left, return_counts=True)
+        runs = np.flatnonzero(np.diff(left)) + 1  # `left` rises: runs of one interval
+        starts = np.concatenate([[0], runs])
+        intervals = left[starts]
+        counts = np.diff(np.append(starts, len(left)))
         t0 = self.t[intervals]
         h = self.t[intervals + 1] - t0
         q0, q1 = self.q[intervals], self.q[intervals + 1]
