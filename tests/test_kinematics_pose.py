@@ -197,3 +197,10 @@ def test_one_pose_as_a_sequence_matches_the_batched_formula(p):
     batched = pose.to_matrix(np.asarray(p)[None])[0]
     for one in (tuple(p), list(p)):
         assert np.allclose(pose.to_matrix(one), batched, atol=1e-14, rtol=0)
+
+
+def test_six_poses_in_a_list_are_a_batch_and_bad_input_says_so():
+    six = [[0.1 * i, 0.0, 0.2, 0.0, 3.1, 0.0] for i in range(6)]
+    assert np.allclose(pose.to_matrix(six), pose.to_matrix(np.array(six)))
+    with pytest.raises(ValueError, match="6 numbers"):
+        pose.to_matrix(5.0)

@@ -54,3 +54,15 @@ def test_slow_moves_solved_every_few_millimetres_match_solving_every_sample(robo
     assert np.abs(interpolated.q - dense.q).max() < 1e-6
     assert np.abs(interpolated.qd - dense.qd).max() < 1e-4
     assert interpolated.duration > 15.0  # slow indeed
+
+
+@pytest.mark.parametrize("count", [0, 1, 2, 3, 7, 8, 9, 16, 17, 50])
+def test_blocked_derivative_is_numpys_gradient(count):
+    """The trace's speeds come from central differences computed in blocks on two threads;
+    blocks of 8 rows put block edges everywhere in these short arrays."""
+    from urdsl._threads import shared_pool
+
+    values = np.random.default_rng(count).normal(size=(count, 6))
+    derivative = trace_module._derivative(values, 0.002, shared_pool(), block=8)
+    expected = np.gradient(values, 0.002, axis=0) if count > 1 else np.zeros_like(values)
+    np.testing.assert_allclose(derivative, expected, rtol=1e-15, atol=0)

@@ -335,7 +335,7 @@ class CollisionModel:
         Q = np.asarray(Q, dtype=float)
         if Q.ndim == 1:
             Q = Q[None]
-        if Q.ndim != 2 or Q.shape[1] != 6 or not np.isfinite(Q.sum()):
+        if Q.ndim != 2 or Q.shape[1] != 6 or not np.all(np.isfinite(Q)):
             raise KinematicsError(f"Q must be finite joint vectors of shape (N, 6), got {Q.shape}")
         return Q
 

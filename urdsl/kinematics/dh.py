@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["fk_ur", "ur_axes", "dh_frames", "dh_transforms"]
+__all__ = ["fk_ur", "ur_axes", "arm_terms", "dh_frames", "dh_transforms"]
 
 
 #: Joint vectors per block: the temporaries stay in the CPU cache (1.8x faster than one
@@ -44,7 +44,7 @@ def fk_ur(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
     return out
 
 
-def _arm_terms(q: np.ndarray, a2: float, a3: float):
+def arm_terms(q: np.ndarray, a2: float, a3: float):
     """Cosines and sines (N, 6) of the joints, ``C``, ``S`` of θ2+θ3+θ4 and the arm-plane
     coordinates ``u``, ``v`` of the wrist-1 point (see the module docstring)."""
     c, s = np.cos(q), np.sin(q)
@@ -57,7 +57,7 @@ def _arm_terms(q: np.ndarray, a2: float, a3: float):
 
 def _fk_ur_block(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float,
                  d6: float, out: np.ndarray) -> None:
-    c, s, cc, ss, u, v = _arm_terms(q, a2, a3)
+    c, s, cc, ss, u, v = arm_terms(q, a2, a3)
     c1, s1, c5, s5, c6, s6 = c[:, 0], s[:, 0], c[:, 4], s[:, 4], c[:, 5], s[:, 5]
 
     c1c = c1 * cc
@@ -99,7 +99,7 @@ def ur_axes(q: np.ndarray, d1: float, a2: float, a3: float, d4: float, d5: float
     """
     q = np.asarray(q, dtype=float)
     n = q.shape[0]
-    c, s, cc, ss, u, v = _arm_terms(q, a2, a3)
+    c, s, cc, ss, u, v = arm_terms(q, a2, a3)
     c1, s1, c2, s2, c5, s5 = c[:, 0], s[:, 0], c[:, 1], s[:, 1], c[:, 4], s[:, 4]
     axes = np.zeros((n, 6, 3))
     axes[:, 0, 2] = 1.0

@@ -168,8 +168,9 @@ def matrix_to_rpy(rotation) -> np.ndarray:
 
 def to_matrix(pose) -> np.ndarray:
     """Homogeneous matrices (..., 4, 4) of URScript poses (..., 6)."""
-    if type(pose) is not np.ndarray and len(pose) == 6:  # one pose: scalar maths is faster
-        return _one_matrix(*map(float, pose))
+    if isinstance(pose, (tuple, list)) and len(pose) == 6 \
+            and all(isinstance(v, (int, float)) for v in pose):
+        return _one_matrix(*map(float, pose))  # one pose of numbers: scalar maths is faster
     p = _array(pose, 6, "a pose")
     out = np.zeros(p.shape[:-1] + (4, 4))
     out[..., :3, :3] = rotvec_to_matrix(p[..., 3:])

@@ -29,7 +29,7 @@ import pinocchio as pin
 from . import ik as _ik
 from . import pose as _pose
 from .calibration import Calibration
-from .dh import dh_frames, fk_ur, ur_axes
+from .dh import arm_terms, dh_frames, fk_ur, ur_axes
 from .errors import KinematicsError
 from .models import ModelSpec, model_spec
 from .pinmodel import URDF_MODELS, build_dh_model, load_urdf_model
@@ -438,11 +438,9 @@ class Robot:
 def _nominal_singularity(Q: np.ndarray, d1: float, a2: float, a3: float, d4: float,
                          d5: float, d6: float) -> dict[str, np.ndarray]:
     """:meth:`Robot.singularity` of a nominal arm, in closed form."""
-    s3, s5 = np.sin(Q[:, 2]), np.sin(Q[:, 4])
-    q23 = Q[:, 1] + Q[:, 2]
-    u = a2 * np.cos(Q[:, 1]) + a3 * np.cos(q23)
-    v = a2 * np.sin(Q[:, 1]) + a3 * np.sin(q23)
-    sideways = u + d5 * np.sin(q23 + Q[:, 3])
+    _, sines, _, big_s, u, v = arm_terms(Q, a2, a3)
+    s3, s5 = sines[:, 2], sines[:, 4]
+    sideways = u + d5 * big_s
     length = np.sqrt(u * u + v * v)
     reach, fold = abs(a2) + abs(a3), abs(abs(a2) - abs(a3))
     return {"shoulder": np.abs(sideways),
