@@ -1,0 +1,2 @@
+"""PolyScope files: programs (``.urp``), installations (``.installation``) and installation
+variables (``.variables``)."""
