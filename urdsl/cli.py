@@ -13,14 +13,14 @@ from __future__ import annotations
 import argparse
 import difflib
 import importlib
-import json
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 from . import __version__
+from ._deep import FOLLOWED_DEPTH, run_deep
 from .script.diagnostics import ScriptError
-from .script.nodes import to_dict
+from .script.nodes import dump_json, to_dict
 from .script.parser import parse
 from .script.printer import format as format_tree
 
@@ -84,7 +84,7 @@ def cmd_parse(args: argparse.Namespace) -> int:
         elif not args.quiet:
             print(f"{source.name}: ok ({len(tree.body)} top-level items)", file=sys.stderr)
     if args.json:
-        json.dump(trees, sys.stdout, indent=1 if args.pretty else None)
+        sys.stdout.write(dump_json(trees, indent=1 if args.pretty else None))
         sys.stdout.write("\n")
     return status
 
@@ -218,6 +218,10 @@ _COMMAND_MODULES: list[str] = [
 """Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""
 
 
+_DEEP_COMMANDS = frozenset(("parse", "fmt", "lint", "check", "compile", "send", "lsp"))
+"""Commands that walk a program's syntax tree, run on a deep stack (see urdsl._deep)."""
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``urdsl`` console script."""
     parser = build_parser()
@@ -226,7 +230,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return EXIT_USAGE
     try:
+        if args.command in _DEEP_COMMANDS:
+            return run_deep(args.run, args)
         return args.run(args)
+    except RecursionError:
+        _error("the program nests too deeply for urdsl to follow (it follows at least "
+               f"{FOLLOWED_DEPTH:,} levels of nested blocks and expressions)")
+        return EXIT_PROBLEMS
     except UsageError as error:
         _error(str(error))
         return EXIT_USAGE

@@ -48,6 +48,12 @@ _BAD_CHARACTER_HINTS = {
 }
 
 
+def _line_breaks(text: str, start: int, end: int) -> int:
+    """How many line breaks (LF, CRLF or a lone CR) ``text[start:end]`` holds."""
+    return text.count("\n", start, end) + text.count("\r", start, end) \
+        - text.count("\r\n", start, end)
+
+
 class Lexer:
     """A scanner for the terminals of a Lark grammar (see the module docstring)."""
 
@@ -86,12 +92,13 @@ class Lexer:
         keywords = self.keywords
         operators = self.operators
         last_end = -1  # end of the last token that is not a comment; -1 before the first
-        for match in self._regex.finditer(text):
+        # A UTF-8 byte-order mark (editors on Windows write one) is no token.
+        for match in self._regex.finditer(text, 1 if text.startswith("\ufeff") else 0):
             kind = match.lastgroup
             start = match.end(1)
             end = match.end()
             space = match.start()  # the white space before this token starts here
-            if start - space > 1 and space > 0 and text.count("\n", space, start) >= 2:
+            if start - space > 1 and space > 0 and _line_breaks(text, space, start) >= 2:
                 yield ("BLANK", "", space, start)
             if kind == "NUMBER" or kind == "STRING":
                 last_end = end

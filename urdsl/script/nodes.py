@@ -14,6 +14,7 @@ so that printing keeps them.
 from __future__ import annotations
 
 import bisect
+import re
 from dataclasses import dataclass, field
 from typing import NamedTuple, TypeAlias
 
@@ -27,6 +28,9 @@ __all__ = [
     "Item", "BINARY_PRECEDENCE", "PREFIX_PRECEDENCE", "ATOM_PRECEDENCE", "precedence",
     "walk", "to_dict",
 ]
+
+
+_LINE_BREAK = re.compile(r"\r\n|\r|\n")
 
 
 class Source:
@@ -44,12 +48,16 @@ class Source:
 
     def _starts(self) -> list[int]:
         if self._line_starts is None:
-            starts = [0]
-            find = self.text.find
-            pos = find("\n")
-            while pos >= 0:
-                starts.append(pos + 1)
-                pos = find("\n", pos + 1)
+            text = self.text
+            if "\r" in text:  # CR-only (old Mac) and mixed line ends count as line breaks too
+                starts = [0] + [m.end() for m in _LINE_BREAK.finditer(text)]
+            else:
+                starts = [0]
+                find = text.find
+                pos = find("\n")
+                while pos >= 0:
+                    starts.append(pos + 1)
+                    pos = find("\n", pos + 1)
             self._line_starts = starts
         return self._line_starts
 
@@ -57,7 +65,10 @@ class Source:
         """(line, column), both 1-based, of a character offset."""
         starts = self._starts()
         index = bisect.bisect_right(starts, offset) - 1
-        return index + 1, offset - starts[index] + 1
+        column = offset - starts[index] + 1
+        if index == 0 and offset > 0 and self.text.startswith("\ufeff"):
+            column -= 1  # a byte-order mark is no column
+        return index + 1, column
 
     def line_text(self, line: int) -> str:
         """The text of a 1-based line, without its line break."""
@@ -65,8 +76,8 @@ class Source:
         if not 1 <= line <= len(starts):
             return ""
         begin = starts[line - 1]
-        end = starts[line] - 1 if line < len(starts) else len(self.text)
-        return self.text[begin:end].rstrip("\r")
+        end = starts[line] if line < len(starts) else len(self.text)
+        return self.text[begin:end].rstrip("\r\n").lstrip("\ufeff")
 
     def __repr__(self) -> str:
         return f"Source({self.filename!r}, {len(self.text)} chars)"
@@ -514,21 +525,89 @@ def walk(node: Node):
 
 def to_dict(node: Node) -> dict:
     """A JSON-ready dict of a tree: ``{"type": "Call", "span": {...}, <fields>}``. Spans are
-    ``{"line", "column", "end_line", "end_column"}`` (1-based), or absent for built nodes."""
-    result: dict = {"type": type(node).__name__}
-    span = getattr(node, "span", NO_SPAN)
-    if span.source is not None:
-        result["span"] = {
-            "line": span.line, "column": span.column,
-            "end_line": span.end_line, "end_column": span.end_column,
-        }
-    for name in node.__dataclass_fields__:  # type: ignore[attr-defined]
-        if name == "span":
+    ``{"line", "column", "end_line", "end_column"}`` (1-based), or absent for built nodes.
+
+    Built without recursion (trees are as deep as the program nests); write deep results with
+    :func:`dump_json`, which does not recurse either."""
+    root: dict = {}
+    # work: (node, the dict that receives it, key or list index in that container)
+    work: list[tuple[Node, dict | list, str | int]] = [(node, {"": None}, "")]
+    first = True
+    while work:
+        current, container, key = work.pop()
+        result: dict = {"type": type(current).__name__}
+        if first:
+            root, first = result, False
+        else:
+            container[key] = result  # type: ignore[index]
+        span = getattr(current, "span", NO_SPAN)
+        if span.source is not None:
+            result["span"] = {
+                "line": span.line, "column": span.column,
+                "end_line": span.end_line, "end_column": span.end_column,
+            }
+        for name in current.__dataclass_fields__:  # type: ignore[attr-defined]
+            if name == "span":
+                continue
+            value = getattr(current, name)
+            if isinstance(value, Node):
+                result[name] = None
+                work.append((value, result, name))
+            elif isinstance(value, tuple):
+                items: list = list(value)
+                result[name] = items
+                for index, item in enumerate(value):
+                    if isinstance(item, Node):
+                        work.append((item, items, index))
+            else:
+                result[name] = value
+    return root
+
+
+def dump_json(value, indent: int | None = None) -> str:
+    """JSON text of nested dicts, lists, strings, numbers, booleans and None, written with an
+    explicit stack (``json.dumps`` recurses once per level and fails on deep syntax trees)."""
+    import json
+
+    out: list[str] = []
+    write = out.append
+    comma = ", " if indent is None else ","  # as json.dumps separates
+    # work: (a value to write, or _Text to write as it is; the nesting level)
+    work: list = [(value, 0)]
+    while work:
+        item, level = work.pop()
+        if type(item) is _Text:
+            write(item)
             continue
-        value = getattr(node, name)
-        if isinstance(value, Node):
-            value = to_dict(value)
-        elif isinstance(value, tuple):
-            value = [to_dict(v) if isinstance(v, Node) else v for v in value]
-        result[name] = value
-    return result
+        if isinstance(item, dict):
+            if not item:
+                write("{}")
+                continue
+            pairs = list(item.items())
+            write("{")
+            work.append((_Text(_newline(indent, level) + "}"), level))
+            for k in range(len(pairs) - 1, -1, -1):
+                name, child = pairs[k]
+                work.append((child, level + 1))
+                head = (comma if k else "") + _newline(indent, level + 1) + json.dumps(name)
+                work.append((_Text(head + ": "), level))
+        elif isinstance(item, list):
+            if not item:
+                write("[]")
+                continue
+            write("[")
+            work.append((_Text(_newline(indent, level) + "]"), level))
+            for k in range(len(item) - 1, -1, -1):
+                work.append((item[k], level + 1))
+                work.append((_Text((comma if k else "") + _newline(indent, level + 1)), level))
+        else:
+            write(json.dumps(item))
+    return "".join(out)
+
+
+class _Text(str):
+    """Text that :func:`dump_json` writes as it is."""
+
+
+def _newline(indent: int | None, level: int) -> str:
+    return "" if indent is None else "\n" + " " * (indent * level)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import math
 import re
 from dataclasses import replace
 from importlib import resources
@@ -363,6 +364,9 @@ class _Builder:
     def number(self, s: list) -> Number:
         _, text, start, end = s[0]
         value: int | float = int(text) if text.isdigit() else float(text)
+        if value == math.inf:
+            self.error(start, end, f"{text} is larger than the largest number a controller "
+                       "float holds (about 1.8e308)", "write a smaller number")
         return Number(value, _span((self.src, start, end)))
 
     def string(self, s: list) -> String:

@@ -96,11 +96,23 @@ class Printer:
         return "\n".join(lines)
 
     # -- blocks ------------------------------------------------------------------------------
+    #
+    # Blocks and expressions nest as deep as the program does, so neither is printed by
+    # recursion: each keeps an explicit stack of work (a sum of thousands of terms or
+    # thousands of nested blocks prints like any other program).
 
     def _block(self, items: tuple, depth: int, lines: list[str]) -> None:
-        pad = self.indent * depth
-        # Whether the last line written is code that a trailing comment may follow.
-        for item in items:
+        # Work items: (items, index, depth, closing lines) of the blocks being printed.
+        stack: list[tuple[tuple, int, int, list[str]]] = [(items, 0, depth, [])]
+        while stack:
+            items, index, depth, closing = stack.pop()
+            if index >= len(items):
+                for line in closing:  # `elif ...:`/`else:` headers open the next block
+                    lines.append(line)
+                continue
+            item = items[index]
+            stack.append((items, index + 1, depth, closing))
+            pad = self.indent * depth
             kind = type(item)
             if kind is Comment:
                 if item.trailing and lines and self._code_line(lines[-1]):
@@ -112,11 +124,46 @@ class Printer:
                     lines.append("")
             elif kind is Marker:
                 lines.append(pad + self._marker(item))
+            elif kind in _KEYWORD_STATEMENTS or kind in _SIMPLE_STATEMENTS:
+                lines.append(pad + self._simple_text(item))
             else:
-                method = _STATEMENTS.get(kind)
-                if method is None:
+                parts = self._compound(item, pad)
+                if parts is None:
                     raise TypeError(f"cannot print {kind.__name__} as a statement")
-                method(self, item, depth, pad, lines)
+                # parts: (header, body), (header, body), ..., then the `end` line; pushed in
+                # reverse so that the first body is printed first
+                sections, end = parts
+                lines.append(sections[0][0])
+                stack.append(((), 0, depth, [end]))
+                for k in range(len(sections) - 1, 0, -1):
+                    header, body = sections[k]
+                    stack.append((body, 0, depth + 1, []))
+                    stack.append(((), 0, depth, [header]))
+                stack.append((sections[0][1], 0, depth + 1, []))
+
+    def _compound(self, node: Node, pad: str):
+        """The headers and bodies of a block statement: ``([(header, body), ...], end)``."""
+        kind = type(node)
+        if kind is If:
+            sections = [(f"{pad}if {self.expr(node.test)}:", node.body)]
+            sections += [(f"{pad}elif {self.expr(b.test)}:", b.body) for b in node.elifs]
+            if node.orelse is not None:
+                sections.append((f"{pad}else:", node.orelse))
+        elif kind is While:
+            sections = [(f"{pad}while {self.expr(node.test)}:", node.body)]
+        elif kind is FunctionDef:
+            params = ", ".join(
+                p.name if p.default is None else f"{p.name}={self.expr(p.default)}"
+                for p in node.params
+            )
+            sections = [(f"{pad}def {node.name}({params}):", node.body)]
+        elif kind is ThreadDef:
+            sections = [(f"{pad}thread {node.name}():", node.body)]
+        elif kind is SecDef:
+            sections = [(f"{pad}sec {node.name}():", node.body)]
+        else:
+            return None
+        return sections, f"{pad}end"
 
     @staticmethod
     def _code_line(line: str) -> bool:
@@ -136,9 +183,6 @@ class Printer:
 
     # -- statements --------------------------------------------------------------------------
 
-    def _simple(self, node: Node, depth: int, pad: str, lines: list[str]) -> None:
-        lines.append(pad + self._simple_text(node))
-
     def _simple_text(self, node: Node) -> str:
         kind = type(node)
         if kind is ExprStmt:
@@ -157,105 +201,95 @@ class Printer:
             return f"kill {self.expr(node.thread)}"
         return _KEYWORD_STATEMENTS[kind]
 
-    def _if(self, node: If, depth: int, pad: str, lines: list[str]) -> None:
-        lines.append(f"{pad}if {self.expr(node.test)}:")
-        self._block(node.body, depth + 1, lines)
-        for branch in node.elifs:
-            lines.append(f"{pad}elif {self.expr(branch.test)}:")
-            self._block(branch.body, depth + 1, lines)
-        if node.orelse is not None:
-            lines.append(f"{pad}else:")
-            self._block(node.orelse, depth + 1, lines)
-        lines.append(f"{pad}end")
-
-    def _while(self, node: While, depth: int, pad: str, lines: list[str]) -> None:
-        lines.append(f"{pad}while {self.expr(node.test)}:")
-        self._block(node.body, depth + 1, lines)
-        lines.append(f"{pad}end")
-
-    def _function(self, node: FunctionDef, depth: int, pad: str, lines: list[str]) -> None:
-        params = ", ".join(
-            p.name if p.default is None else f"{p.name}={self.expr(p.default)}"
-            for p in node.params
-        )
-        lines.append(f"{pad}def {node.name}({params}):")
-        self._block(node.body, depth + 1, lines)
-        lines.append(f"{pad}end")
-
-    def _thread(self, node: ThreadDef, depth: int, pad: str, lines: list[str]) -> None:
-        lines.append(f"{pad}thread {node.name}():")
-        self._block(node.body, depth + 1, lines)
-        lines.append(f"{pad}end")
-
-    def _sec(self, node: SecDef, depth: int, pad: str, lines: list[str]) -> None:
-        lines.append(f"{pad}sec {node.name}():")
-        self._block(node.body, depth + 1, lines)
-        lines.append(f"{pad}end")
-
     # -- expressions -------------------------------------------------------------------------
 
     def expr(self, node: Expr) -> str:
         """The text of one expression."""
-        method = _EXPRESSIONS.get(type(node))
-        if method is None:
-            raise TypeError(f"cannot print {type(node).__name__} as an expression")
-        return method(self, node)
+        kind = type(node)
+        # leaves and shallow calls directly (most expressions); anything else by the stack
+        if kind is Number:
+            return format_number(node.value)
+        if kind is Name:
+            return node.id
+        out: list[str] = []
+        # work: an expression node to expand, or a str to write as it is
+        work: list = [node]
+        pop, push, write = work.pop, work.append, out.append
+        while work:
+            item = pop()
+            if type(item) is str:
+                write(item)
+                continue
+            kind = type(item)
+            if kind is Number:
+                write(format_number(item.value))
+            elif kind is Name:
+                write(item.id)
+            elif kind is BinOp:
+                push(item.right)
+                push(f" {item.op} ")
+                push(item.left)
+            elif kind is Call:
+                push(")")
+                args = [*item.args, *item.keywords]
+                for k in range(len(args) - 1, -1, -1):
+                    arg = args[k]
+                    if type(arg) is Keyword:
+                        push(arg.value)
+                        push(arg.name + "=")
+                    else:
+                        push(arg)
+                    if k:
+                        push(", ")
+                push("(")
+                push(item.func)
+            elif kind is Pose or kind is List:
+                push("]")
+                self._push_items(item.items, push)
+                push("p[" if kind is Pose else "[")
+            elif kind is Paren:
+                push(")")
+                push(item.expr)
+                push("(")
+            elif kind is UnaryOp:
+                push(item.operand)
+                push("not " if item.op == "not" else item.op)
+            elif kind is Index:
+                push("]")
+                self._push_items(item.indices, push)
+                push("[")
+                push(item.value)
+            elif kind is Attribute:
+                push("." + item.attr)
+                if type(item.value) is Number:
+                    push(" ")  # `1 .a`: written `1.a` it would read as `1.` and `a`
+                push(item.value)
+            elif kind is String:
+                write(self._string(item))
+            elif kind is Bool:
+                write("True" if item.value else "False")
+            elif kind is NoneLit:
+                write("None")
+            elif kind is Run:
+                write(f"run {item.thread}()")
+            else:
+                raise TypeError(f"cannot print {kind.__name__} as an expression")
+        return "".join(out)
 
-    def _number(self, node: Number) -> str:
-        return format_number(node.value)
+    @staticmethod
+    def _push_items(items: tuple, push) -> None:
+        for k in range(len(items) - 1, -1, -1):
+            push(items[k])
+            if k:
+                push(", ")
 
-    def _string(self, node: String) -> str:
+    @staticmethod
+    def _string(node: String) -> str:
         if '"' not in node.value:
             return f'"{node.value}"'
         if "'" not in node.value:
             return f"'{node.value}'"
         raise ValueError("a URScript string cannot hold both kinds of quote")
-
-    def _bool(self, node: Bool) -> str:
-        return "True" if node.value else "False"
-
-    def _none(self, node: NoneLit) -> str:
-        return "None"
-
-    def _name(self, node: Name) -> str:
-        return node.id
-
-    def _items(self, items: tuple) -> str:
-        return ", ".join([self.expr(item) for item in items])
-
-    def _pose(self, node: Pose) -> str:
-        return f"p[{self._items(node.items)}]"
-
-    def _list(self, node: List) -> str:
-        return f"[{self._items(node.items)}]"
-
-    def _paren(self, node: Paren) -> str:
-        return f"({self.expr(node.expr)})"
-
-    def _unary(self, node: UnaryOp) -> str:
-        if node.op == "not":
-            return f"not {self.expr(node.operand)}"
-        return node.op + self.expr(node.operand)
-
-    def _binop(self, node: BinOp) -> str:
-        return f"{self.expr(node.left)} {node.op} {self.expr(node.right)}"
-
-    def _call(self, node: Call) -> str:
-        args = [self.expr(arg) for arg in node.args]
-        args += [self._keyword(k) for k in node.keywords]
-        return f"{self.expr(node.func)}({', '.join(args)})"
-
-    def _keyword(self, node: Keyword) -> str:
-        return f"{node.name}={self.expr(node.value)}"
-
-    def _index(self, node: Index) -> str:
-        return f"{self.expr(node.value)}[{self._items(node.indices)}]"
-
-    def _attribute(self, node: Attribute) -> str:
-        return f"{self.expr(node.value)}.{node.attr}"
-
-    def _run(self, node: Run) -> str:
-        return f"run {node.thread}()"
 
 
 _KEYWORD_STATEMENTS = {
@@ -263,20 +297,7 @@ _KEYWORD_STATEMENTS = {
     EnterCritical: "enter_critical", ExitCritical: "exit_critical",
 }
 
-_STATEMENTS = {
-    **{kind: Printer._simple for kind in (
-        ExprStmt, Assign, Declare, Return, Join, Kill, *_KEYWORD_STATEMENTS)},
-    If: Printer._if, While: Printer._while, FunctionDef: Printer._function,
-    ThreadDef: Printer._thread, SecDef: Printer._sec,
-}
-
-_EXPRESSIONS = {
-    Number: Printer._number, String: Printer._string, Bool: Printer._bool,
-    NoneLit: Printer._none, Name: Printer._name, Pose: Printer._pose, List: Printer._list,
-    Paren: Printer._paren, UnaryOp: Printer._unary, BinOp: Printer._binop,
-    Call: Printer._call, Index: Printer._index, Attribute: Printer._attribute,
-    Run: Printer._run,
-}
+_SIMPLE_STATEMENTS = frozenset((ExprStmt, Assign, Declare, Return, Join, Kill))
 
 _DEFAULT = Printer()
 

@@ -1,0 +1,111 @@
+"""Hostile and unusual input to the language tools: deep trees, huge numbers, odd line ends,
+byte-order marks. Every case ends with a result or a message, never a traceback."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import urdsl
+from urdsl._deep import FOLLOWED_DEPTH
+from urdsl.cli import main
+from urdsl.script.nodes import dump_json, to_dict
+
+DEEP = FOLLOWED_DEPTH
+
+
+def _long_sum(terms: int) -> str:
+    return "x = " + " + ".join(["1"] * terms) + "\n"
+
+
+def _nested_blocks(levels: int) -> str:
+    head = "".join("  " * (i % 40) + "while True:\n" for i in range(levels))
+    return head + "sync()\n" + "end\n" * levels
+
+
+def test_deep_trees_print_without_recursion():
+    # the printer, to_dict and the JSON writer walk with explicit stacks at any depth
+    tree = urdsl.parse(_long_sum(20_000), filename="sum.script")
+    text = urdsl.format(tree)
+    assert text == "x = " + " + ".join(["1"] * 20_000) + "\n"
+    document = dump_json(to_dict(tree))
+    assert document.count('"BinOp"') == 19_999
+    nested = urdsl.parse(_nested_blocks(3_000), filename="nest.script")
+    lines = urdsl.format(nested).splitlines()
+    assert lines[2_999] == "  " * 2_999 + "while True:"
+    assert lines[3_000] == "  " * 3_000 + "sync()"
+    assert lines[-1] == "end"
+
+
+@pytest.mark.parametrize("command", [
+    ["parse", "--json"], ["fmt"], ["lint"], ["check", "--max-time", "1"],
+    ["send", "--dry-run", "--host", "127.0.0.1"],
+])
+@pytest.mark.parametrize("program", ["sum", "blocks"])
+def test_commands_follow_deep_programs(tmp_path, capsys, command, program):
+    path = tmp_path / "deep.script"
+    # blocks: 2,000 levels (lint's time still grows with the square of loop nesting)
+    path.write_text(_long_sum(DEEP) if program == "sum" else _nested_blocks(2_000))
+    status = main([*command, str(path)])
+    out, err = capsys.readouterr()
+    assert "Traceback" not in err and "RecursionError" not in err
+    assert status == 0, err[-500:]
+
+
+def test_too_deep_is_a_message_not_a_traceback(tmp_path, capsys):
+    path = tmp_path / "deeper.script"
+    path.write_text(_long_sum(150_000))
+    status = main(["check", "--max-time", "1", str(path)])
+    err = capsys.readouterr().err
+    assert status == 1
+    assert "nests too deeply for urdsl to follow" in err and "Traceback" not in err
+
+
+@given(st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | st.text(),
+    lambda children: st.lists(children, max_size=4)
+    | st.dictionaries(st.text(max_size=5), children, max_size=4),
+    max_leaves=30))
+def test_dump_json_is_json(value):
+    assert dump_json(value) == json.dumps(value)
+    assert json.loads(dump_json(value, indent=1)) == json.loads(json.dumps(value, indent=1))
+    assert dump_json(value, indent=1) == json.dumps(value, indent=1)
+
+
+def test_number_beyond_float_range_is_a_syntax_error():
+    with pytest.raises(urdsl.ScriptSyntaxError) as caught:
+        urdsl.parse("x = 1e309\n", filename="big.script")
+    diagnostic = caught.value.diagnostic
+    assert (diagnostic.line, diagnostic.column) == (1, 5)
+    assert "largest number" in diagnostic.message
+    assert urdsl.format(urdsl.parse("x = 1.7e308\n")) == "x = 1.7e308\n"
+
+
+def test_attribute_of_a_number_keeps_its_meaning():
+    tree = urdsl.parse("x = 1 .a\n")
+    text = urdsl.format(tree)
+    assert text == "x = 1 .a\n"
+    assert urdsl.parse(text) == tree
+
+
+@pytest.mark.parametrize("newline", ["\r", "\r\n", "\n"])
+def test_line_ends_of_any_kind_give_the_right_line(newline):
+    text = newline.join(["x = 1", "y = 2", "", "z = (", ""])
+    with pytest.raises(urdsl.ScriptSyntaxError) as caught:
+        urdsl.parse(text, filename="ends.script")
+    assert (caught.value.diagnostic.line, caught.value.diagnostic.column) == (4, 5)
+    tree = urdsl.parse(newline.join(["a = 1", "", "b = 2"]))
+    assert urdsl.format(tree) == "a = 1\n\nb = 2\n"  # the blank line is kept
+
+
+def test_byte_order_mark_is_no_character():
+    tree = urdsl.parse("\ufeffx = 1\ny = x\n", filename="bom.script")
+    assert urdsl.format(tree) == "x = 1\ny = x\n"
+    with pytest.raises(urdsl.ScriptSyntaxError) as caught:
+        urdsl.parse("\ufeffx = )\n", filename="bom.script")
+    diagnostic = caught.value.diagnostic
+    assert (diagnostic.line, diagnostic.column) == (1, 5)  # the mark is no column
+    assert "\ufeff" not in diagnostic.render()
