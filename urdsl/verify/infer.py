@@ -7,7 +7,8 @@
   (:func:`urdsl.kinematics.identify.identify`).
 * **The start joints.** PolyScope makes the arm go to the first move's target before the
   program runs: the joints of the first move's waypoint (its ``_q`` or ``qnear``), or the
-  first ``movej``'s joint target.
+  first ``movej``'s joint target. Only for PolyScope programs (waypoint pairs or ``$ N``
+  markers): a script sent to the arm starts wherever the arm is.
 * **TCP and payload.** The first ``set_tcp``/``set_payload``/``set_target_payload`` with
   constant arguments (the preamble), and the project's ``.installation`` beside the file.
 
@@ -96,7 +97,8 @@ class Inference:
         if self.start_source == "inferred":
             where = f" (line {self.start_span.line})" if self.start_span.source else ""
             return f"start joints from {self.start_from}{where}"
-        return "start joints by default (no first move target found)"
+        why = self.start_from or "no taught target of a first move found"
+        return f"start joints by default ({why})"
 
     def lines(self) -> list[str]:
         """Everything inferred, one sentence each."""
@@ -134,7 +136,7 @@ class Inference:
                 robot["reason"] = found.reason
         start: dict[str, Any] = {"joints": [round(v, 9) for v in self.start_joints],
                                  "source": self.start_source}
-        if self.start_from:
+        if self.start_from and self.start_source == "inferred":
             start["from"] = self.start_from
             if self.start_span.source:
                 start["line"] = self.start_span.line
@@ -414,6 +416,8 @@ def infer(module: n.Module, filename: str | None = None, *, robot: str | None = 
             result.robot_source = "inferred"
     if start_joints is not None:
         result.start_joints, result.start_source = tuple(start_joints), "given"
+    elif not pairs and not any(isinstance(node, n.Marker) for node in n.walk(module)):
+        result.start_from = "not a PolyScope program"
     else:
         first = first_move_joints(module)
         if first is not None:
