@@ -94,7 +94,7 @@ def test_pairs_from_two_different_arms_infer_nothing():
     mixed = np.concatenate([taught("ur5e", q[:4]), taught("ur16e", q[4:])])
     found = identify(q, mixed)
     assert found.model is None
-    assert "no UR model" in found.reason or "about equally" in found.reason
+    assert found.reason == "the pairs fit different arms (4 ur5e, 4 ur16e)"
 
 
 def test_a_few_pairs_taught_with_another_tcp_do_not_hide_the_arm():
@@ -103,6 +103,23 @@ def test_a_few_pairs_taught_with_another_tcp_do_not_hide_the_arm():
     poses[:2] = taught("ur10", q[:2], (0, 0, 0.2, 0, 0, 0))
     found = identify(q, poses)
     assert found.model == "ur10" and found.used == 8
+
+
+def test_a_few_exact_pairs_identify_the_arm_when_the_rest_used_an_unknown_tcp():
+    q = random_joints(10)
+    poses = taught("ur20", q, (0.0, -0.3, 0.1, 1.2, -1.2, 1.2))
+    poses[:4] = taught("ur20", q[:4])
+    found = identify(q, poses)
+    assert found.model == "ur20" and found.used == 4
+
+
+def test_one_exact_pair_among_many_unexplained_is_not_enough():
+    q = random_joints(6)
+    poses = taught("ur20", q)
+    poses[1:, :3] += RNG.uniform(0.03, 0.06, size=(5, 3))       # hand-edited poses
+    found = identify(q, poses)
+    assert found.model is None
+    assert found.reason.startswith("only 1 of 6 pair(s) fit ur20 within 5 mm")
 
 
 @settings(max_examples=40, deadline=None)

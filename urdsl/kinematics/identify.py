@@ -42,6 +42,10 @@ MIN_SHARE = 0.6
 """Share of the pairs a model must explain to be taken (waypoints taught with another TCP, or
 edited by hand, may not fit)."""
 
+MIN_EXACT = 3
+"""With fewer than :data:`MIN_SHARE` of the pairs explained, a model is still taken when it
+explains at least this many and no other arm a third as many."""
+
 
 @dataclass(frozen=True)
 class ModelFit:
@@ -118,18 +122,26 @@ def _project_rotation(m: np.ndarray) -> np.ndarray:
     return u @ np.diag([1.0, 1.0, d]) @ vt
 
 
+def _candidates(tcp) -> np.ndarray:
+    """TCP candidates (K, 4, 4) from one pose (6,), several (K, 6) or ``None`` (the flange)."""
+    values = np.asarray(tcp if tcp is not None else [0.0] * 6, float).reshape(-1, 6)
+    return pose_math.to_matrix(values)
+
+
 def fit_models(joints, poses, tcp=None, *, fit_tcp: bool = False,
                models: dict[str, ModelSpec] | None = None) -> list[ModelFit]:
     """Every arm's fit of ``poses`` (N, 6: TCP poses in Base, m and rotation vector) from
     ``joints`` (N, 6, rad), best (lowest RMS) first.
 
-    ``tcp``: the TCP pose in the flange frame (default: the flange); with ``fit_tcp`` the TCP
-    is instead solved for per arm as one constant offset (needs at least 2 pairs to mean
-    anything, 3 to tell arms apart).
+    ``tcp``: the TCP pose in the flange frame (default: the flange), or several candidates
+    (K, 6): a program with several TCPs teaches each waypoint with one of them, so each pair
+    is fitted with the candidate that explains it best (the fit's ``tcp`` is the one used
+    most). With ``fit_tcp`` the TCP is instead solved for per arm as one constant offset
+    (needs at least 2 pairs to mean anything, 3 to tell arms apart).
     """
     q, p = _as_arrays(joints, poses)
     target = pose_math.to_matrix(p)
-    known = pose_math.to_matrix(np.asarray(tcp if tcp is not None else [0.0] * 6, float))
+    known = _candidates(tcp)
     fits = []
     models = models or MODELS
     for group in same_arm_groups(models):
@@ -143,14 +155,18 @@ def fit_models(joints, poses, tcp=None, *, fit_tcp: bool = False,
             offset[:3, :3] = _project_rotation(np.einsum("nij,njk->ik", rt,
                                                          target[:, :3, :3]))
         else:
-            offset = known
-        predicted = flange @ offset
-        errors = np.linalg.norm(predicted[:, :3, 3] - target[:, :3, 3], axis=1)
-        rotation = np.atleast_1d(pose_math.rotation_angle(predicted[:, :3, :3],
-                                                          target[:, :3, :3]))
-        fits.append(ModelFit(group[0], group[1:], errors, np.asarray(rotation, float),
-                             tuple(float(v) for v in pose_math.from_matrix(offset)),
-                             fit_tcp))
+            offset = known[0]
+        offsets = offset[None] if fit_tcp else known
+        predicted = flange[None] @ offsets[:, None]                          # (K, N, 4, 4)
+        errors = np.linalg.norm(predicted[..., :3, 3] - target[None, :, :3, 3], axis=-1)
+        best = np.argmin(errors, axis=0) if len(q) else np.zeros(0, int)
+        pick = predicted[best, np.arange(len(q))]
+        rotation = np.atleast_1d(pose_math.rotation_angle(pick[:, :3, :3], target[:, :3, :3]))
+        if not fit_tcp and len(q):
+            offset = offsets[np.bincount(best, minlength=len(offsets)).argmax()]
+        fits.append(ModelFit(group[0], group[1:], errors[best, np.arange(len(q))],
+                             np.asarray(rotation, float),
+                             tuple(float(v) for v in pose_math.from_matrix(offset)), fit_tcp))
     fits.sort(key=lambda fit: fit.rms())
     return fits
 
@@ -166,12 +182,15 @@ def _decide(fits: list[ModelFit], pairs: int, tolerance: float,
     best = ranked[0]
     mask = best.inliers(tolerance)
     used = int(mask.sum())
-    if used == 0 or used < min_share * pairs:
-        return None
     runner = ranked[1] if len(ranked) > 1 else None
+    runner_used = int(runner.inliers(tolerance).sum()) if runner is not None else 0
+    # most pairs explained; or, when some waypoints were taught with a TCP the program no
+    # longer names, enough exact fits that no other arm comes near
+    if used == 0 or (used < min_share * pairs
+                     and (used < MIN_EXACT or runner_used * 3 > used)):
+        return None
     runner_up = (runner.model, runner.rms()) if runner is not None else None
     if runner is not None:
-        runner_used = int(runner.inliers(tolerance).sum())
         if runner_used >= used and runner.rms(runner.inliers(tolerance)) <= 2 * best.rms(mask):
             return Identification(
                 None, pairs, reason=f"the waypoints fit {best.model} and {runner.model} "
@@ -189,7 +208,8 @@ def identify(joints, poses, tcp=None, *, tolerance: float = TOLERANCE,
              models: dict[str, ModelSpec] | None = None) -> Identification:
     """The arm that maps ``joints`` (N, 6, rad) to ``poses`` (N, 6, TCP poses in Base).
 
-    First with the given ``tcp`` (flange frame; default the flange); if no arm explains at
+    First with the given ``tcp`` (flange frame, one pose or several candidates, see
+    :func:`fit_models`; default the flange); if no arm explains at
     least ``min_share`` of the pairs within ``tolerance`` [m] and there are three pairs or more,
     again with a TCP solved for per arm. Two different arms explaining the pairs about
     equally well (possible with few, similar pairs) give no answer.
@@ -208,7 +228,19 @@ def identify(joints, poses, tcp=None, *, tolerance: float = TOLERANCE,
     if found is not None:
         return found
     best = fits[0]
-    return Identification(
-        None, pairs, residual=best.rms(), runner_up=(best.model, best.rms()),
-        reason=f"no UR model maps the joints to the poses (best {best.model}: "
-        f"{best.rms() * 1000:.0f} mm RMS over {pairs} pair(s))", fits=tuple(fits))
+    most = max(fits, key=lambda fit: int(fit.inliers(tolerance).sum()))
+    fitting = int(most.inliers(tolerance).sum())
+    arms = sorted(((int(f.inliers(tolerance).sum()), f.model) for f in fits
+                   if f.inliers(tolerance).any()), reverse=True)
+    if len(arms) > 1:
+        reason = "the pairs fit different arms (" + ", ".join(
+            f"{count} {model}" for count, model in arms) + ")"
+    elif fitting:
+        reason = (f"only {fitting} of {pairs} pair(s) fit {most.model} within "
+                  f"{tolerance * 1000:g} mm (the others were taught with a TCP or frame "
+                  "the program does not show?)")
+    else:
+        reason = (f"no UR model maps the joints to the poses (best {best.model}: "
+                  f"{best.rms() * 1000:.0f} mm RMS over {pairs} pair(s))")
+    return Identification(None, pairs, residual=best.rms(),
+                          runner_up=(best.model, best.rms()), reason=reason, fits=tuple(fits))

@@ -26,7 +26,8 @@ from typing import Any
 from ..script import nodes as n
 from .run import DEFAULT_START, CheckOptions
 
-__all__ = ["WaypointPair", "Inference", "waypoint_pairs", "static_tcp", "static_payload",
+__all__ = ["WaypointPair", "Inference", "waypoint_pairs", "static_tcp", "static_tcps",
+           "static_payload",
            "first_move_joints", "infer", "apply"]
 
 _MOVES = frozenset({"movej", "movel", "movep", "movec"})
@@ -246,9 +247,11 @@ def _first_call(module: n.Module, names: set[str]) -> n.Call | None:
     return None
 
 
-def static_tcp(module: n.Module) -> tuple[tuple[float, ...], n.Span] | None:
-    """The first ``set_tcp`` whose pose is a constant (a literal or a name bound to one)."""
+def static_tcps(module: n.Module) -> list[tuple[tuple[float, ...], n.Span]]:
+    """Every ``set_tcp`` whose pose is a constant (a literal or a name bound to one), in
+    source order, each pose once."""
     constants = _constants(module)
+    found: dict[tuple[float, ...], n.Span] = {}
     for node in n.walk(module):
         if _call_name(node) != "set_tcp":
             continue
@@ -258,8 +261,14 @@ def static_tcp(module: n.Module) -> tuple[tuple[float, ...], n.Span] | None:
             arg = constants[arg.id][0]
         pose = _vector(arg, n.Pose, 6)
         if pose is not None:
-            return pose, node.span
-    return None
+            found.setdefault(pose, node.span)
+    return list(found.items())
+
+
+def static_tcp(module: n.Module) -> tuple[tuple[float, ...], n.Span] | None:
+    """The first ``set_tcp`` whose pose is a constant (the preamble's, in an export)."""
+    tcps = static_tcps(module)
+    return tcps[0] if tcps else None
 
 
 def static_payload(module: n.Module
@@ -382,17 +391,23 @@ def infer(module: n.Module, filename: str | None = None, *, robot: str | None = 
             except InstallationError as error:
                 notes.append(f"installation not used: {error}")
 
-    # the TCP the waypoints were taught with: the flag, the preamble, the installation
+    # the TCP at the start: the flag, the preamble, the installation's active TCP
     fit_tcp = tcp
     tcp_from = "--tcp" if tcp is not None else ""
+    program_tcps = static_tcps(module)
     if fit_tcp is None:
-        found_tcp = static_tcp(module)
-        if found_tcp is not None:
-            fit_tcp, span = found_tcp
+        if program_tcps:
+            fit_tcp, span = program_tcps[0]
             tcp_from = f"set_tcp at line {span.line}"
         elif setup is not None and setup.tcp is not None:
             fit_tcp = setup.tcp.offset
             tcp_from = f"TCP {setup.tcp.name!r} of {Path(setup.path).name}"
+    # the waypoints may have been taught with any TCP the program or installation names
+    candidates = [fit_tcp] if fit_tcp is not None else []
+    candidates += [pose for pose, _ in program_tcps]
+    candidates += [t.offset for t in setup.tcps] if setup is not None else []
+    candidates.append((0.0,) * 6)
+    candidates = list(dict.fromkeys(tuple(float(v) for v in c) for c in candidates))
     result = Inference(robot=(robot or default_robot), robot_source="given" if robot
                        else "default", tcp=fit_tcp, tcp_from=tcp_from)
     if setup is not None:
@@ -409,7 +424,7 @@ def infer(module: n.Module, filename: str | None = None, *, robot: str | None = 
     pairs = waypoint_pairs(module)
     result.pairs = len(pairs)
     if robot is None:
-        found = identify([p.joints for p in pairs], [p.pose for p in pairs], fit_tcp)
+        found = identify([p.joints for p in pairs], [p.pose for p in pairs], candidates)
         result.identification = found
         if found.model is not None:
             result.robot = found.model
