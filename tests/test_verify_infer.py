@@ -119,7 +119,7 @@ def test_one_exact_pair_among_many_unexplained_is_not_enough():
     poses[1:, :3] += RNG.uniform(0.03, 0.06, size=(5, 3))       # hand-edited poses
     found = identify(q, poses)
     assert found.model is None
-    assert found.reason.startswith("only 1 of 6 pair(s) fit ur20 within 5 mm")
+    assert found.reason.startswith("only 1 of 6 pair(s) fit ur20 within 8 mm")
 
 
 @settings(max_examples=40, deadline=None)
