@@ -9,6 +9,8 @@ import gzip
 import math
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from urdsl.polyscope.installation import (
     InstallationError,
@@ -138,3 +140,18 @@ def test_the_installation_beside_a_program(tmp_path):
     (tmp_path / "pick.installation").write_bytes(CB3)
     assert find_installation(program).name == "pick.installation"     # named like the program
     assert read_installation(find_installation(program)).tcp.offset[2] == 0.15
+
+
+@settings(max_examples=60, deadline=None)
+@given(cut=st.integers(0, 10_000), flip=st.integers(0, 10_000), compress=st.booleans())
+def test_law_a_damaged_file_reads_or_fails_with_the_one_clear_error(cut, flip, compress):
+    data = bytearray(gzip.compress(E_SERIES) if compress else E_SERIES)
+    if flip < len(data):
+        data[flip] ^= 0x55
+    data = data[:cut] if cut < len(data) else data
+    try:
+        setup = parse_installation(bytes(data), "x.installation")
+    except InstallationError as error:
+        assert str(error).startswith("x.installation: ")
+    else:
+        assert setup.path == "x.installation"
