@@ -227,6 +227,24 @@ end
         assert joints == (0.5, -1, 1, -1.5, -1.5, 0)
 
 
+@pytest.mark.parametrize("first", [
+    "movej(q2r(Home_deg_q))",                  # a hand-written waypoint in degrees
+    "movej(target)",                           # a variable waypoint
+    "movej(Sentinel_q)",                       # outside ±2π: not joint positions
+    "movej(get_actual_joint_positions())",
+])
+def test_a_first_target_that_is_not_a_taught_waypoint_leaves_the_start_unknown(first):
+    text = f"""def prog():
+  global Home_deg_q=[0, -90, 90, -90, -90, 0]
+  global Sentinel_q=[255, 255, 255, 255, 255, 255]
+  global target=[0.1, -1.5, 1.5, -1.5, -1.5, 0]
+  $ 1 "Robot Program"
+  {first}
+end
+"""
+    assert first_move_joints(parse(text)) is None
+
+
 def test_inference_for_a_program_without_waypoints_says_nothing_was_inferred():
     result = infer(parse("movej([0, -1.5, 1.5, -1.5, -1.5, 0])\n"))
     assert result.robot == "ur5e" and result.robot_source == "default"

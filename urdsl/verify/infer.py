@@ -341,28 +341,51 @@ def first_move_joints(module: n.Module) -> tuple[tuple[float, ...], str, n.Span]
     return None
 
 
+_WRAPPERS = frozenset({"get_inverse_kin", "pose_trans", "pose_add"})
+"""Calls PolyScope wraps a waypoint in (a feature-relative or IK-solved target)."""
+
+
+def _joints_ok(joints: tuple[float, ...] | None) -> tuple[float, ...] | None:
+    """Joint positions within the controller's ±2π, else ``None`` (degrees, a sentinel)."""
+    if joints is None or any(abs(v) > 2.0 * math.pi + 1e-6 for v in joints):
+        return None
+    return joints
+
+
 def _target_joints(target: n.Expr, constants) -> tuple[tuple[float, ...], str, n.Span] | None:
-    joints = _vector(target, n.List, 6)
+    """The taught joints of a move's target as PolyScope writes it: a joint list, a
+    ``NAME_q``/``NAME_p`` waypoint, ``get_inverse_kin(.., qnear=..)`` or a waypoint inside
+    ``pose_trans``/``pose_add`` (feature-relative). Anything else (a computed target, a
+    variable waypoint) is unknown."""
+    while isinstance(target, n.Paren):
+        target = target.expr
+    joints = _joints_ok(_vector(target, n.List, 6))
     if joints is not None:
         return joints, "the first move's joint target", target.span
-    candidates: list[str] = []
-    for node in n.walk(target):
-        if _call_name(node) == "get_inverse_kin":
-            near = _argument(node, 1, "qnear")  # type: ignore[arg-type]
-            joints = _vector(near, n.List, 6)
+    if _call_name(target) == "get_inverse_kin":
+        assert isinstance(target, n.Call)
+        near = _argument(target, 1, "qnear")
+        joints = _joints_ok(_vector(near, n.List, 6))
+        if joints is not None:
+            return joints, "the first move's qnear", near.span  # type: ignore[union-attr]
+        if near is not None:
+            found = _target_joints(near, constants)
+            if found is not None:
+                return found
+    if _call_name(target) in _WRAPPERS:
+        assert isinstance(target, n.Call)
+        for arg in reversed(target.args):       # the waypoint comes after the feature
+            found = _target_joints(arg, constants)
+            if found is not None:
+                return found
+        return None
+    if isinstance(target, n.Name) and target.id.endswith(("_q", "_p")):
+        key = target.id[:-2] + "_q"
+        if key in constants:
+            value, span = constants[key]
+            joints = _joints_ok(_vector(value, n.List, 6))
             if joints is not None:
-                return joints, "the first move's qnear", near.span
-            if isinstance(near, n.Name):
-                candidates.insert(0, near.id)
-        if isinstance(node, n.Name):
-            candidates.append(node.id)
-    for name in candidates:
-        for key in (name, name[:-2] + "_q" if name.endswith("_p") else None):
-            if key and key in constants:
-                value, span = constants[key]
-                joints = _vector(value, n.List, 6)
-                if joints is not None:
-                    return joints, key, span
+                return joints, key, span
     return None
 
 
