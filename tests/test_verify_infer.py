@@ -203,6 +203,7 @@ def test_preamble_tcp_and_payload_are_read_statically():
     ("movej(Home_q)", "Home_q"),
     ("movej([0.5, -1, 1, -1.5, -1.5, 0])", "the first move's joint target"),
     ("pick()", "Home_q"),
+    ("thread Thread_if_4():\n    movel(Home_p)\n  end\n  t = run Thread_if_4()", "Home_q"),
 ])
 def test_start_joints_are_the_first_moves_taught_target(first, expected):
     text = f"""def prog():

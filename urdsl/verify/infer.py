@@ -304,9 +304,10 @@ def _program_body(module: n.Module) -> tuple[n.Item, ...]:
     return module.body
 
 
-def _moves(body, functions: dict[str, n.FunctionDef], depth: int = 0):
-    """Move calls in the order the program reaches them: nested blocks in source order, and
-    the bodies of user functions it calls (not thread bodies, not definitions it skips)."""
+def _moves(body, functions: dict[str, n.Node], depth: int = 0):
+    """Move calls in the order the program reaches them: nested blocks in source order, the
+    bodies of user functions it calls and of threads it runs (PolyScope 5 runs an If's body
+    as a thread), not the definitions it passes."""
     for item in body:
         if isinstance(item, (n.FunctionDef, n.ThreadDef, n.SecDef)):
             continue
@@ -321,18 +322,21 @@ def _moves(body, functions: dict[str, n.FunctionDef], depth: int = 0):
         if not isinstance(item, n.Stmt):
             continue
         for node in n.walk(item):
-            name = _call_name(node)
+            name = node.thread if isinstance(node, n.Run) else _call_name(node)
             if name in _MOVES:
                 yield node
             elif name in functions and depth < 8:
-                yield from _moves(functions[name].body, functions, depth + 1)
+                yield from _moves(functions[name].body, functions,  # type: ignore[attr-defined]
+                                  depth + 1)
 
 
 def first_move_joints(module: n.Module) -> tuple[tuple[float, ...], str, n.Span] | None:
     """The joints (rad) the arm is at when the program starts: the target of its first move
     as taught, with a description and where the joints are written; ``None`` if unknown."""
     constants = _constants(module)
-    functions = {node.name: node for node in n.walk(module) if isinstance(node, n.FunctionDef)}
+    functions: dict[str, n.Node] = {
+        node.name: node for node in n.walk(module)
+        if isinstance(node, (n.FunctionDef, n.ThreadDef))}
     for call in _moves(_program_body(module), functions):
         assert isinstance(call, n.Call)
         target = _argument(call, 1 if call.func.id == "movec" else 0,  # type: ignore[attr-defined]
