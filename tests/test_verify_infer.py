@@ -364,3 +364,10 @@ def test_a_corrupt_installation_is_a_note_not_a_traceback(tmp_path, capsys):
     assert "installation not used:" in out and "default.installation" in out
     assert "truncated" in out
     assert "robot ur10e inferred" in out
+
+
+def test_a_cell_is_checked_with_the_inferred_robot(ur10e_program, tmp_path, capsys):
+    cell = tmp_path / "cell.toml"
+    cell.write_text("[floor]\nheight = -0.5\n")
+    assert main(["check", str(ur10e_program), "--cell", str(cell), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["robot"] == "ur10e"
