@@ -53,13 +53,15 @@ def add_commands(commands) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="a URScript file (.script) or a DSL program (.py)")
-    p.add_argument("--robot", default="ur5e", metavar="MODEL",
+    p.add_argument("--robot", metavar="MODEL",
                    help="robot model: ur3, ur5, ur10, ur3e, ur5e, ur10e, ur16e, ur20, ur30, "
-                   "ur7e, ur12e, ur15, ur18, ur8long (default: ur5e)")
+                   "ur7e, ur12e, ur15, ur18, ur8long (default: the model whose kinematics "
+                   "maps the program's taught waypoint joints to their poses, else ur5e)")
     start = p.add_mutually_exclusive_group()
     start.add_argument("--start-joints", metavar="Q", type=lambda t: parse_vector(
         t, 6, "--start-joints"), help="joint positions in rad where the arm starts, "
-        "comma-separated (default: 0,-pi/2,pi/2,-pi/2,-pi/2,0)")
+        "comma-separated (default: the joints of the first move's taught target, as "
+        "PolyScope starts there, else 0,-pi/2,pi/2,-pi/2,-pi/2,0)")
     start.add_argument("--start-joints-deg", metavar="Q", type=lambda t: parse_vector(
         t, 6, "--start-joints-deg", degrees=True), help="the same in degrees")
     p.add_argument("--tcp", metavar="POSE", type=lambda t: parse_vector(t, 6, "--tcp"),
@@ -96,9 +98,9 @@ def add_commands(commands) -> None:
 def cmd_check(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
     from ..kinematics import MODELS
-    from .run import DEFAULT_START, CheckOptions, check_text
+    from .run import DEFAULT_START, CheckOptions
 
-    robot = args.robot.lower()
+    robot = (args.robot or "ur5e").lower()
     if robot not in MODELS:
         raise UsageError(f"unknown robot model {args.robot!r}; known: {', '.join(MODELS)}")
     if args.plot and len(args.files) > 1:
@@ -128,7 +130,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                 continue
         else:
             source = read_input(name)
-            report = check_text(source.text, source.name, options=options)
+            report = _check_script(source, options, args)
         reports.append(report)
         if not args.json:
             _print(report, args.all_moves)
@@ -142,6 +144,29 @@ def cmd_check(args: argparse.Namespace) -> int:
         reports[0].plot(args.plot)
         print(f"plot written to {args.plot}", file=sys.stderr)
     return EXIT_PROBLEMS if failed or any(r.has_errors for r in reports) else EXIT_OK
+
+
+def _check_script(source, options, args):
+    """Check one URScript file with what can be inferred from it (robot model, start joints,
+    TCP and payload; see :mod:`urdsl.verify.infer`) where the command line leaves it open."""
+    from ..script.diagnostics import ScriptSyntaxError
+    from ..script.parser import parse
+    from .infer import apply, infer
+    from .run import check_text, check_tree
+
+    try:
+        module = parse(source.text, filename=source.name)
+    except ScriptSyntaxError:
+        return check_text(source.text, source.name, options=options)  # reports it
+    inference = infer(module, source.path, robot=options.robot if args.robot else None,
+                      start_joints=args.start_joints or args.start_joints_deg, tcp=args.tcp,
+                      default_robot=options.robot)
+    file_options = apply(options, inference, tcp_given=args.tcp is not None)
+    if args.cell and file_options.robot != options.robot:
+        file_options.cell = _load_cell(file_options.robot, args.cell)
+    report = check_tree(module, source.name, file_options)
+    report.inferred = inference
+    return report
 
 
 def _load_cell(robot: str, path: str):

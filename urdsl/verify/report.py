@@ -9,7 +9,10 @@ JSON shape (``urdsl check --json``), one document::
                    "time": 2.31}],
      "moves": [{"kind": "movej", "line": 3, "column": 1, "start": 0.0,
                 "duration": 2.094}],
-     "events": [{"time": 0.0, "kind": "textmsg", "message": "hello", "line": 2}]}
+     "events": [{"time": 0.0, "kind": "textmsg", "message": "hello", "line": 2}],
+     "inferred": {"robot": {"model": "ur10e", "source": "inferred", "pairs": 14, ...},
+                  "start": {"joints": [...], "source": "inferred", "from": "Waypoint_1_q",
+                            "line": 40}, "text": ["robot ur10e inferred from ..."]}}
 
 Times in s of robot time.
 """
@@ -52,6 +55,7 @@ class Report:
     events: list = field(default_factory=list)
     cycle_time: float = 0.0
     trace: Any = field(default=None, repr=False)
+    inferred: Any = None  # urdsl.verify.infer.Inference: robot, start, TCP the check used
 
     def sort(self) -> None:
         """Order findings by position in the file, then by time; a finding repeated word for
@@ -89,6 +93,7 @@ class Report:
             "moves": [m.to_dict() for m in self.moves],
             "events": [{"time": round(e.time, 6), "kind": e.kind, "message": e.message,
                         "line": e.span.line} for e in self.events],
+            **({"inferred": self.inferred.to_dict()} if self.inferred is not None else {}),
         }
 
     def to_json(self) -> str:
@@ -105,6 +110,8 @@ class Report:
                              f"start {move.start:8.3f} s  duration {move.duration:7.3f} s")
             if len(self.moves) > max_moves:
                 lines.append(f"  ... {len(self.moves) - max_moves} more")
+        if self.inferred is not None:
+            lines.extend(self.inferred.lines())
         lines.append(self.summary())
         return "\n".join(lines) + "\n"
 
@@ -135,6 +142,8 @@ class Report:
             if len(self.moves) > max_moves:
                 table.add_row("…", f"{len(self.moves) - max_moves} more", "", "")
             console.print(table)
+        for line in self.inferred.lines() if self.inferred is not None else ():
+            console.print(Text(line, style="cyan"))
         style = "bold red" if self.has_errors else "bold green"
         console.print(Text(self.summary(), style=style))
 

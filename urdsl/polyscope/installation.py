@@ -1,0 +1,246 @@
+"""A minimal reader of PolyScope installations (``.installation``): TCPs, payload, mounting.
+
+An installation is XML, gzip-compressed as PolyScope saves it (plain XML is accepted too).
+Three layouts are known:
+
+* PolyScope 3.x and 5.x: root ``<Installation>``; ``<TCPSettings activePose="NAME">`` with
+  ``<tcp name=".." offset="x, y, z, rx, ry, rz"/>`` entries (3.x also carries the payload
+  mass as ``toolPayload="kg"`` on ``TCPSettings``); 5.x ``<PayloadSettings>`` with
+  ``<Payload name=".." mass="kg" centerOfGravity="x, y, z" defaultPayload="true"/>``; the
+  mounting as ``<WorldtoMarshal baseAngle="rad" tiltAngle="rad"/>``; the software version
+  as ``<Version major= minor= bugfix=/>``.
+* PolyScope 1.x (CB2, a serialised Java object): root ``<gui.installation.RobotInstallation>``
+  with ``<tcpTransform>`` (six ``<double>``), ``<toolPayload>``, ``<mountingTiltAngle>`` and
+  ``<mountingBaseAngle>``.
+
+Everything else (safety settings, I/O names, features, URCap data) is ignored here; a later
+reader builds the full tree on this one. Lengths in m, angles in rad, masses in kg.
+
+A file that is not an installation, is truncated, corrupt or not XML raises
+:class:`InstallationError` naming the file.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+import math
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+from xml.etree import ElementTree
+
+__all__ = ["Installation", "InstallationError", "Tcp", "Payload", "read_installation",
+           "parse_installation", "find_installation", "GRAVITY"]
+
+GRAVITY = 9.82
+"""The gravity magnitude [m/s²] PolyScope writes in ``set_gravity``."""
+
+_MAX_SIZE = 64 * 1024 * 1024
+"""Largest decompressed installation accepted [bytes] (real ones are well under 1 MB)."""
+
+
+class InstallationError(Exception):
+    """An installation file that cannot be read; the message names the file."""
+
+    def __init__(self, path: str, message: str) -> None:
+        super().__init__(f"{path}: {message}")
+        self.path = path
+        self.reason = message
+
+
+@dataclass(frozen=True)
+class Tcp:
+    """A named TCP: ``offset`` is the TCP pose in the flange frame (x, y, z m; rotation
+    vector rad)."""
+
+    name: str
+    offset: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class Payload:
+    """A named payload: ``mass`` in kg, ``cog`` the centre of gravity in the flange frame [m]
+    (``None`` when the installation does not say)."""
+
+    name: str
+    mass: float
+    cog: tuple[float, float, float] | None = None
+
+
+@dataclass(frozen=True)
+class Installation:
+    """What urdsl reads from an installation so far.
+
+    ``tcps`` in file order and the name of the active one; ``payloads`` and the name of the
+    default one; ``mounting``: (base rotation, tilt) [rad] or ``None`` if absent; ``version``:
+    ``"5.11.9"``-like when the file says.
+    """
+
+    path: str
+    tcps: tuple[Tcp, ...] = ()
+    active_tcp: str | None = None
+    payloads: tuple[Payload, ...] = ()
+    active_payload: str | None = None
+    mounting: tuple[float, float] | None = None
+    version: str | None = None
+
+    @property
+    def tcp(self) -> Tcp | None:
+        """The active TCP (the first one if the file names none)."""
+        for tcp in self.tcps:
+            if tcp.name == self.active_tcp:
+                return tcp
+        return self.tcps[0] if self.tcps else None
+
+    @property
+    def payload(self) -> Payload | None:
+        """The default payload (the first one if the file marks none)."""
+        for payload in self.payloads:
+            if payload.name == self.active_payload:
+                return payload
+        return self.payloads[0] if self.payloads else None
+
+    @property
+    def gravity(self) -> tuple[float, float, float] | None:
+        """The ``set_gravity`` vector [m/s²] of the mounting: ``g·(sin t·cos b, −sin t·sin b,
+        cos t)`` for tilt ``t`` and base rotation ``b``. Floor (t = 0): (0, 0, 9.82); ceiling
+        (t = π): (0, 0, −9.82), as PolyScope writes them. The sign convention of ``b`` for a
+        tilted arm is inferred from one real ceiling-mounted project [U]."""
+        if self.mounting is None:
+            return None
+        base, tilt = self.mounting
+        return (GRAVITY * math.sin(tilt) * math.cos(base) + 0.0,
+                -GRAVITY * math.sin(tilt) * math.sin(base) + 0.0, GRAVITY * math.cos(tilt) + 0.0)
+
+
+def _numbers(text: str | None, count: int, what: str, path: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in (text or "").replace(";", ",").split(","))
+    except ValueError:
+        raise InstallationError(path, f"{what} is not {count} numbers: {text!r}") from None
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise InstallationError(path, f"{what} is not {count} finite numbers: {text!r}")
+    return values
+
+
+def _number(text: str | None, what: str, path: str) -> float:
+    return _numbers(text, 1, what, path)[0]
+
+
+def _decompress(data: bytes, path: str) -> bytes:
+    if data[:2] != b"\x1f\x8b":
+        return data
+    try:
+        with gzip.GzipFile(fileobj=io.BytesIO(data)) as handle:
+            out = handle.read(_MAX_SIZE + 1)
+    except (OSError, EOFError, zlib.error) as error:
+        reason = "truncated" if isinstance(error, EOFError) else "corrupt"
+        raise InstallationError(path, f"the gzip data is {reason} ({error})") from None
+    if len(out) > _MAX_SIZE:
+        raise InstallationError(path, f"larger than {_MAX_SIZE // 2**20} MB uncompressed")
+    return out
+
+
+def parse_installation(data: bytes, path: str = "<installation>") -> Installation:
+    """Read an installation from its bytes (gzip or plain XML); ``path`` names it in errors."""
+    data = _decompress(data, path)
+    if b"<!DOCTYPE" in data[:4096] or b"<!ENTITY" in data:
+        raise InstallationError(path, "XML with a DOCTYPE or entities is not an installation")
+    try:
+        root = ElementTree.fromstring(data)
+    except ElementTree.ParseError as error:
+        raise InstallationError(path, f"not well-formed XML ({error})") from None
+    if root.tag == "Installation":
+        return _modern(root, path)
+    if root.tag.endswith("RobotInstallation"):
+        return _legacy(root, path)
+    raise InstallationError(path, f"not a PolyScope installation (root element <{root.tag}>)")
+
+
+def _modern(root: ElementTree.Element, path: str) -> Installation:
+    """PolyScope 3.x and 5.x."""
+    tcps: list[Tcp] = []
+    active_tcp = None
+    payloads: list[Payload] = []
+    active_payload = None
+    settings = root.find("TCPSettings")
+    if settings is not None:
+        active_tcp = settings.get("activePose")
+        for element in settings.iter("tcp"):
+            name = element.get("name") or f"TCP {len(tcps) + 1}"
+            tcps.append(Tcp(name, _numbers(element.get("offset"), 6, f"TCP {name!r} offset",
+                                           path)))
+        if settings.get("toolPayload") is not None:
+            payloads.append(Payload("Payload", _number(settings.get("toolPayload"),
+                                                       "toolPayload", path)))
+    for element in root.iter("Payload"):
+        name = element.get("name") or f"Payload {len(payloads) + 1}"
+        cog = element.get("centerOfGravity")
+        payloads.append(Payload(
+            name, _number(element.get("mass"), f"payload {name!r} mass", path),
+            _numbers(cog, 3, f"payload {name!r} centre of gravity", path)  # type: ignore[arg-type]
+            if cog is not None else None))
+        if element.get("defaultPayload") == "true" and active_payload is None:
+            active_payload = name
+    mounting = None
+    marshal = root.find(".//WorldtoMarshal")
+    if marshal is not None and marshal.get("tiltAngle") is not None:
+        mounting = (_number(marshal.get("baseAngle", "0"), "mounting base angle", path),
+                    _number(marshal.get("tiltAngle"), "mounting tilt angle", path))
+    version = None
+    element = root.find("LastSavedInVersion")
+    if element is None:
+        element = root.find("Version")
+    if element is not None and element.get("major") is not None:
+        version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
+    return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
+                        mounting, version)
+
+
+def _legacy(root: ElementTree.Element, path: str) -> Installation:
+    """PolyScope 1.x (CB2): a serialised ``RobotInstallation`` object."""
+    tcps: tuple[Tcp, ...] = ()
+    transform = root.find("tcpTransform")
+    if transform is not None:
+        values = ",".join((d.text or "") for d in transform.findall("double"))
+        tcps = (Tcp("TCP", _numbers(values, 6, "tcpTransform", path)),)
+    payloads: tuple[Payload, ...] = ()
+    mass = root.find("toolPayload")
+    if mass is not None:
+        payloads = (Payload("Payload", _number(mass.text, "toolPayload", path)),)
+    mounting = None
+    tilt = root.find(".//mountingTiltAngle")
+    if tilt is not None:
+        base = root.find(".//mountingBaseAngle")
+        mounting = (_number(base.text, "mountingBaseAngle", path) if base is not None else 0.0,
+                    _number(tilt.text, "mountingTiltAngle", path))
+    return Installation(path, tcps, "TCP" if tcps else None, payloads,
+                        "Payload" if payloads else None, mounting, None)
+
+
+def read_installation(path: str | Path) -> Installation:
+    """Read the installation file at ``path``; :class:`InstallationError` if it cannot be."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError as error:
+        raise InstallationError(str(path), f"cannot read: {error.strerror}") from None
+    return parse_installation(data, str(path))
+
+
+def find_installation(program: str | Path) -> Path | None:
+    """The installation beside a program file: the only ``*.installation`` in its folder,
+    else the one named like the program, else ``default.installation``; ``None`` if none."""
+    program = Path(program)
+    folder = program.parent
+    try:
+        candidates = sorted(p for p in folder.glob("*.installation") if p.is_file())
+    except OSError:
+        return None
+    if len(candidates) == 1:
+        return candidates[0]
+    for name in (program.stem + ".installation", "default.installation"):
+        for candidate in candidates:
+            if candidate.name == name:
+                return candidate
+    return None
