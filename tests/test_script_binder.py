@@ -136,3 +136,24 @@ def test_a_call_site_is_bound_once():
     signature = Signature("h", ("a", "b"), (True, False))
     first = signature.bind(1, ("b",))
     assert signature.bind(1, ("b",)) is first
+
+
+def test_check_runs_cb3_code_and_unsimulated_catalog_rows(tmp_path, capsys):
+    # speedj's CB3 keyword reaches the simulated speedj as its t; builtins urdsl does not
+    # simulate give a neutral value and one event per call site, never an error
+    from urdsl.cli import main
+
+    program = tmp_path / "cb3.script"
+    program.write_text("speedj([0.1, 0, 0, 0, 0, 0], 2.0, t_min=0.5)\nstopj(2.0)\n"
+                       "i = 0\nwhile i < 3:\n  varmsg(\"i\", i)\n  i = i + 1\nend\n"
+                       "p = tool_pose()\nset_runstate_outputs([])\n")
+    status = main(["check", str(program), "--json", "--no-self-collision"])
+    import json
+
+    report = json.loads(capsys.readouterr().out)
+    assert status == 0, report
+    assert report["moves"][0]["duration"] >= 0.5
+    unsupported = [e["message"] for e in report["events"] if e["kind"] == "unsupported"]
+    assert unsupported == ["varmsg() is not simulated; it did nothing here",
+                           "tool_pose() is not simulated; it did nothing here",
+                           "set_runstate_outputs() is not simulated; it did nothing here"]

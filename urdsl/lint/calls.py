@@ -4,6 +4,7 @@ arguments that do not fit the signature (of a builtin or of a ``def`` in the fil
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import replace
 
 from ..script import nodes as n
 from ..script.binder import Problem, Signature, problems
@@ -12,7 +13,7 @@ from ..script.diagnostics import Diagnostic
 from .context import LintContext
 from .registry import rule
 
-_SERIES = {"cb": "CB3 (3.x)", "e": "e-Series (5.x)", "x": "PolyScope X (10.x)"}
+_SERIES = {"cb": "CB2/CB3 (1.x-3.x)", "e": "e-Series (5.x)", "x": "PolyScope X (10.x)"}
 
 
 def _version_text(version: tuple[int, int]) -> str:
@@ -94,7 +95,16 @@ def _problems(ctx: LintContext, call: n.Call) -> list[Problem]:
     builtin = ctx.builtin(call)
     if builtin is None or not builtin.callable:
         return []
-    return builtin.call_problems(len(call.args), keywords, ctx.version)
+    found = builtin.call_problems(len(call.args), keywords, ctx.version)
+    if found and ctx.version is not None:  # the call may fit another generation's signature
+        applicable = builtin.rows(ctx.version)
+        other = next((row for row in (builtin, *builtin.variants) if row not in applicable
+                      and not isinstance(row.call_signature.bind(len(call.args), keywords),
+                                         Problem)), None)
+        if other is not None:
+            note = f"{other.signature} is the signature on {where_available(other)}"
+            found = [replace(p, hint=f"{p.hint}; {note}" if p.hint else note) for p in found]
+    return found
 
 
 def _diagnostics(ctx: LintContext, code: str, kinds: tuple[str, ...]) -> Iterator[Diagnostic]:

@@ -229,8 +229,8 @@ class Builtin:
         firsts = self.first_versions()
         series = _series(version)
         if series not in firsts:
-            if since == "3.x" and last is None and "CB3 only" not in self.remarks:
-                return None
+            if since in ("1.x", "3.x") and last is None and "CB3 only" not in self.remarks:
+                return None  # a CB-era builtin whose fate on later series is not known
             return False
         first = firsts[series]
         if first is None:
