@@ -1,9 +1,13 @@
-"""The builtin catalog: every URScript builtin with its parameters, defaults, return type,
-controller versions and deprecation.
+"""The builtin catalog: every URScript builtin of every UR controller generation with its
+parameters, defaults, return type, controller versions and deprecation.
 
 This is the one source that the linter, the DSL and the interpreter read. The data is
-``builtins.tsv`` (package data, from ``../shared/reference/builtins.tsv``; its columns are
-explained in ``../shared/reference/BUILTINS.md``)::
+``builtins.tsv`` (package data): tab-separated, one header line, columns ``module``,
+``name``, ``params_with_defaults`` (``name=default``, ``[name]`` optional without a stated
+default, ``...`` any ``name=value``, ``-`` not callable), ``returns``, ``since_version``,
+``deprecated``, ``replaced_by`` and ``remarks`` (the row's source; ``[S]`` one public source,
+``[U]`` unconfirmed, ``[X]`` UR's own scripts; unmarked rows follow the e-Series/PolyScope X
+manuals)::
 
     >>> from urdsl.script.builtins import catalog
     >>> movej = catalog()["movej"]
@@ -12,8 +16,18 @@ explained in ``../shared/reference/BUILTINS.md``)::
     >>> movej.available_in("5.15"), catalog()["get_euromap_input"].available_in("5.15")
     (True, False)
 
-Versions are PolyScope software versions: 1.x–3.x CB-Series, 5.x e-Series, 10.x and later
-PolyScope X.
+A builtin may have several signature rows (the same name on several lines): the first is the
+current one, the others are :attr:`Builtin.variants`, each with the versions it applies to.
+``since_version`` is the first version (``5.15``, ``3.14/5.9`` per series, ``doc<=2020``
+documented in the 2020-era manual, ``<=5.15`` documented by then, ``1.x``/``3.x`` CB-era,
+``5.x`` e-Series, ``10.x`` PolyScope X, ``~`` approximate, ``?`` unknown), optionally followed
+by ``..last`` for the last version the row applies to (``1.x..3.x``: CB2 and CB3 only)::
+
+    >>> [row.signature for row in (catalog()["speedj"], *catalog()["speedj"].variants)]
+    ['speedj(qd, a, [t])', 'speedj(qd, a, [t_min])']
+
+Versions are PolyScope software versions: 1.x CB2, 3.x CB3 (together the CB-Series), 5.x
+e-Series, 10.x and later PolyScope X.
 """
 
 from __future__ import annotations
