@@ -69,6 +69,9 @@ def test_methods():
         ("varmsg", "1.8", True), ("varmsg", "3.15", True), ("varmsg", "5.15", None),
         ("set_runstate_outputs", "3.2", True), ("set_runstate_outputs", "10.11", None),
         ("get_euromap_input", "1.8", True), ("get_euromap_input", "10.11", False),
+        # seen in a program of that version (<=3.5): later ones have it, earlier ones unknown
+        ("enable_external_ft_sensor", "3.5", True), ("enable_external_ft_sensor", "3.2", None),
+        ("ft_rtde_input_enable", "3.15", True), ("ft_rtde_input_enable", "5.15", True),
     ],
 )
 def test_availability_by_controller_version(name, version, expected):

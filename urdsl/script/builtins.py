@@ -207,9 +207,12 @@ class Builtin:
         if since.startswith("doc"):  # documented in the 2020-era (or 2022-23) manuals
             return {"cb": None, "e": None if "2020" in since else (5, 11), "x": None}
         if since.startswith("<="):
-            return {"e": None, "x": None}
+            result: dict[str, Version | None] = dict.fromkeys(self._seen_by(), None)
+            if "e" in result:
+                result["x"] = None
+            return result
         if since in ("1.x", "3.x"):
-            result: dict[str, Version | None] = {"cb": None}
+            result = {"cb": None}
         elif since == "5.x":
             result = {"e": None, "x": None}
         elif since == "10.x":
@@ -231,6 +234,18 @@ class Builtin:
             result["x"] = None  # PolyScope X carries the e-Series language forward
         return result
 
+    def _seen_by(self) -> dict[str, Version]:
+        """For ``since`` written ``<=A/B``: the version per series by which the row is known
+        to exist (documented or seen in a program of that version)."""
+        since = self.since_first.lstrip("~")
+        if not since.startswith("<="):
+            return {}
+        bounds = {}
+        for part in since[2:].split("/"):
+            version = parse_version(part.removeprefix("<="))
+            bounds[_series(version)] = version
+        return bounds
+
     def row_available_in(self, version: Version) -> bool | None:
         """Whether controller software ``version`` has this signature row: True, False, or
         None when the catalog cannot tell (an unconfirmed or open-ended first version)."""
@@ -248,8 +263,8 @@ class Builtin:
             return False
         first = firsts[series]
         if first is None:
-            if since.startswith("<=") and series == "e":
-                bound = parse_version(since[2:].split("/")[0])
+            bound = self._seen_by().get(series)
+            if bound is not None:  # documented by then; earlier versions cannot be told
                 return True if version >= bound else None
             return True
         if version >= first:
