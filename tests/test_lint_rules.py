@@ -225,3 +225,47 @@ def test_select_and_ignore_take_prefixes_and_names():
     assert not lint_text(text, "t", build_settings(select=["URS0"]))
     none = {d.code for d in lint_text(text, "t", build_settings(ignore=["unused-variable"]))}
     assert "URS112" not in none and "URS119" in none
+
+
+# ---- the catalog of every controller generation ------------------------------------------
+
+CB3_SPEEDJ = "speedj([0.1, 0, 0, 0, 0, 0], 0.5, t_min=0.008)\n"
+CB_ERA = ("varmsg(\"x\", 1)\np = tool_pose()\nset_runstate_outputs([])\n"
+          "set_runstate_standard_digital_outputs([])\n")
+
+
+def _codes(text: str, **settings) -> list[str]:
+    return [d.code for d in lint_text(text, "t.script", build_settings(**settings))]
+
+
+@pytest.mark.parametrize("version", [None, "3.15", "3.2", "1.8"])
+def test_cb3_speedj_signature_is_accepted_where_it_applies(version):
+    settings = {"version": version} if version else {}
+    assert _codes(CB3_SPEEDJ, **settings) == []
+
+
+@pytest.mark.parametrize("version", ["5.15", "10.11"])
+def test_cb3_speedj_signature_is_an_error_on_later_versions(version):
+    found = finding(CB3_SPEEDJ, "URS106", version=version)
+    assert found.message == "speedj() has no parameter 't_min'"
+    assert "speedj(qd, a, [t_min]) is the signature on CB2/CB3" in found.hint
+    assert _codes(CB3_SPEEDJ, version=version) == ["URS106"]
+
+
+@pytest.mark.parametrize("version", [None, "1.8", "3.15", "5.15"])
+def test_cb_era_builtins_are_not_errors(version):
+    # valid on some controller: never an error without --version; on e-Series their fate
+    # is not known, so they are not reported there either
+    settings = {"version": version} if version else {}
+    assert _codes(CB_ERA, **settings) == []
+
+
+def test_a_builtin_the_version_lacks_is_still_an_error():
+    text = "x = get_euromap_input(1)\n"
+    assert _codes(text) == [] and _codes(text, version="3.15") == []
+    assert "CB2/CB3" in finding(text, "URS103", version="5.15").message
+
+
+def test_an_unknown_function_is_still_urs102():
+    assert "varmsg" in finding("varmesg(\"x\", 1)\n", "URS102").hint
+    assert _codes("tool_poses()\n", version="3.15") == ["URS102"]

@@ -9,9 +9,19 @@ from urdsl.script.builtins import catalog, lookup, methods, parse_version
 
 def test_every_row_is_there():
     # 299 rows of the reference catalog + get_joint_positions, eip_reader_factory and
-    # eip_writer_factory (added from UR's own scripts, see their remarks)
-    assert len(catalog()) + len(methods()) == 302
+    # eip_writer_factory (added from UR's own scripts, see their remarks) + 7 CB-era builtins
+    # (varmsg, tool_pose, set_runstate_outputs and four set_runstate_*_outputs)
+    assert len(catalog()) + len(methods()) == 309
     assert sum(b.deprecated for b in catalog().values()) == 16
+    # 3 more signature rows of older generations: speedj, speedl (t_min), set_payload (CoG)
+    assert sum(len(b.variants) for b in catalog().values()) == 3
+
+
+def test_every_added_row_names_its_source_or_stays_unconfirmed():
+    for builtin in catalog().values():
+        for row in (builtin, *builtin.variants):
+            if row.since_first in ("1.x", "3.x") or row.last is not None:
+                assert row.remarks.startswith(("[S]", "[U]", "CB3 only")), row.name
 
 
 def test_movej_signature_and_defaults():
@@ -55,6 +65,13 @@ def test_methods():
         ("direct_torque", "5.22", False), ("direct_torque", "5.23", True),
         ("get_jacobian", "5.23", True), ("get_jacobian", "5.20", None),
         ("assert", "5.15", None),
+        # CB-era builtins: there on CB2/CB3, unknown (never "absent") on later series
+        ("varmsg", "1.8", True), ("varmsg", "3.15", True), ("varmsg", "5.15", None),
+        ("set_runstate_outputs", "3.2", True), ("set_runstate_outputs", "10.11", None),
+        ("get_euromap_input", "1.8", True), ("get_euromap_input", "10.11", False),
+        # seen in a program of that version (<=3.5): later ones have it, earlier ones unknown
+        ("enable_external_ft_sensor", "3.5", True), ("enable_external_ft_sensor", "3.2", None),
+        ("ft_rtde_input_enable", "3.15", True), ("ft_rtde_input_enable", "5.15", True),
     ],
 )
 def test_availability_by_controller_version(name, version, expected):
@@ -70,3 +87,32 @@ def test_version_parsing():
     assert parse_version("5.15.2") == (5, 15)
     with pytest.raises(ValueError, match="controller version"):
         parse_version("five")
+
+
+def test_a_builtin_has_one_signature_row_per_generation():
+    speedj = lookup("speedj")
+    assert speedj.signature == "speedj(qd, a, [t])"
+    (cb,) = speedj.variants
+    assert cb.signature == "speedj(qd, a, [t_min])" and cb.last == (3, 999)
+    assert cb.row_available_in((3, 15)) and cb.row_available_in((5, 4)) is False
+    assert speedj.rows() == (speedj, cb)
+    assert speedj.rows((5, 15)) == (speedj,)
+    assert speedj.rows((3, 15)) == (speedj, cb)
+
+
+@pytest.mark.parametrize(("version", "fits"), [(None, True), ((3, 15), True), ((1, 8), True),
+                                               ((5, 15), False), ((10, 11), False)])
+def test_the_signature_of_the_version_applies(version, fits):
+    problem = lookup("speedj").argument_problem(2, ("t_min",), version)
+    assert (problem is None) is fits
+    if not fits:
+        assert problem.message == "speedj() has no parameter 't_min'"
+    assert lookup("speedj").argument_problem(2, ("t",), version) is None
+
+
+def test_a_call_of_an_older_signature_binds_to_that_row():
+    speedj = lookup("speedj")
+    row, binding = speedj.bind(2, ("t_min",))
+    assert row is speedj.variants[0] and binding.positional == ("qd", "a")
+    row, _ = speedj.bind(3, ())
+    assert row is speedj  # positional calls fit the current row first

@@ -18,6 +18,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 from ..script import nodes as n
+from ..script.binder import Signature, first_problem
 from ..script.builtins import lookup
 from ..script.printer import format as format_tree
 from .errors import DslError, caller
@@ -156,7 +157,7 @@ class Program:
             raise DslError(f"{name!r} is not a URScript name")
         self.name = name
         self._blocks: list[_Block] = [_Block("def")]
-        self._functions: set[str] = set()
+        self._functions: dict[str, Signature] = {}
         self._threads: set[str] = set()
         self._variables: set[str] = set()
         self._span = _span()
@@ -341,6 +342,9 @@ class Program:
 
     def _check_call(self, name: str, args: tuple, keywords: dict) -> None:
         if name in self._functions:
+            problem = first_problem(self._functions[name], len(args), tuple(keywords))
+            if problem is not None:
+                raise DslError(problem.message, problem.hint)
             return
         row = lookup(name)
         if row is None:
@@ -351,9 +355,12 @@ class Program:
             close = difflib.get_close_matches(name, list(catalog()) + sorted(self._functions))
             raise DslError(f"{name!r} is not a URScript builtin or a function of this program",
                            f"did you mean {', '.join(close)}?" if close else None)
-        problem = row.argument_problem(len(args), keywords)
+        if not row.callable:
+            raise DslError(f"'{name}' is a command of the interpreter socket (port 30020), "
+                           "not a function")
+        problem = row.argument_problem(len(args), tuple(keywords))
         if problem is not None:
-            raise DslError(*problem)
+            raise DslError(problem.message, problem.hint)
 
     # ---- variables -------------------------------------------------------------------------
 
@@ -462,7 +469,8 @@ class Program:
         if lookup(name) is not None:
             raise DslError(f"{name!r} is the name of a builtin", "choose another name")
         span = _span()
-        self._functions.add(name)
+        self._functions[name] = Signature(
+            name, (*params, *defaults), (True,) * len(params) + (False,) * len(defaults))
         handle = Function(self, name, (*params, *defaults))
         with self._body("def") as block:
             yield handle

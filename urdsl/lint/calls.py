@@ -3,17 +3,17 @@ arguments that do not fit the signature (of a builtin or of a ``def`` in the fil
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import replace
 
 from ..script import nodes as n
+from ..script.binder import Problem, Signature, problems
 from ..script.builtins import Builtin
 from ..script.diagnostics import Diagnostic
 from .context import LintContext
 from .registry import rule
 
-_SERIES = {"cb": "CB3 (3.x)", "e": "e-Series (5.x)", "x": "PolyScope X (10.x)"}
+_SERIES = {"cb": "CB2/CB3 (1.x-3.x)", "e": "e-Series (5.x)", "x": "PolyScope X (10.x)"}
 
 
 def _version_text(version: tuple[int, int]) -> str:
@@ -81,35 +81,43 @@ def deprecated(ctx: LintContext) -> Iterator[Diagnostic]:
         yield ctx.diagnostic("URS104", call.func, f"{builtin.name}() is deprecated", hint)
 
 
-@dataclass(frozen=True)
-class _Signature:
-    """What a call has to match: parameter names, which are required, whether any keyword
-    is accepted (``struct``), and how to name the callee in messages."""
-
-    title: str
-    names: tuple[str, ...]
-    required: tuple[bool, ...]
-    any_keyword: bool
-    text: str
-
-
-def _signature(ctx: LintContext, call: n.Call) -> _Signature | None:
+def _problems(ctx: LintContext, call: n.Call) -> list[Problem]:
+    """Every argument mistake of a call of a ``def`` of the file or of a builtin (against
+    the signature rows that apply to the target version), from the one call binder."""
     name = call.func.id  # type: ignore[union-attr]
+    keywords = tuple(k.name for k in call.keywords)
     definitions = ctx.analysis.functions.get(name)
     if definitions:
-        definition = definitions[-1]
-        names = tuple(p.name for p in definition.params)
-        required = tuple(p.default is None for p in definition.params)
-        text = f"{name}({', '.join(names)})"
-        return _Signature(f"{name}()", names, required, False, text)
+        params = definitions[-1].params
+        signature = Signature(name, tuple(p.name for p in params),
+                              tuple(p.default is None for p in params))
+        return problems(signature, len(call.args), keywords)
     builtin = ctx.builtin(call)
     if builtin is None or not builtin.callable:
-        return None
-    return _Signature(
-        f"{name}()", tuple(p.name for p in builtin.params),
-        tuple(not p.optional for p in builtin.params), builtin.variadic_keywords,
-        builtin.signature,
-    )
+        return []
+    found = builtin.call_problems(len(call.args), keywords, ctx.version)
+    if found and ctx.version is not None:  # the call may fit another generation's signature
+        applicable = builtin.rows(ctx.version)
+        other = next((row for row in (builtin, *builtin.variants) if row not in applicable
+                      and not isinstance(row.call_signature.bind(len(call.args), keywords),
+                                         Problem)), None)
+        if other is not None:
+            note = f"{other.signature} is the signature on {where_available(other)}"
+            found = [replace(p, hint=f"{p.hint}; {note}" if p.hint else note) for p in found]
+    return found
+
+
+def _diagnostics(ctx: LintContext, code: str, kinds: tuple[str, ...]) -> Iterator[Diagnostic]:
+    for _scope, call in ctx.calls():
+        for problem in _problems(ctx, call):
+            if problem.kind not in kinds:
+                continue
+            node: n.Node = call
+            if problem.index is not None and problem.index < len(call.args):
+                node = call.args[problem.index]
+            elif problem.keyword is not None:
+                node = next(k for k in call.keywords if k.name == problem.keyword)
+            yield ctx.diagnostic(code, node, problem.message, problem.hint)
 
 
 @rule(
@@ -117,34 +125,13 @@ def _signature(ctx: LintContext, call: n.Call) -> _Signature | None:
     "More positional arguments than the function has parameters, or one argument given twice.",
     """
 The controller checks the number of arguments when it compiles the program. Checked against
-the builtin catalog and against the `def`s of the file.""",
+the builtin catalog (every signature the target version accepts; without `--version`, the
+signatures of every controller generation) and against the `def`s of the file.""",
     "movej([0, -1.57, 0, -1.57, 0, 0], 1.4, 1.05, 0, 0, 0)",
     "movej([0, -1.57, 0, -1.57, 0, 0], 1.4, 1.05, 0, 0)",
 )
 def too_many_arguments(ctx: LintContext) -> Iterator[Diagnostic]:
-    for _scope, call in ctx.calls():
-        signature = _signature(ctx, call)
-        if signature is None:
-            continue
-        count = len(call.args)
-        if count > len(signature.names):
-            extra = call.args[len(signature.names)]
-            yield ctx.diagnostic(
-                "URS105", extra, f"{signature.title} takes at most {len(signature.names)} "
-                f"argument{'s' if len(signature.names) != 1 else ''}, {count} given",
-                f"the signature is {signature.text}")
-        for keyword in call.keywords:
-            if keyword.name in signature.names[:count]:
-                yield ctx.diagnostic(
-                    "URS105", keyword, f"argument '{keyword.name}' of {signature.title} is "
-                    "given twice, by position and by name", "remove one of the two")
-
-
-# What people write for the move parameters a, v, t, r.
-_SYNONYMS = {
-    "speed": "v", "velocity": "v", "vel": "v", "acceleration": "a", "acc": "a", "accel": "a",
-    "time": "t", "duration": "t", "radius": "r", "blend": "r", "blend_radius": "r",
-}
+    yield from _diagnostics(ctx, "URS105", ("too-many", "twice", "positional"))
 
 
 @rule(
@@ -152,26 +139,14 @@ _SYNONYMS = {
     "A keyword argument that the function has no parameter for.",
     """
 `movej(q, speed=1.0)` is rejected: the parameters of a builtin have fixed names (movej takes
-a, v, t, r). The hint names the closest parameter.""",
+a, v, t, r). The hint names the closest parameter. Some names changed between controller
+generations (`speedj(qd, a, t_min)` on CB3, `speedj(qd, a, t)` on e-Series): without
+`--version` either is accepted.""",
     "movej(q_home, speed=1.0)",
     "movej(q_home, v=1.0)",
 )
 def unknown_keyword(ctx: LintContext) -> Iterator[Diagnostic]:
-    for _scope, call in ctx.calls():
-        signature = _signature(ctx, call)
-        if signature is None or signature.any_keyword:
-            continue
-        for keyword in call.keywords:
-            if keyword.name in signature.names:
-                continue
-            close = difflib.get_close_matches(keyword.name, signature.names, n=1, cutoff=0.6)
-            synonym = _SYNONYMS.get(keyword.name.lower())
-            if synonym in signature.names:
-                close = [synonym]
-            hint = f"did you mean `{close[0]}`? " if close else ""
-            yield ctx.diagnostic(
-                "URS106", keyword, f"{signature.title} has no parameter '{keyword.name}'",
-                f"{hint}the signature is {signature.text}")
+    yield from _diagnostics(ctx, "URS106", ("unknown-keyword",))
 
 
 @rule(
@@ -183,17 +158,4 @@ Parameters without a default value must be given, by position or by name.""",
     "set_standard_digital_out(3, True)",
 )
 def missing_argument(ctx: LintContext) -> Iterator[Diagnostic]:
-    for _scope, call in ctx.calls():
-        signature = _signature(ctx, call)
-        if signature is None:
-            continue
-        given = set(signature.names[:len(call.args)]) | {k.name for k in call.keywords}
-        missing = [name for name, required in zip(signature.names, signature.required,
-                                                   strict=True)
-                   if required and name not in given]
-        if missing:
-            listed = ", ".join(f"'{m}'" for m in missing)
-            yield ctx.diagnostic(
-                "URS107", call, f"{signature.title} is missing the argument"
-                f"{'s' if len(missing) > 1 else ''} {listed}",
-                f"the signature is {signature.text}")
+    yield from _diagnostics(ctx, "URS107", ("missing",))

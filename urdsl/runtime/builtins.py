@@ -18,6 +18,7 @@ import random
 from collections.abc import Callable
 from typing import Any
 
+from ..script.binder import Problem
 from ..script.builtins import Builtin, lookup, methods
 from ..script.nodes import Node
 from .values import (
@@ -84,10 +85,12 @@ class BuiltinTable:
     def _prepare(self, name: str, positional: int, keywords: tuple[str, ...]):
         row = lookup(name)
         implementation = IMPLEMENTATIONS.get(name)
-        if row is None or implementation is None or row.variadic_keywords \
-                or row.argument_problem(positional, keywords) is not None:
+        if row is None or implementation is None or row.variadic_keywords or not row.callable:
             return None
-        params = tuple(p.name for p in row.params[:positional])
+        result = row.bind(positional, keywords)
+        if isinstance(result, Problem) or result[0] is not row:
+            return None  # call() reports the problem, or renames another row's parameters
+        params = result[1].positional
         rt = self.rt
 
         def call(values: list, named: dict, node: Node) -> Any:
@@ -99,15 +102,28 @@ class BuiltinTable:
         return call
 
     def bind(self, row: Builtin, args: list, named: dict, node: Node) -> dict[str, Any]:
+        """The arguments of a call of ``row`` by parameter name, bound by the one call
+        binder against every signature row of the builtin; raises the binder's message.
+        A call that fits an older signature row (``speedj(qd, a, t_min=...)``) is given
+        to the implementation under the current row's names, position by position."""
         rt = self.rt
-        problem = row.argument_problem(len(args), named)
-        if problem is not None:
-            message, hint = problem
-            raise rt.error("call" if not row.callable else "arguments", message, node, hint)
+        if not row.callable:
+            raise rt.error("call", f"'{row.name}' is a command of the interpreter socket "
+                           "(port 30020), not a function", node,
+                           f"send `{row.name}` alone on a line to port 30020")
+        result = row.bind(len(args), tuple(named))
+        if isinstance(result, Problem):
+            raise rt.error("arguments", result.message, node, result.hint)
         if row.variadic_keywords:
             return {"__members__": named}
-        bound = {param.name: value for param, value in zip(row.params, args, strict=False)}
+        used, binding = result
+        bound = dict(zip(binding.positional, args, strict=False))
         bound.update(named)
+        if used is not row:
+            current = [p.name for p in row.params]
+            older = [p.name for p in used.params]
+            bound = {current[older.index(key)]: value for key, value in bound.items()
+                     if older.index(key) < len(current)}
         return bound
 
     def unsupported(self, row: Builtin, node: Node) -> Any:

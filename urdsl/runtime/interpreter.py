@@ -26,6 +26,7 @@ from typing import Any
 import greenlet
 
 from ..script import nodes as n
+from ..script.binder import Binding, Signature
 from ..script.nodes import NO_SPAN, Span
 from .errors import ScriptRuntimeError
 from .values import (
@@ -123,7 +124,7 @@ class Thread:
 
 
 class _Function:
-    __slots__ = ("name", "params", "body", "node", "defaults")
+    __slots__ = ("name", "params", "body", "node", "defaults", "signature")
 
     def __init__(self, node: n.FunctionDef, body: Callable, defaults: list) -> None:
         self.name = node.name
@@ -131,6 +132,8 @@ class _Function:
         self.defaults = defaults
         self.body = body
         self.node = node
+        self.signature = Signature(node.name, tuple(self.params),
+                                   tuple(p.default is None for p in node.params))
 
 
 class Interpreter:
@@ -895,26 +898,19 @@ class _Compiler:
     def call_user(self, function: _Function, args: list, named: dict, node: n.Call) -> Any:
         rt = self.rt
         params = function.params
-        if len(args) > len(params):
-            raise rt.error("arguments", f"{function.name}() takes {len(params)} arguments, "
-                           f"{len(args)} given", node)
+        # bound once per call shape by the one call binder (cached in the signature)
+        binding = function.signature.bind(len(args), tuple(named))
+        if type(binding) is not Binding:
+            raise rt.error("arguments", binding.message, node, binding.hint)
         frame = Frame({}, top=False)
         bound = frame.vars
-        for name, value in zip(params, args, strict=False):
+        for name, value in zip(binding.positional, args, strict=True):
             bound[name] = copy_value(value)
         for name, value in named.items():
-            if name not in params:
-                raise rt.error("arguments", f"{function.name}() has no parameter '{name}'",
-                               node)
-            if name in bound:
-                raise rt.error("arguments", f"{function.name}() got '{name}' twice", node)
             bound[name] = copy_value(value)
-        for name, default in zip(params, function.defaults, strict=True):
-            if name not in bound:
-                if default is None:
-                    raise rt.error("arguments", f"{function.name}() needs argument '{name}'",
-                                   node)
-                bound[name] = copy_value(default(frame))
+        defaults = function.defaults
+        for index, name in binding.defaulted:
+            bound[name] = copy_value(defaults[index](frame))
         frame.local_names.update(params)
         rt.depth += 1
         if rt.depth > rt.config.max_call_depth:

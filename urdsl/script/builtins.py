@@ -1,9 +1,13 @@
-"""The builtin catalog: every URScript builtin with its parameters, defaults, return type,
-controller versions and deprecation.
+"""The builtin catalog: every URScript builtin of every UR controller generation with its
+parameters, defaults, return type, controller versions and deprecation.
 
 This is the one source that the linter, the DSL and the interpreter read. The data is
-``builtins.tsv`` (package data, from ``../shared/reference/builtins.tsv``; its columns are
-explained in ``../shared/reference/BUILTINS.md``)::
+``builtins.tsv`` (package data): tab-separated, one header line, columns ``module``,
+``name``, ``params_with_defaults`` (``name=default``, ``[name]`` optional without a stated
+default, ``...`` any ``name=value``, ``-`` not callable), ``returns``, ``since_version``,
+``deprecated``, ``replaced_by`` and ``remarks`` (the row's source; ``[S]`` one public source,
+``[U]`` unconfirmed, ``[X]`` UR's own scripts; unmarked rows follow the e-Series/PolyScope X
+manuals)::
 
     >>> from urdsl.script.builtins import catalog
     >>> movej = catalog()["movej"]
@@ -12,16 +16,29 @@ explained in ``../shared/reference/BUILTINS.md``)::
     >>> movej.available_in("5.15"), catalog()["get_euromap_input"].available_in("5.15")
     (True, False)
 
-Versions are PolyScope software versions: 1.x–3.x CB-Series, 5.x e-Series, 10.x and later
-PolyScope X.
+A builtin may have several signature rows (the same name on several lines): the first is the
+current one, the others are :attr:`Builtin.variants`, each with the versions it applies to.
+``since_version`` is the first version (``5.15``, ``3.14/5.9`` per series, ``doc<=2020``
+documented in the 2020-era manual, ``<=5.15`` documented by then, ``1.x``/``3.x`` CB-era,
+``5.x`` e-Series, ``10.x`` PolyScope X, ``~`` approximate, ``?`` unknown), optionally followed
+by ``..last`` for the last version the row applies to (``1.x..3.x``: CB2 and CB3 only)::
+
+    >>> [row.signature for row in (catalog()["speedj"], *catalog()["speedj"].variants)]
+    ['speedj(qd, a, [t])', 'speedj(qd, a, [t_min])']
+
+Versions are PolyScope software versions: 1.x CB2, 3.x CB3 (together the CB-Series), 5.x
+e-Series, 10.x and later PolyScope X.
 """
 
 from __future__ import annotations
 
 import functools
 import re
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 from importlib import resources
+
+from .binder import Binding, Problem, Signature, problems
 
 __all__ = ["BuiltinParam", "Builtin", "catalog", "lookup", "parse_version", "methods"]
 
@@ -68,6 +85,8 @@ class Builtin:
     remarks: str
     callable: bool = True
     variadic_keywords: bool = False
+    variants: tuple[Builtin, ...] = ()
+    _bound: dict = field(default_factory=dict, init=False, compare=False, hash=False, repr=False)
 
     @property
     def min_args(self) -> int:
@@ -108,81 +127,159 @@ class Builtin:
         """The parameter called ``name``, if there is one."""
         return next((p for p in self.params if p.name == name), None)
 
-    def argument_problem(self, positional: int, keywords) -> tuple[str, str | None] | None:
+    @functools.cached_property
+    def call_signature(self) -> Signature:
+        """This row's parameters as the call binder sees them."""
+        return Signature(self.name, tuple(p.name for p in self.params),
+                         tuple(not p.optional for p in self.params), self.variadic_keywords,
+                         self.signature)
+
+    def rows(self, version: Version | None = None) -> tuple[Builtin, ...]:
+        """The signature rows of this builtin that apply to controller ``version``: all of
+        them without a version (code valid on SOME controller is accepted); with one, the
+        rows not known to be absent there (all rows again when none is left, so that an
+        unavailable builtin is reported once, as not available, not as a bad call)."""
+        every = (self, *self.variants)
+        if version is None or not self.variants:
+            return every
+        fitting = tuple(row for row in every if row.row_available_in(version) is not False)
+        return fitting or every
+
+    def bind(self, positional: int, keywords: Sequence[str],
+             version: Version | None = None) -> tuple[Builtin, Binding] | Problem:
+        """Bind a call giving ``positional`` arguments and the ``keywords`` names: the first
+        applicable signature row that fits and its binding, or the problem of the first
+        applicable row (see :meth:`rows`). A call site is bound once (cached per shape)."""
+        keywords = tuple(keywords)
+        key = (positional, keywords, version)
+        cached = self._bound.get(key)
+        if cached is not None:
+            return cached
+        rows = self.rows(version)
+        result: tuple[Builtin, Binding] | Problem | None = None
+        for row in rows:
+            binding = row.call_signature.bind(positional, keywords)
+            if isinstance(binding, Binding):
+                result = (row, binding)
+                break
+        if result is None:
+            result = rows[0].call_signature.bind(positional, keywords)
+        self._bound[key] = result
+        return result
+
+    def call_problems(self, positional: int, keywords: Sequence[str],
+                      version: Version | None = None) -> list[Problem]:
+        """Every mistake of a call (for the linter); empty when one applicable signature row
+        fits. The mistakes are those against the first applicable row (:meth:`rows`)."""
+        if isinstance(self.bind(positional, keywords, version), Problem):
+            return problems(self.rows(version)[0].call_signature, positional, keywords)
+        return []
+
+    def argument_problem(self, positional: int, keywords: Sequence[str],
+                         version: Version | None = None) -> Problem | None:
         """What is wrong with a call giving ``positional`` arguments and the ``keywords``
-        names, as ``(message, hint)``; None when the call fits the signature. The one rule
-        for the interpreter and the DSL."""
-        if not self.callable:
-            return (f"'{self.name}' is a command of the interpreter socket, not a function",
-                    None)
-        if self.variadic_keywords:
-            if positional:
-                return f"{self.name}() takes only name=value arguments", None
+        names (see :mod:`urdsl.script.binder`); None when it fits one applicable row."""
+        result = self.bind(positional, keywords, version)
+        return result if isinstance(result, Problem) else None
+
+    @property
+    def since_first(self) -> str:
+        """The ``since`` column without its ``..last`` part: when the row starts to apply."""
+        return self.since.split("..", 1)[0]
+
+    @property
+    def last(self) -> Version | None:
+        """The last controller version this signature row applies to (``since`` written
+        ``first..last``; ``3.x`` as last means "to the end of the CB-Series"); None when the
+        row has no end."""
+        if ".." not in self.since:
             return None
-        names = [p.name for p in self.params]
-        if positional > len(names):
-            return (f"{self.signature} takes at most {len(names)} arguments, {positional} "
-                    "given"), None
-        for key in keywords:
-            if key not in names:
-                return (f"{self.name}() has no parameter '{key}'",
-                        f"the signature is {self.signature}")
-            if names.index(key) < positional:
-                return f"{self.name}() got '{key}' twice", f"the signature is {self.signature}"
-        given = set(names[:positional]) | set(keywords)
-        for param in self.params:
-            if param.name not in given and not param.optional:
-                return (f"{self.name}() needs argument '{param.name}'",
-                        f"the signature is {self.signature}")
-        return None
+        text = self.since.split("..", 1)[1].strip().lstrip("~")
+        if text.endswith(".x"):
+            return int(text[:-2]), 999
+        return parse_version(text)
 
     def first_versions(self) -> dict[str, Version | None]:
-        """First version per series (``"cb"``, ``"e"``, ``"x"``) that has this builtin;
+        """First version per series (``"cb"``, ``"e"``, ``"x"``) that has this row;
         a series missing from the dict does not have it; ``None`` means "from the first
-        version we know of"."""
-        since = self.since.lstrip("~")
+        version we know of". CB2 (1.x) and CB3 (3.x) are the one CB series."""
+        since = self.since_first.lstrip("~")
         if since.startswith("doc"):  # documented in the 2020-era (or 2022-23) manuals
             return {"cb": None, "e": None if "2020" in since else (5, 11), "x": None}
         if since.startswith("<="):
-            return {"e": None, "x": None}
-        if since == "3.x":
-            return {"cb": None}
-        if since == "5.x":
-            return {"e": None, "x": None}
-        if since == "10.x":
-            return {"x": None}
-        if since == "?":
+            result: dict[str, Version | None] = dict.fromkeys(self._seen_by(), None)
+            if "e" in result:
+                result["x"] = None
+            return result
+        if since in ("1.x", "3.x"):
+            result = {"cb": None}
+        elif since == "5.x":
+            result = {"e": None, "x": None}
+        elif since == "10.x":
+            result = {"x": None}
+        elif since == "?":
             return {}
-        result: dict[str, Version | None] = {}
-        for part in since.split("/"):
-            version = parse_version(part)
-            result[_series(version)] = version
-        if "e" in result and "x" not in result:
+        else:
+            result = {}
+            for part in since.split("/"):
+                version = parse_version(part)
+                result[_series(version)] = version
+        last = self.last
+        if last is not None:  # a row that ends does not reach the later series
+            order = ("cb", "e", "x")
+            final = order.index(_series((last[0], 0)))
+            result = {series: first for series, first in result.items()
+                      if order.index(series) <= final}
+        elif "e" in result and "x" not in result:
             result["x"] = None  # PolyScope X carries the e-Series language forward
         return result
 
-    def available_in(self, version: str | Version) -> bool | None:
-        """Whether controller software ``version`` has this builtin: True, False, or None
-        when the catalog cannot tell (an unconfirmed or open-ended first version)."""
-        if isinstance(version, str):
-            version = parse_version(version)
-        if self.since == "?":
+    def _seen_by(self) -> dict[str, Version]:
+        """For ``since`` written ``<=A/B``: the version per series by which the row is known
+        to exist (documented or seen in a program of that version)."""
+        since = self.since_first.lstrip("~")
+        if not since.startswith("<="):
+            return {}
+        bounds = {}
+        for part in since[2:].split("/"):
+            version = parse_version(part.removeprefix("<="))
+            bounds[_series(version)] = version
+        return bounds
+
+    def row_available_in(self, version: Version) -> bool | None:
+        """Whether controller software ``version`` has this signature row: True, False, or
+        None when the catalog cannot tell (an unconfirmed or open-ended first version)."""
+        since = self.since_first
+        if since == "?":
             return None
+        last = self.last
+        if last is not None and version > last:
+            return False
         firsts = self.first_versions()
         series = _series(version)
         if series not in firsts:
-            if self.since == "3.x" and "CB3 only" not in self.remarks:
-                return None
+            if since in ("1.x", "3.x") and last is None and "CB3 only" not in self.remarks:
+                return None  # a CB-era builtin whose fate on later series is not known
             return False
         first = firsts[series]
         if first is None:
-            if self.since.startswith("<=") and series == "e":
-                bound = parse_version(self.since[2:].split("/")[0])
+            bound = self._seen_by().get(series)
+            if bound is not None:  # documented by then; earlier versions cannot be told
                 return True if version >= bound else None
             return True
         if version >= first:
             return True
-        return None if self.since.startswith("~") else False
+        return None if since.startswith("~") else False
+
+    def available_in(self, version: str | Version) -> bool | None:
+        """Whether controller software ``version`` has this builtin under any of its
+        signature rows: True, False, or None when the catalog cannot tell."""
+        if isinstance(version, str):
+            version = parse_version(version)
+        answers = [row.row_available_in(version) for row in (self, *self.variants)]
+        if True in answers:
+            return True
+        return None if None in answers else False
 
 
 def _split_params(text: str) -> list[str]:
@@ -254,6 +351,9 @@ def _load() -> tuple[dict[str, Builtin], dict[str, Builtin]]:
         builtin = _row(fields)
         if builtin.is_method:
             method_rows[builtin.name.split(".", 1)[1]] = builtin
+        elif builtin.name in functions:  # another signature row of the same builtin
+            first = functions[builtin.name]
+            functions[builtin.name] = replace(first, variants=(*first.variants, builtin))
         else:
             functions[builtin.name] = builtin
     return functions, method_rows
