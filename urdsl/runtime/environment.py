@@ -35,6 +35,11 @@ class Environment:
     ``unsupported``: what a call of a builtin that urdsl does not simulate does:
     ``"default"`` returns a neutral value of its return type and records an event;
     ``"error"`` stops the program with URS209.
+    ``devices``: what reads from outside the controller give (inputs, input registers, socket
+    and XML-RPC replies, fieldbus and Modbus signals, operator answers): ``"quiet"`` the
+    values held here (inputs low, registers zero, sockets that never answer: a read with
+    timeout 0 waits for ever); ``"unknown"`` an unknown value that the checker follows as a
+    working device would answer (see :mod:`urdsl.runtime.unknown`; ``urdsl check`` uses it).
     ``connectable``: hosts (as strings, with or without ``:port``) a script's
     ``socket_open`` may "connect" to; ``None`` means every host (nothing is opened either way).
     """
@@ -58,5 +63,6 @@ class Environment:
     sockets: dict[str, SocketModel] = field(default_factory=dict)
     socket_replies: dict[str, list[str]] = field(default_factory=dict)
     unsupported: str = "default"
+    devices: str = "quiet"
     connectable: set[str] | None = None
     messages: list[tuple[float, str, str]] = field(default_factory=list)
