@@ -383,8 +383,7 @@ class Interpreter:
         where = f" in thread {self.current.name}" if self.current is not None and \
             self.current.name != "main" else ""
         raise _StopRun(Event(self.time, "deadline",
-                             f"the wall-clock bound was reached at robot time "
-                             f"{self.time:.3f} s{where}, here", span))
+                             f"stopped at robot time {self.time:.3f} s{where}", span))
 
     def warn_once(self, message: str, node: Any, unknown: Unknown | None = None) -> None:
         """A warning about what depends on a value unknown offline, once per statement."""

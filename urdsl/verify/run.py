@@ -199,8 +199,8 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
 def _stopped_finding(event, options: CheckOptions) -> Finding:
     """URS313 for a run that stopped early: it names the robot time and the statement."""
     if event.kind == "deadline":
-        message = (f"the check stopped after {options.timeout:g} s of wall-clock time: "
-                   f"{event.message}; what follows was not checked")
+        message = (f"the check reached its wall-clock bound of {options.timeout:g} s and "
+                   f"{event.message}, here; what follows was not checked")
         hint = "use --timeout to allow more time"
     else:
         message = f"{event.message}; the check stops here at robot time {event.time:.3f} s"
