@@ -20,6 +20,7 @@ from typing import Any
 
 from ..script.builtins import Builtin, lookup, methods
 from ..script.nodes import Node
+from .interpreter import LIST_LIMIT
 from .unknown import (
     DEVICE_READS,
     DEVICE_REPLY_TIME,
@@ -32,6 +33,7 @@ from .values import (
     PoseValue,
     StructValue,
     Unknown,
+    exceeds,
     format_value,
     is_number,
     type_name,
@@ -378,6 +380,9 @@ def _make_list(rt, node, length, initial_value, capacity=None):
     capacity = length if capacity is None else capacity
     if capacity < length:
         raise rt.error("index", "make_list: capacity is smaller than length", node)
+    if not is_number(capacity) or capacity > LIST_LIMIT:
+        raise rt.error("index", f"make_list: a capacity of more than {LIST_LIMIT:,} values",
+                       node)
     return ListValue([initial_value] * length, capacity)
 
 
@@ -426,7 +431,10 @@ def _integer_to_binary_list(rt, node, x):
 
 @implements("struct")
 def _struct(rt, node, __members__):
-    return StructValue(__members__)
+    value = StructValue(__members__)
+    if exceeds(value, LIST_LIMIT):
+        raise rt.error("index", f"a struct holding more than {LIST_LIMIT:,} values", node)
+    return value
 
 
 # ---- messages, time --------------------------------------------------------------------------

@@ -29,7 +29,7 @@ from typing import Any
 
 __all__ = [
     "PoseValue", "ListValue", "StructValue", "ThreadHandle", "copy_value", "type_name",
-    "format_value", "is_number", "Unknown", "has_unknown",
+    "format_value", "is_number", "Unknown", "has_unknown", "exceeds",
 ]
 
 
@@ -131,6 +131,25 @@ def has_unknown(value: Any) -> Unknown | None:
             if found is not None:
                 return found
     return None
+
+
+def exceeds(value: Any, limit: int) -> bool:
+    """Whether ``value`` holds more than ``limit`` values, counted through nested lists and
+    structs (stops counting once past the limit)."""
+    count = 0
+    stack = [value]
+    while stack:
+        item = stack.pop()
+        kind = type(item)
+        if kind is ListValue:
+            count += len(item)
+            stack.extend(v for v in item if type(v) is ListValue or type(v) is StructValue)
+        elif kind is StructValue:
+            count += len(item.members)
+            stack.extend(item.members.values())
+        if count > limit:
+            return True
+    return False
 
 
 def is_number(value: Any) -> bool:
