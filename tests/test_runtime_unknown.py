@@ -165,3 +165,11 @@ def test_quiet_socket_read_with_timeout_0_waits_for_ever():
 def test_list_values_keep_their_type():
     result = run("x = [1, 2]\n")
     assert result.globals["x"] == ListValue([1, 2])
+
+
+def test_and_or_with_an_unknown_on_either_side():
+    result = run("r = get_standard_digital_in(0)\n"
+                 "a = True and r\nb = r and False\nc = False or r\nd = r or True\n")
+    assert result.error is None, result.error
+    assert type(result.globals["a"]) is Unknown and result.globals["b"] is False
+    assert type(result.globals["c"]) is Unknown and result.globals["d"] is True

@@ -279,7 +279,8 @@ class Interpreter:
             self.event("thread", f"the program ended while thread {name} was still running")
 
     def _prune(self) -> None:
-        """Forget finished threads (the scheduler looks at live ones only)."""
+        """Forget finished threads (the scheduler looks at live ones only); called by the
+        scheduler alone, which may end the greenlets of threads killed while waiting."""
         live = []
         for thread in self._threads:
             if not thread.done:
@@ -427,8 +428,8 @@ class Interpreter:
         if self.steps > self.config.runaway_limit:
             self.count_step(node)
         if len(self._threads) - self._dead >= self.config.max_threads:
-            self._prune()
-            if len(self._threads) >= self.config.max_threads:
+            # (no pruning here: only the scheduler may end suspended greenlets)
+            if sum(1 for t in self._threads if not t.done) >= self.config.max_threads:
                 raise self.error(
                     "call", f"more than {self.config.max_threads} threads would run at once",
                     node, "join or kill threads that are done with their work")
@@ -959,7 +960,8 @@ class _Compiler:
                     return b if b is False else a
                 if not _bool_operand(a, rt, node):
                     return False
-                return _bool_operand(right(frame), rt, node)
+                b = right(frame)
+                return b if type(b) is Unknown else _bool_operand(b, rt, node)
             return conj
         if op == "or":
             def disj(frame):
@@ -969,7 +971,8 @@ class _Compiler:
                     return b if b is True else a
                 if _bool_operand(a, rt, node):
                     return True
-                return _bool_operand(right(frame), rt, node)
+                b = right(frame)
+                return b if type(b) is Unknown else _bool_operand(b, rt, node)
             return disj
         operation = binary(op)
         if op in ("==", "!="):
