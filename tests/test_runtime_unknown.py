@@ -72,7 +72,7 @@ def test_queued_socket_replies_stay_known():
 
 def test_register_read_wait_loop_warns_once_and_goes_on():
     result = run("n = 0\n"
-                 "while read_input_integer_register(0) != 1:\n"
+                 "while read_input_integer_register(0) < 1:\n"
                  "  n = n + 1\n"
                  "  sync()\n"
                  "end\n"
@@ -80,6 +80,35 @@ def test_register_read_wait_loop_warns_once_and_goes_on():
     assert result.error is None and result.globals["after"] == 1
     assert result.globals["n"] == UNKNOWN_LOOP_PASSES
     assert lines(result.warnings) == [2]
+
+
+def test_a_wait_for_the_expected_reply_ends_at_once():
+    result = run("n = 0\n"
+                 "while read_input_integer_register(0) != 1:\n"
+                 "  n = n + 1\n"
+                 "  sync()\n"
+                 "end\n")
+    assert result.error is None and result.globals["n"] == 0
+    assert "reply ends the loop" in result.warnings[0].message
+
+
+def test_a_reply_check_function_sees_the_expected_reply():
+    result = run("def is_ack(b):\n"
+                 "  if b[0] != 3:\n"
+                 "    return False\n"
+                 "  end\n"
+                 "  if b[1] != 97 or b[2] != 99:\n"
+                 "    return False\n"
+                 "  end\n"
+                 "  return True\n"
+                 "end\n"
+                 'socket_open("127.0.0.1", 1, "s")\n'
+                 "tries = 0\n"
+                 'while not is_ack(socket_read_byte_list(3, "s", 0)):\n'
+                 "  tries = tries + 1\n"
+                 "end\n")
+    assert result.error is None and result.globals["tries"] == 0
+    assert lines(result.warnings) == [2, 5]
 
 
 def test_one_warning_per_statement_not_per_pass():

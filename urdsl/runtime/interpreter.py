@@ -699,14 +699,17 @@ class _Compiler:
             for test, body, test_node, ending in branches:
                 value = test(frame)
                 if type(value) is Unknown:
-                    # follow a working device: into the branch, unless it is the error
-                    # branch (it ends the program)
+                    # follow a working device: not into an error branch (it ends the
+                    # program), not against the reply the program expects, else in
+                    take = not ending and value.lean is not False
                     rt.warn_once(
                         f"this condition depends on {value.source}, which is unknown "
                         "offline; the check follows a working device: "
                         + ("it skips this branch, which ends the program" if ending
-                           else "it takes this branch"), test_node)
-                    if ending:
+                           else "it takes this branch" if take
+                           else "it skips this branch (the reply is as expected)"),
+                        test_node)
+                    if not take:
                         continue
                     return body(frame)
                 if _truth(value, rt, test_node):
@@ -730,6 +733,12 @@ class _Compiler:
                 value = test(frame)
                 if type(value) is Unknown:
                     unknown_passes += 1
+                    if value.lean is False:  # the expected reply came at once
+                        rt.warn_once(
+                            f"this loop's condition depends on {value.source}, which is "
+                            "unknown offline; the check follows a working device, whose "
+                            "reply ends the loop", test_node)
+                        break
                     if unknown_passes == 1:
                         rt.warn_once(
                             f"this loop's condition depends on {value.source}, which is "
@@ -924,7 +933,7 @@ class _Compiler:
                 value = operand(frame)
                 if type(value) is not bool:
                     if type(value) is Unknown:
-                        return value
+                        return value.leaning(None if value.lean is None else not value.lean)
                     raise rt.error("type", f"'{node.op}' needs a bool, not a "
                                    f"{type_name(value)}", node)
                 return not value
@@ -939,7 +948,7 @@ class _Compiler:
             if kind is ListValue and all(is_number(v) for v in value):
                 return ListValue([sign * v for v in value])
             if has_unknown(value) is not None:
-                return has_unknown(value)
+                return has_unknown(value).leaning(None)
             raise rt.error("type", f"unary '{node.op}' needs a number, not a "
                            f"{type_name(value)}", node)
 
@@ -957,7 +966,12 @@ class _Compiler:
                 a = left(frame)
                 if type(a) is Unknown:  # unknown, unless the right side is false
                     b = right(frame)
-                    return b if b is False else a
+                    if b is False:
+                        return b
+                    if type(b) is Unknown:
+                        return a.leaning(False if False in (a.lean, b.lean) else
+                                         a.lean and b.lean)
+                    return a
                 if not _bool_operand(a, rt, node):
                     return False
                 b = right(frame)
@@ -968,7 +982,12 @@ class _Compiler:
                 a = left(frame)
                 if type(a) is Unknown:  # unknown, unless the right side is true
                     b = right(frame)
-                    return b if b is True else a
+                    if b is True:
+                        return b
+                    if type(b) is Unknown:
+                        return a.leaning(True if True in (a.lean, b.lean) else
+                                         None if None in (a.lean, b.lean) else False)
+                    return a
                 if _bool_operand(a, rt, node):
                     return True
                 b = right(frame)
@@ -976,12 +995,14 @@ class _Compiler:
             return disj
         operation = binary(op)
         if op in ("==", "!="):
+            lean = op == "=="  # a working device answers what the program expects
+
             def compare(frame):
                 a = left(frame)
                 b = right(frame)
                 found = has_unknown(a) or has_unknown(b)
                 if found is not None:
-                    return found
+                    return found.leaning(lean)
                 return operation(a, b)
             return compare
 
@@ -995,7 +1016,7 @@ class _Compiler:
             except (TypeError, ValueError) as error:
                 found = has_unknown(a) or has_unknown(b)
                 if found is not None:
-                    return found
+                    return found.leaning(None)
                 raise rt.error("type", f"'{op}' cannot combine a {type_name(a)} and a "
                                f"{type_name(b)}" + (f": {error}" if str(error) else ""),
                                node, _operator_hint(op, a, b)) from None

@@ -97,13 +97,22 @@ class Unknown:
     ``source`` says where it came from, for messages ("the reply of socket_read_byte_list()
     at line 12"); ``span`` is that read's place in the program. Operations on an unknown
     value give an unknown value (the first one's source is kept); immutable.
+
+    ``lean``: for a condition, the truth a working device would give, when there is one: a
+    reply compared with ``==`` to what the program expects is taken as equal (True), with
+    ``!=`` as not different (False); ``not`` flips it; None: no lean.
     """
 
-    __slots__ = ("source", "span")
+    __slots__ = ("source", "span", "lean")
 
-    def __init__(self, source: str, span: Any = None) -> None:
+    def __init__(self, source: str, span: Any = None, lean: bool | None = None) -> None:
         self.source = source
         self.span = span
+        self.lean = lean
+
+    def leaning(self, lean: bool | None) -> Unknown:
+        """The same unknown value with another lean."""
+        return self if lean is self.lean else Unknown(self.source, self.span, lean)
 
     def __repr__(self) -> str:
         return f"<unknown: {self.source}>"
