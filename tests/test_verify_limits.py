@@ -146,3 +146,10 @@ def test_a_move_to_an_unknown_pose_is_noted_once_and_not_checked():
     finding = only(report, "URS210")
     assert finding.span.line == 4 and "not checked" in finding.message
     assert not report.moves and "URS301" not in codes(report)
+
+
+def test_exponential_recursion_meets_the_wall_clock_bound():
+    report = check("def f(n):\n  if n > 0:\n    f(n - 1)\n    f(n - 1)\n  end\nend\nf(60)\n",
+                   timeout=0.5)
+    finding = only(report, "URS313")
+    assert "wall-clock bound of 0.5 s" in finding.message and finding.span.line in (3, 4)

@@ -192,6 +192,7 @@ class Interpreter:
         self.steps = 0
         self._steps_time = 0.0  # robot time (s) when the runaway counter was last reset
         self._waits = 0
+        self.calls = 0  # user function calls so far
         self.loop_node: n.Node | None = None  # the loop last entered (for "how far")
         self.unknown = getattr(self.env, "devices", "quiet") == "unknown"
         self.warnings: list[Event] = []
@@ -1122,9 +1123,9 @@ class _Compiler:
                 named[k] = v(frame)
             function = functions.get(name)
             if function is not None:
-                rt.steps += 1  # calls count like loop turns (recursion without loops)
-                if rt.steps > rt.config.runaway_limit:
-                    rt.count_step(node)
+                rt.calls += 1  # recursion without loops meets the wall-clock bound here
+                if not rt.calls & 1023:
+                    rt.check_deadline(node)
                 return self.call_user(function, values, named, node)
             if unknown:
                 found = first_unknown(values, named)
