@@ -136,9 +136,8 @@ def test_unknown_flows_through_expressions_without_errors():
                  "h = [r, r] + [1, 2]\n"
                  "k = False and r > 1\n")
     assert result.error is None, result.error
-    for name in "abcdfgh":
+    for name in "abcdefgh":
         assert type(result.globals[name]) is Unknown, name
-    assert result.globals["e"] == "r=?"
     assert result.globals["k"] is False  # decided without the unknown value
     assert "read_input_float_register() at line 1" in result.globals["a"].source
 
@@ -202,3 +201,8 @@ def test_and_or_with_an_unknown_on_either_side():
     assert result.error is None, result.error
     assert type(result.globals["a"]) is Unknown and result.globals["b"] is False
     assert type(result.globals["c"]) is Unknown and result.globals["d"] is True
+
+
+def test_textmsg_of_an_unknown_prints_a_question_mark():
+    result = run('textmsg("reply: ", read_input_integer_register(1))\n')
+    assert result.error is None and result.events[-1].message == "reply: ?"

@@ -24,7 +24,8 @@ names the read and its line), never with an error:
 * ``while`` on an unknown condition runs at most :data:`UNKNOWN_LOOP_PASSES` passes and then
   leaves the loop, as a wait loop does when the device answers;
 * a move or a builtin with an unknown argument is not checked (noted once); an unchecked move
-  takes :data:`UNCHECKED_MOVE_TIME` of robot time and leaves the arm where it was.
+  takes :data:`UNCHECKED_MOVE_TIME` of robot time (a servo or speed command one controller
+  frame) and leaves the arm where it was; string and maths builtins give an unknown result.
 
 Robot time of device replies (chosen, not measured; a real device may be faster or slower):
 :data:`DEVICE_REPLY_TIME` for a reply over a link (a socket read, also with timeout 0, which
@@ -131,7 +132,7 @@ def first_unknown(values: Any, named: dict | None = None) -> Unknown | None:
 
 _PASS_THROUGH = frozenset({
     "textmsg", "popup", "socket_send_string", "socket_send_line", "socket_send_byte",
-    "socket_send_int", "socket_set_var", "to_str", "str_cat",
+    "socket_send_int", "socket_set_var",
 })
 """Builtins that take an unknown argument as it is (they print or send it)."""
 
@@ -168,12 +169,18 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
                      "unknown offline; not checked", node)
         return None
     if _is_motion(name):
+        # a servo or speed command lasts a controller frame; a move is taken as
+        # UNCHECKED_MOVE_TIME
+        frame = name.startswith(("servo", "speed"))
+        took = f"{rt.config.step_time:g}" if frame else f"{UNCHECKED_MOVE_TIME:g}"
         rt.warn_once(f"this move depends on {found.source}, which is unknown offline; the "
-                     f"move is not checked (taken as {UNCHECKED_MOVE_TIME:g} s where the arm "
-                     "stays)", node)
+                     f"move is not checked (taken as {took} s where the arm stays)", node)
         if rt.robot is not None:
             rt.robot.stop_blending(rt.time)
-        rt.wait(UNCHECKED_MOVE_TIME)
+        if frame:
+            rt.sync()
+        else:
+            rt.wait(UNCHECKED_MOVE_TIME)
         return None
     if name == "sleep":
         rt.warn_once(f"this wait depends on {found.source}, which is unknown offline; taken "
