@@ -3,6 +3,9 @@ warns once per statement, and never turns a device's reply into an error."""
 
 from __future__ import annotations
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 from urdsl import parse
 from urdsl.runtime import Environment, Interpreter, RuntimeConfig
 from urdsl.runtime.unknown import DEVICE_REPLY_TIME, OPERATOR_REPLY_TIME, UNKNOWN_LOOP_PASSES
@@ -206,3 +209,27 @@ def test_and_or_with_an_unknown_on_either_side():
 def test_textmsg_of_an_unknown_prints_a_question_mark():
     result = run('textmsg("reply: ", read_input_integer_register(1))\n')
     assert result.error is None and result.events[-1].message == "reply: ?"
+
+
+_KNOWN = {
+    "int": "3", "float": "2.5", "bool": "True", "string": '"ok"', "list": "[1, 2, 3]",
+    "matrix": "[[1, 2], [3, 4]]", "pose": "p[0.1, 0, 0.2, 0, 3.14, 0]",
+}
+
+
+@settings(max_examples=60, deadline=None)
+@given(op=st.sampled_from(["+", "-", "*", "/", "%", "<", ">", "<=", ">=", "==", "!=", "and",
+                           "or", "xor"]),
+       known=st.sampled_from(sorted(_KNOWN)), unknown_left=st.booleans())
+def test_an_operation_with_an_unknown_operand_never_fails(op, known, unknown_left):
+    """Law: an operator on an unknown value gives an unknown value, or (and/or) the value
+    it is decided by; it fails only when the known operand is wrong on its own (a boolean
+    operator on something that is not a bool)."""
+    left, right = ("r", _KNOWN[known]) if unknown_left else (_KNOWN[known], "r")
+    result = run(f"r = read_input_integer_register(0)\nx = {left} {op} {right}\n")
+    if op in ("and", "or", "xor") and known != "bool":
+        assert result.error is not None and result.error.diagnostic.code == "URS203"
+        return
+    assert result.error is None, result.error
+    x = result.globals["x"]
+    assert type(x) is Unknown or (op in ("and", "or") and type(x) is bool)

@@ -969,7 +969,9 @@ class _Compiler:
                     b = right(frame)
                     if b is False:
                         return b
-                    if type(b) is Unknown:
+                    if type(b) is not Unknown:
+                        _bool_operand(b, rt, node)  # a known operand must be a bool
+                    else:
                         return a.leaning(False if False in (a.lean, b.lean) else
                                          a.lean and b.lean)
                     return a
@@ -985,7 +987,9 @@ class _Compiler:
                     b = right(frame)
                     if b is True:
                         return b
-                    if type(b) is Unknown:
+                    if type(b) is not Unknown:
+                        _bool_operand(b, rt, node)  # a known operand must be a bool
+                    else:
                         return a.leaning(True if True in (a.lean, b.lean) else
                                          None if None in (a.lean, b.lean) else False)
                     return a
@@ -1016,7 +1020,8 @@ class _Compiler:
                 raise rt.error("arithmetic", "division by zero", node) from None
             except (TypeError, ValueError) as error:
                 found = has_unknown(a) or has_unknown(b)
-                if found is not None:
+                if found is not None and not (op == "xor" and type(a if found is b else b)
+                                              is not bool):
                     return found.leaning(None)
                 raise rt.error("type", f"'{op}' cannot combine a {type_name(a)} and a "
                                f"{type_name(b)}" + (f": {error}" if str(error) else ""),
