@@ -153,3 +153,11 @@ def test_exponential_recursion_meets_the_wall_clock_bound():
                    timeout=0.5)
     finding = only(report, "URS313")
     assert "wall-clock bound of 0.5 s" in finding.message and finding.span.line in (3, 4)
+
+
+def test_a_message_at_every_pass_does_not_fill_memory():
+    from urdsl.runtime.interpreter import EVENT_LIMIT
+
+    report = check('while True:\n  textmsg("tick")\n  sync()\nend\n', max_time=30)
+    assert len(report.events) == EVENT_LIMIT  # 15,000 passes; the rest are counted
+    assert len(report.trace.times) <= 1  # the arm never moved: nothing to sample

@@ -443,14 +443,14 @@ def _struct(rt, node, __members__):
 @implements("textmsg")
 def _textmsg(rt, node, s1, s2=""):
     text = format_value(s1) + format_value(s2)
-    rt.env.messages.append((rt.time, "textmsg", text))
+    rt.message("textmsg", text)
     rt.event("textmsg", text, node.span)
 
 
 @implements("popup")
 def _popup(rt, node, s, title="Popup", warning=False, error=False, blocking=False):
     text = format_value(s)
-    rt.env.messages.append((rt.time, "popup", text))
+    rt.message("popup", text)
     rt.event("popup", f"{title}: {text}", node.span)
     if blocking is True and rt.unknown:  # the program waits for the operator
         rt.wait(OPERATOR_REPLY_TIME)

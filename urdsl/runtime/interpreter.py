@@ -43,12 +43,17 @@ from .values import (
 )
 
 __all__ = ["Interpreter", "RuntimeConfig", "RunResult", "Event", "MAX_THREADS",
-           "LIST_LIMIT"]
+           "LIST_LIMIT", "EVENT_LIMIT"]
 
 MAX_THREADS = 128
 """Threads that may run at once; starting one more stops the program (URS208). The
 controller documents no limit [U]: a program that starts a thread per command and never
 ends them is what this stops."""
+
+EVENT_LIMIT = 10_000
+"""Events (and environment messages) an unpaced run keeps; later ones are counted, not kept
+(``RunResult.events_dropped``): a cell program's ``textmsg`` at every pass would otherwise
+fill the checker's memory. A paced run (the virtual controller) keeps all."""
 
 LIST_LIMIT = 1_000_000
 """Values (list items, matrix cells, struct members, counted through nesting) one value may
@@ -110,6 +115,8 @@ class RunResult:
     warnings: list[Event] = field(default_factory=list)
     """What depends on a value from outside that is unknown offline (kind ``"unknown"``),
     once per statement."""
+    events_dropped: int = 0
+    """Events not kept beyond :data:`EVENT_LIMIT`."""
     stopped_early: Event | None = None
     """Why the run stopped before the program's end without an error: ``"blocked"`` (the
     program waits forever, e.g. a read with timeout 0 that nothing answers) or
@@ -197,6 +204,7 @@ class Interpreter:
         self.unknown = getattr(self.env, "devices", "quiet") == "unknown"
         self.warnings: list[Event] = []
         self._dead = 0
+        self.events_dropped = 0
         self.depth = 0
         self.current: Thread | None = None
         self.critical: Thread | None = None
@@ -236,6 +244,7 @@ class Interpreter:
         result.events = self.events
         result.globals = self.globals
         result.warnings = self.warnings
+        result.events_dropped = self.events_dropped
         return result
 
     def _schedule(self, main: Thread, result: RunResult) -> None:
@@ -407,7 +416,17 @@ class Interpreter:
         self.wait_until(frames * step)
 
     def event(self, kind: str, message: str, span: Span = NO_SPAN) -> None:
+        if len(self.events) >= EVENT_LIMIT and self.config.pace is None:
+            self.events_dropped += 1
+            return
         self.events.append(Event(self.time, kind, message, span))
+
+    def message(self, kind: str, text: str) -> None:
+        """A message for the environment (``textmsg``, ``popup``), kept up to
+        :data:`EVENT_LIMIT` in an unpaced run."""
+        messages = self.env.messages
+        if len(messages) < EVENT_LIMIT or self.config.pace is not None:
+            messages.append((self.time, kind, text))
 
     def event_once(self, kind: str, message: str, span: Span = NO_SPAN) -> None:
         """An event recorded only the first time this statement causes it (a builtin that is

@@ -184,7 +184,10 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
             "was stopped there (a cell program that loops forever?)", module.span,
             options.max_time, "use --max-time to check longer"))
 
-    trace = sample(planner, options.sample_time or step, until=options.max_time)
+    # sampled while the arm moves (after the last move it rests: nothing to check), and
+    # never past --max-time
+    last = max((s.end for s in planner.segments), default=0.0)
+    trace = sample(planner, options.sample_time or step, until=min(last, options.max_time))
     report.trace = trace
     report.cycle_time = float(min(max(result.time, trace.duration), options.max_time))
     report.moves = [Move(s.kind, s.span, s.start, s.duration, s.params.get("lead"))
