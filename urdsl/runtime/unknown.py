@@ -35,6 +35,7 @@ operator's answer to a prompt or a blocking popup.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 from ..script import nodes as n
@@ -85,9 +86,21 @@ def describe(name: str, node: Any) -> str:
     return f"{name}() at line {line}" if line else f"{name}()"
 
 
+_READS: dict[tuple[str, int], tuple[Any, Unknown]] = {}
+
+
 def unknown_from(name: str, node: Any) -> Unknown:
-    """The unknown result of the read ``name`` at ``node``."""
-    return Unknown(describe(name, node), getattr(node, "span", None))
+    """The unknown result of the read ``name`` at ``node`` (one object per read site: it is
+    immutable, and a loop reads the same site at every pass)."""
+    key = (name, id(node))
+    cached = _READS.get(key)
+    if cached is not None and cached[0] is node:
+        return cached[1]
+    value = Unknown(describe(name, node), getattr(node, "span", None))
+    if len(_READS) > 4096:
+        _READS.clear()
+    _READS[key] = (node, value)
+    return value
 
 
 def ends_program(body: Any) -> bool:
@@ -154,21 +167,17 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
     """Call the builtin ``name`` whose arguments hold the unknown value ``found``: a move is
     not planned (noted once, it takes :data:`UNCHECKED_MOVE_TIME`), a procedure is skipped
     (noted once), a function gives an unknown result."""
-    from ..script.builtins import lookup
-
-    row = lookup(name)
-    if row is None or row.argument_problem(len(values), tuple(named)) is not None:
-        return call(values, named, node)  # reports the unknown name or the bad call
-    if name in _PASS_THROUGH:
+    kind = _kind(name, len(values), tuple(named))
+    if kind == "call":
         return call(values, named, node)
-    if name in _STORES:
+    if kind == "store":
         where = values[0] if values else next(iter(named.values()), None)
         if type(where) is not Unknown:
             return call(values, named, node)
         rt.warn_once(f"which output {name}() writes depends on {found.source}, which is "
                      "unknown offline; not checked", node)
         return None
-    if _is_motion(name):
+    if kind == "motion":
         # a servo or speed command lasts a controller frame; a move is taken as
         # UNCHECKED_MOVE_TIME
         frame = name.startswith(("servo", "speed"))
@@ -182,13 +191,36 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
         else:
             rt.wait(UNCHECKED_MOVE_TIME)
         return None
-    if name == "sleep":
+    if kind == "sleep":
         rt.warn_once(f"this wait depends on {found.source}, which is unknown offline; taken "
                      "as one controller frame", node)
         rt.sync()
         return None
-    if (not row.returns or row.returns[0] == "None"):
+    if kind == "procedure":
         rt.warn_once(f"{name}() depends on {found.source}, which is unknown offline; not "
                      "checked", node)
         return None
     return found
+
+
+@functools.lru_cache(maxsize=1024)
+def _kind(name: str, positional: int, keywords: tuple[str, ...]) -> str:
+    """How :func:`unknown_call` treats a call shape: ``call`` (as usual: it takes unknown
+    values, or the call is wrong and reports it), ``store``, ``motion``, ``sleep``,
+    ``procedure`` (skipped) or ``function`` (an unknown result)."""
+    from ..script.builtins import lookup
+
+    row = lookup(name)
+    if row is None or row.argument_problem(positional, keywords) is not None:
+        return "call"  # reports the unknown name or the bad call
+    if name in _PASS_THROUGH:
+        return "call"
+    if name in _STORES:
+        return "store"
+    if _is_motion(name):
+        return "motion"
+    if name == "sleep":
+        return "sleep"
+    if not row.returns or row.returns[0] == "None":
+        return "procedure"
+    return "function"
