@@ -233,3 +233,11 @@ def test_an_operation_with_an_unknown_operand_never_fails(op, known, unknown_lef
     assert result.error is None, result.error
     x = result.globals["x"]
     assert type(x) is Unknown or (op in ("and", "or") and type(x) is bool)
+
+
+def test_boolean_registers_go_up_to_127():
+    result = run("write_output_boolean_register(100, True)\n"
+                 "a = read_output_boolean_register(100)\n"
+                 "b = read_input_boolean_register(127)\n")
+    assert result.error is None and result.globals["a"] is True
+    assert type(result.globals["b"]) is Unknown

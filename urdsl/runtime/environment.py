@@ -30,7 +30,8 @@ class SocketModel:
 
 @dataclass
 class Environment:
-    """I/O and register state, in the controller's numbering (counts as on e-Series).
+    """I/O and register state, in the controller's numbering (counts as on e-Series; boolean
+    registers 0-127, 64-127 since 3.9/5.3).
 
     ``unsupported``: what a call of a builtin that urdsl does not simulate does:
     ``"default"`` returns a neutral value of its return type and records an event;
@@ -57,8 +58,8 @@ class Environment:
     output_int_registers: list[int] = field(default_factory=lambda: [0] * 48)
     input_float_registers: list[float] = field(default_factory=lambda: [0.0] * 48)
     output_float_registers: list[float] = field(default_factory=lambda: [0.0] * 48)
-    input_bool_registers: list[bool] = field(default_factory=lambda: [False] * 64)
-    output_bool_registers: list[bool] = field(default_factory=lambda: [False] * 64)
+    input_bool_registers: list[bool] = field(default_factory=lambda: [False] * 128)
+    output_bool_registers: list[bool] = field(default_factory=lambda: [False] * 128)
     flags: list[bool] = field(default_factory=lambda: [False] * 32)
     sockets: dict[str, SocketModel] = field(default_factory=dict)
     socket_replies: dict[str, list[str]] = field(default_factory=dict)
