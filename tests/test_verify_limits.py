@@ -159,5 +159,6 @@ def test_a_message_at_every_pass_does_not_fill_memory():
     from urdsl.runtime.interpreter import EVENT_LIMIT
 
     report = check('while True:\n  textmsg("tick")\n  sync()\nend\n', max_time=30)
-    assert len(report.events) == EVENT_LIMIT  # 15,000 passes; the rest are counted
+    assert len(report.events) == EVENT_LIMIT + 1  # 15,000 passes; the rest are counted
+    assert report.events[-1].message.startswith("5,0")
     assert len(report.trace.times) <= 1  # the arm never moved: nothing to sample

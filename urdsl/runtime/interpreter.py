@@ -245,6 +245,9 @@ class Interpreter:
         result.globals = self.globals
         result.warnings = self.warnings
         result.events_dropped = self.events_dropped
+        if self.events_dropped:
+            self.events.append(Event(self.time, "dropped", f"{self.events_dropped:,} more "
+                                     f"events after the first {EVENT_LIMIT:,} were not kept"))
         return result
 
     def _schedule(self, main: Thread, result: RunResult) -> None:
