@@ -423,10 +423,13 @@ def joints_at(planner, times: np.ndarray) -> np.ndarray:
     return result
 
 
-def sample(planner, dt: float | None = None) -> Trace:
-    """Sample the planned trajectory every ``dt`` s (default: the controller step)."""
+def sample(planner, dt: float | None = None, until: float | None = None) -> Trace:
+    """Sample the planned trajectory every ``dt`` s (default: the controller step), up to
+    robot time ``until`` (s; default: the end of the last move)."""
     dt = dt or planner.step_time
     end = max(planner.end_time, max((s.end for s in planner.segments), default=0.0))
+    if until is not None:
+        end = min(end, until)
     count = int(np.floor(end / dt + 1e-9)) + 1
     times = np.arange(count) * dt
     pool = shared_pool()

@@ -21,10 +21,20 @@ from typing import Any
 from ..script.binder import Problem
 from ..script.builtins import Builtin, lookup, methods
 from ..script.nodes import Node
+from .interpreter import LIST_LIMIT
+from .unknown import (
+    DEVICE_READS,
+    DEVICE_REPLY_TIME,
+    OPERATOR_PROMPTS,
+    OPERATOR_REPLY_TIME,
+    unknown_from,
+)
 from .values import (
     ListValue,
     PoseValue,
     StructValue,
+    Unknown,
+    exceeds,
     format_value,
     is_number,
     type_name,
@@ -128,6 +138,10 @@ class BuiltinTable:
 
     def unsupported(self, row: Builtin, node: Node) -> Any:
         rt = self.rt
+        if rt.unknown and (row.name in DEVICE_READS or row.name in OPERATOR_PROMPTS):
+            if row.name in OPERATOR_PROMPTS:
+                rt.wait(OPERATOR_REPLY_TIME)
+            return unknown_from(row.name, node)
         if rt.env.unsupported == "error":
             raise rt.error("unsupported", f"{row.name}() is not simulated by urdsl", node)
         rt.event_once("unsupported", f"{row.name}() is not simulated; it did nothing here",
@@ -152,9 +166,15 @@ class BuiltinTable:
             bound = self.bind(row, args, named, node)
             return _list_method(rt, node, receiver, method, bound)
         if type(receiver) is _RemoteHandle:
+            if rt.unknown:  # a blocking call: the server's reply is unknown offline
+                rt.wait(DEVICE_REPLY_TIME)
+                return Unknown(f"the {receiver.kind} reply of {method}() at line "
+                               f"{node.span.line}", node.span)
             rt.event("rpc", f"{receiver.kind} call {method}() is not simulated; it did "
                      "nothing here", node.span)
             return None
+        if type(receiver) is Unknown:
+            return receiver
         raise rt.error("type", f"a {type_name(receiver)} has no method '{method}'", node)
 
 
@@ -376,6 +396,9 @@ def _make_list(rt, node, length, initial_value, capacity=None):
     capacity = length if capacity is None else capacity
     if capacity < length:
         raise rt.error("index", "make_list: capacity is smaller than length", node)
+    if not is_number(capacity) or capacity > LIST_LIMIT:
+        raise rt.error("index", f"make_list: a capacity of more than {LIST_LIMIT:,} values",
+                       node)
     return ListValue([initial_value] * length, capacity)
 
 
@@ -424,7 +447,10 @@ def _integer_to_binary_list(rt, node, x):
 
 @implements("struct")
 def _struct(rt, node, __members__):
-    return StructValue(__members__)
+    value = StructValue(__members__)
+    if exceeds(value, LIST_LIMIT):
+        raise rt.error("index", f"a struct holding more than {LIST_LIMIT:,} values", node)
+    return value
 
 
 # ---- messages, time --------------------------------------------------------------------------
@@ -433,15 +459,17 @@ def _struct(rt, node, __members__):
 @implements("textmsg")
 def _textmsg(rt, node, s1, s2=""):
     text = format_value(s1) + format_value(s2)
-    rt.env.messages.append((rt.time, "textmsg", text))
+    rt.message("textmsg", text)
     rt.event("textmsg", text, node.span)
 
 
 @implements("popup")
 def _popup(rt, node, s, title="Popup", warning=False, error=False, blocking=False):
     text = format_value(s)
-    rt.env.messages.append((rt.time, "popup", text))
+    rt.message("popup", text)
     rt.event("popup", f"{title}: {text}", node.span)
+    if blocking is True and rt.unknown:  # the program waits for the operator
+        rt.wait(OPERATOR_REPLY_TIME)
 
 
 @implements("sleep")
@@ -476,16 +504,21 @@ def _io_index(rt, node, n, size: int, what: str) -> int:
 def _setter(attribute: str, what: str, convert=bool):
     def apply(rt, node, n, b):
         bank = getattr(rt.env, attribute)
-        bank[_io_index(rt, node, n, len(bank), what)] = convert(b)
+        bank[_io_index(rt, node, n, len(bank), what)] = b if type(b) is Unknown else convert(b)
 
     return apply
 
 
-def _getter(attribute: str, what: str):
+def _getter(attribute: str, what: str, name: str | None = None):
+    """A read of an I/O bank; ``name`` is given for inputs, which come from outside (unknown
+    when the environment's devices are)."""
     def apply(rt, node, n=None, address=None):
         bank = getattr(rt.env, attribute)
         index = n if address is None else address
-        return bank[_io_index(rt, node, index, len(bank), what)]
+        value = bank[_io_index(rt, node, index, len(bank), what)]
+        if name is not None and rt.unknown:
+            return unknown_from(name, node)
+        return value
 
     return apply
 
@@ -517,13 +550,14 @@ for _names, _attribute, _what in [
     (("read_output_boolean_register",), "output_bool_registers", "register"),
 ]:
     for _n in _names:
-        IMPLEMENTATIONS[_n] = _getter(_attribute, _what)
+        IMPLEMENTATIONS[_n] = _getter(_attribute, _what, _n if _n in DEVICE_READS else None)
 
 
 def _register_writer(attribute: str, convert):
     def apply(rt, node, address, value):
         bank = getattr(rt.env, attribute)
-        bank[_io_index(rt, node, address, len(bank), "register")] = convert(value)
+        bank[_io_index(rt, node, address, len(bank), "register")] = \
+            value if type(value) is Unknown else convert(value)
 
     return apply
 
@@ -537,7 +571,8 @@ IMPLEMENTATIONS["write_output_boolean_register"] = _register_writer("output_bool
 
 @implements("set_standard_analog_out", "set_analog_out")
 def _set_analog_out(rt, node, n, f):
-    rt.env.standard_analog_out[_io_index(rt, node, n, 2, "analog output")] = float(f)
+    rt.env.standard_analog_out[_io_index(rt, node, n, 2, "analog output")] = \
+        f if type(f) is Unknown else float(f)
 
 
 # ---- sockets (modelled; nothing leaves the machine) -----------------------------------------
@@ -579,12 +614,32 @@ def _socket_send(rt, node, **kw):
     return True
 
 
+def _no_reply(rt, node, name: str, socket_name: Any, timeout: Any, model: Any) -> Any:
+    """A socket read that nothing has answered (yet): the environment's queued replies are
+    used up. With unknown devices, an open socket's device answers after
+    DEVICE_REPLY_TIME (or the timeout, if shorter) with an unknown reply. Otherwise the read
+    waits out its timeout and gives None; timeout 0 means "wait for ever"."""
+    seconds = _number(rt, node, timeout, "timeout")
+    if rt.unknown and model is not None:
+        rt.wait(DEVICE_REPLY_TIME if seconds <= 0 else min(seconds, DEVICE_REPLY_TIME))
+        return unknown_from(name, node)
+    if seconds <= 0:
+        why = (f"socket '{socket_name}' is not open" if model is None
+               else f"nothing answers on socket '{socket_name}'")
+        rt.wait_forever(f"{name}() with timeout 0 waits for ever ({why}): on the robot the "
+                        "program stops here until data arrives", node)
+    else:
+        rt.wait(float(seconds))
+    return None
+
+
 @implements("socket_read_string", "socket_read_line")
 def _socket_read_string(rt, node, socket_name="socket_0", timeout=2, **_):
     model = _socket(rt, node, socket_name)
     if model is None or not model.incoming:
-        rt.wait(float(timeout))
-        return ""
+        reply = _no_reply(rt, node, node_name(node, "socket_read_string"), socket_name,
+                          timeout, model)
+        return "" if reply is None else reply
     return str(model.incoming.popleft())
 
 
@@ -592,14 +647,24 @@ def _socket_read_string(rt, node, socket_name="socket_0", timeout=2, **_):
 def _socket_read_numbers(rt, node, number, socket_name="socket_0", timeout=2, **_):
     model = _socket(rt, node, socket_name)
     if model is None or not model.incoming:
-        rt.wait(float(timeout))
-        return ListValue([0])  # the controller's "nothing read" answer: [0]
+        reply = _no_reply(rt, node, node_name(node, "socket_read_byte_list"), socket_name,
+                          timeout, model)
+        return ListValue([0]) if reply is None else reply  # [0]: "nothing read"
     values = model.incoming.popleft()
     return ListValue([len(values), *values])
 
 
+def node_name(node: Node, default: str) -> str:
+    """The name of the builtin a call node calls (for messages)."""
+    func = getattr(node, "func", None)
+    return getattr(func, "id", default)
+
+
 @implements("socket_get_var")
 def _socket_get_var(rt, node, name, socket_name="socket_0"):
+    if rt.unknown and _socket(rt, node, socket_name) is not None:
+        rt.wait(DEVICE_REPLY_TIME)  # the device answers the GET
+        return unknown_from("socket_get_var", node)
     return 0
 
 

@@ -30,11 +30,17 @@ class SocketModel:
 
 @dataclass
 class Environment:
-    """I/O and register state, in the controller's numbering (counts as on e-Series).
+    """I/O and register state, in the controller's numbering (counts as on e-Series; boolean
+    registers 0-127, 64-127 since 3.9/5.3).
 
     ``unsupported``: what a call of a builtin that urdsl does not simulate does:
     ``"default"`` returns a neutral value of its return type and records an event;
     ``"error"`` stops the program with URS209.
+    ``devices``: what reads from outside the controller give (inputs, input registers, socket
+    and XML-RPC replies, fieldbus and Modbus signals, operator answers): ``"quiet"`` the
+    values held here (inputs low, registers zero, sockets that never answer: a read with
+    timeout 0 waits for ever); ``"unknown"`` an unknown value that the checker follows as a
+    working device would answer (see :mod:`urdsl.runtime.unknown`; ``urdsl check`` uses it).
     ``connectable``: hosts (as strings, with or without ``:port``) a script's
     ``socket_open`` may "connect" to; ``None`` means every host (nothing is opened either way).
     """
@@ -52,11 +58,12 @@ class Environment:
     output_int_registers: list[int] = field(default_factory=lambda: [0] * 48)
     input_float_registers: list[float] = field(default_factory=lambda: [0.0] * 48)
     output_float_registers: list[float] = field(default_factory=lambda: [0.0] * 48)
-    input_bool_registers: list[bool] = field(default_factory=lambda: [False] * 64)
-    output_bool_registers: list[bool] = field(default_factory=lambda: [False] * 64)
+    input_bool_registers: list[bool] = field(default_factory=lambda: [False] * 128)
+    output_bool_registers: list[bool] = field(default_factory=lambda: [False] * 128)
     flags: list[bool] = field(default_factory=lambda: [False] * 32)
     sockets: dict[str, SocketModel] = field(default_factory=dict)
     socket_replies: dict[str, list[str]] = field(default_factory=dict)
     unsupported: str = "default"
+    devices: str = "quiet"
     connectable: set[str] | None = None
     messages: list[tuple[float, str, str]] = field(default_factory=list)

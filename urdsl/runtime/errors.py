@@ -15,6 +15,10 @@ URS207    a thread ran without using physical time (no sync/sleep/move): the
 URS208    something that is not a function was called, or a thread misused
 URS209    a builtin that urdsl does not simulate was called
 ========  ====================================================================
+
+Not errors: ``urdsl check`` reports what depends on a value unknown offline (a device's
+reply, an input; :mod:`urdsl.runtime.unknown`) as the warning URS210, and a run that stops
+early without an error (it waits for ever, or the wall-clock bound) as URS313.
 """
 
 from __future__ import annotations

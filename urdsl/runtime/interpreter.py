@@ -19,6 +19,7 @@ script does to the outside world goes through the :class:`~urdsl.runtime.environ
 from __future__ import annotations
 
 import math
+import time as _clock
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -29,17 +30,35 @@ from ..script import nodes as n
 from ..script.binder import Binding, Signature
 from ..script.nodes import NO_SPAN, Span
 from .errors import ScriptRuntimeError
+from .unknown import UNKNOWN_LOOP_PASSES, ends_program, first_unknown, unknown_call
 from .values import (
     ListValue,
     PoseValue,
     StructValue,
     ThreadHandle,
+    Unknown,
     copy_value,
+    has_unknown,
     is_number,
     type_name,
 )
 
-__all__ = ["Interpreter", "RuntimeConfig", "RunResult", "Event"]
+__all__ = ["Interpreter", "RuntimeConfig", "RunResult", "Event", "MAX_THREADS",
+           "LIST_LIMIT", "EVENT_LIMIT"]
+
+MAX_THREADS = 128
+"""Threads that may run at once; starting one more stops the program (URS208). The
+controller documents no limit [U]: a program that starts a thread per command and never
+ends them is what this stops."""
+
+EVENT_LIMIT = 10_000
+"""Events (and environment messages) an unpaced run keeps; later ones are counted, not kept
+(``RunResult.events_dropped``): a cell program's ``textmsg`` at every pass would otherwise
+fill the checker's memory. A paced run (the virtual controller) keeps all."""
+
+LIST_LIMIT = 1_000_000
+"""Values (list items, matrix cells, struct members, counted through nesting) one value may
+hold. The controller documents no maximum [U]; this bounds the checker's memory."""
 
 BREAK, CONTINUE, RETURN = 1, 2, 3
 
@@ -54,12 +73,17 @@ class RuntimeConfig:
     ``max_time``: robot time in s after which a program that runs on (a ``while True`` cell
     program) is stopped; the result says so.
     ``max_call_depth``: nested user function calls before the program is stopped.
+    ``deadline``: a ``time.monotonic()`` value (s of wall-clock time) after which the run
+    stops and says how far it got (``RunResult.stopped_early``); ``None``: no bound.
+    ``max_threads``: threads that may run at once (:data:`MAX_THREADS`).
     """
 
     step_time: float = 0.002
     runaway_limit: int = 50_000
     max_time: float = 3600.0
     max_call_depth: int = 200
+    deadline: float | None = None
+    max_threads: int = MAX_THREADS
     pace: Callable[[float], None] | None = None
     """Called with the robot time (s) the program is about to advance to, before it does:
     the virtual controller sleeps there to run in real time. ``None`` (the verifier): robot
@@ -89,6 +113,23 @@ class RunResult:
     stopped: bool = False
     threads_left_running: list[str] = field(default_factory=list)
     globals: dict[str, Any] = field(default_factory=dict)
+    warnings: list[Event] = field(default_factory=list)
+    """What depends on a value from outside that is unknown offline (kind ``"unknown"``),
+    once per statement."""
+    events_dropped: int = 0
+    """Events not kept beyond :data:`EVENT_LIMIT`."""
+    stopped_early: Event | None = None
+    """Why the run stopped before the program's end without an error: ``"blocked"`` (the
+    program waits forever, e.g. a read with timeout 0 that nothing answers) or
+    ``"deadline"`` (the wall-clock bound); its time and span say how far it got."""
+
+
+class _StopRun(Exception):
+    """Ends a run early without a program error (see :attr:`RunResult.stopped_early`)."""
+
+    def __init__(self, event: Event) -> None:
+        super().__init__(event.message)
+        self.event = event
 
 
 class Frame:
@@ -108,7 +149,7 @@ class Thread:
     """A running URScript thread (the main program is one too)."""
 
     __slots__ = ("name", "glet", "wake", "order", "done", "parent", "children", "joiners",
-                 "span", "handle")
+                 "span", "handle", "blocked")
 
     def __init__(self, name: str, parent: Thread | None, span: Span) -> None:
         self.name = name
@@ -121,6 +162,7 @@ class Thread:
         self.joiners: list[Thread] = []
         self.span = span
         self.handle = ThreadHandle(self)
+        self.blocked: Event | None = None  # why it waits forever, when it does
 
 
 class _Function:
@@ -158,6 +200,14 @@ class Interpreter:
         self.events: list[Event] = []
         self.time = 0.0
         self.steps = 0
+        self._steps_time = 0.0  # robot time (s) when the runaway counter was last reset
+        self._waits = 0
+        self.calls = 0  # user function calls so far
+        self.loop_node: n.Node | None = None  # the loop last entered (for "how far")
+        self.unknown = getattr(self.env, "devices", "quiet") == "unknown"
+        self.warnings: list[Event] = []
+        self._dead = 0
+        self.events_dropped = 0
         self.depth = 0
         self.current: Thread | None = None
         self.critical: Thread | None = None
@@ -184,6 +234,8 @@ class Interpreter:
             if error.time is None:
                 error.time = self.time
             result.error = error
+        except _StopRun as stop:
+            result.stopped_early = stop.event
         finally:
             for thread in self._threads:
                 if thread.glet is not None and not thread.glet.dead:
@@ -194,11 +246,22 @@ class Interpreter:
         result.time = self.time
         result.events = self.events
         result.globals = self.globals
+        result.warnings = self.warnings
+        result.events_dropped = self.events_dropped
+        if self.events_dropped:
+            self.events.append(Event(self.time, "dropped", f"{self.events_dropped:,} more "
+                                     f"events after the first {EVENT_LIMIT:,} were not kept"))
         return result
 
     def _schedule(self, main: Thread, result: RunResult) -> None:
         threads = self._threads
+        turns = 0
         while not main.done and not self.halted:
+            turns += 1
+            if not turns & 255:
+                self.check_deadline(None)
+            if self._dead > 16 and self._dead * 2 > len(threads):
+                self._prune()
             if self.critical is not None and not self.critical.done:
                 thread = self.critical
             elif len(threads) == 1:  # the main thread alone (most programs)
@@ -207,6 +270,8 @@ class Interpreter:
                 thread = min((t for t in threads if not t.done),
                              key=lambda t: (t.wake, t.order))
             if thread.wake == math.inf:
+                if thread.blocked is not None:
+                    raise _StopRun(thread.blocked)
                 raise ScriptRuntimeError(
                     "call", "every thread waits for another one: the program can never go on",
                     thread.span)
@@ -221,7 +286,6 @@ class Interpreter:
                 break
             self.time = max(self.time, thread.wake)
             self.current = thread
-            self.steps = 0
             thread.glet.switch()
         left = [t.name for t in threads if not t.done and t is not main]
         for thread in threads:
@@ -229,6 +293,18 @@ class Interpreter:
         result.threads_left_running = left
         for name in left:
             self.event("thread", f"the program ended while thread {name} was still running")
+
+    def _prune(self) -> None:
+        """Forget finished threads (the scheduler looks at live ones only); called by the
+        scheduler alone, which may end the greenlets of threads killed while waiting."""
+        live = []
+        for thread in self._threads:
+            if not thread.done:
+                live.append(thread)
+            elif thread.glet is not None and not thread.glet.dead:
+                thread.glet.throw(greenlet.GreenletExit)  # killed while it waited
+        self._threads[:] = live
+        self._dead = 0
 
     def _spawn(self, name: str, body: Callable, parent: Thread | None, span: Span) -> Thread:
         thread = Thread(name, parent, span)
@@ -251,6 +327,8 @@ class Interpreter:
         return thread
 
     def _finish(self, thread: Thread) -> None:
+        if not thread.done:
+            self._dead += 1
         thread.done = True
         if self.critical is thread:
             self.critical = None
@@ -264,6 +342,7 @@ class Interpreter:
         if thread.done:
             return
         thread.done = True
+        self._dead += 1
         for joiner in thread.joiners:
             joiner.wake = self.time
         for child in thread.children:
@@ -279,11 +358,14 @@ class Interpreter:
     def wait_until(self, when: float) -> None:
         """Block the current thread until robot time ``when`` (s)."""
         thread = self.current
+        if self.config.deadline is not None:
+            self._waits += 1
+            if not self._waits & 255:
+                self.check_deadline(None)
         if (len(self._threads) == 1 and self.config.pace is None and not self.stop_requested
                 and when <= self.config.max_time):
             # the main thread alone, unpaced: the scheduler would only move the clock on
             thread.wake = self.time = max(when, self.time)
-            self.steps = 0
             return
         thread.wake = max(when, self.time)
         self._order += 1
@@ -291,6 +373,43 @@ class Interpreter:
         self._scheduler.switch()
         if thread.done:  # killed while waiting
             raise greenlet.GreenletExit
+
+    def wait_forever(self, message: str, node: n.Node) -> None:
+        """Block the current thread for good (a read with timeout 0 that nothing will answer):
+        the checker stops there and says so; a paced run (the virtual controller) waits
+        until the program is stopped."""
+        event = Event(self.time, "blocked", message, node.span)
+        if self.config.pace is not None:
+            self.wait_until(self.config.max_time)
+            return
+        if len(self._threads) == 1 or self.current.parent is None:
+            raise _StopRun(event)
+        self.current.blocked = event
+        self.event("blocked", message, node.span)
+        self.wait_until(math.inf)
+
+    def check_deadline(self, node: n.Node | None) -> None:
+        """Stop the run if the wall-clock bound (``config.deadline``) has passed."""
+        deadline = self.config.deadline
+        if deadline is None or _clock.monotonic() < deadline:
+            return
+        if node is None:
+            node = self.loop_node
+        span = node.span if node is not None else (
+            self.current.span if self.current is not None else NO_SPAN)
+        where = f" in thread {self.current.name}" if self.current is not None and \
+            self.current.name != "main" else ""
+        raise _StopRun(Event(self.time, "deadline",
+                             f"stopped at robot time {self.time:.3f} s{where}", span))
+
+    def warn_once(self, message: str, node: Any, unknown: Unknown | None = None) -> None:
+        """A warning about what depends on a value unknown offline, once per statement."""
+        span = node.span if node is not None and hasattr(node, "span") else NO_SPAN
+        key = ("unknown", span)
+        if key in self._once:
+            return
+        self._once.add(key)
+        self.warnings.append(Event(self.time, "unknown", message, span))
 
     def wait(self, seconds: float) -> None:
         """Block the current thread for ``seconds`` of robot time."""
@@ -303,7 +422,17 @@ class Interpreter:
         self.wait_until(frames * step)
 
     def event(self, kind: str, message: str, span: Span = NO_SPAN) -> None:
+        if len(self.events) >= EVENT_LIMIT and self.config.pace is None:
+            self.events_dropped += 1
+            return
         self.events.append(Event(self.time, kind, message, span))
+
+    def message(self, kind: str, text: str) -> None:
+        """A message for the environment (``textmsg``, ``popup``), kept up to
+        :data:`EVENT_LIMIT` in an unpaced run."""
+        messages = self.env.messages
+        if len(messages) < EVENT_LIMIT or self.config.pace is not None:
+            messages.append((self.time, kind, text))
 
     def event_once(self, kind: str, message: str, span: Span = NO_SPAN) -> None:
         """An event recorded only the first time this statement causes it (a builtin that is
@@ -321,6 +450,15 @@ class Interpreter:
         body = self.threads_defs.get(name)
         if body is None:
             raise self.error("undefined", f"thread '{name}' is not defined", node)
+        self.steps += 1  # a thread that starts threads without using time runs away too
+        if self.steps > self.config.runaway_limit:
+            self.count_step(node)
+        if len(self._threads) - self._dead >= self.config.max_threads:
+            # (no pruning here: only the scheduler may end suspended greenlets)
+            if sum(1 for t in self._threads if not t.done) >= self.config.max_threads:
+                raise self.error(
+                    "call", f"more than {self.config.max_threads} threads would run at once",
+                    node, "join or kill threads that are done with their work")
         thread = self._spawn(name, body, self.current, node.span)
         return thread.handle
 
@@ -345,9 +483,17 @@ class Interpreter:
             raise greenlet.GreenletExit
 
     def count_step(self, node: n.Node) -> None:
-        """Called on every loop turn: stop a loop that never uses physical time."""
+        """Called when the loop-turn counter passes ``runaway_limit``: stop a program whose
+        threads keep looping without robot time advancing (the counter restarts only when
+        it does), and check the wall-clock bound."""
+        self.check_deadline(node)
+        if self.time != self._steps_time:
+            self._steps_time = self.time
+            self.steps = 0
+            return
         self.steps += 1
         if self.steps > self.config.runaway_limit:
+            self.steps = 0
             raise self.error(
                 "runaway",
                 f"thread {self.current.name} looped {self.config.runaway_limit:,} times "
@@ -569,13 +715,30 @@ class _Compiler:
 
     def s_If(self, node: n.If):
         rt = self.rt
-        branches = [(self.expr(node.test), self.block(node.body), node.test)]
-        branches += [(self.expr(b.test), self.block(b.body), b.test) for b in node.elifs]
+        branches = [(self.expr(node.test), self.block(node.body), node.test,
+                     ends_program(node.body))]
+        branches += [(self.expr(b.test), self.block(b.body), b.test, ends_program(b.body))
+                     for b in node.elifs]
         orelse = self.block(node.orelse) if node.orelse is not None else None
 
         def run(frame):
-            for test, body, test_node in branches:
-                if _truth(test(frame), rt, test_node):
+            for test, body, test_node, ending in branches:
+                value = test(frame)
+                if type(value) is Unknown:
+                    # follow a working device: not into an error branch (it ends the
+                    # program), not against the reply the program expects, else in
+                    take = not ending and value.lean is not False
+                    rt.warn_once(
+                        f"this condition depends on {value.source}, which is unknown "
+                        "offline; the check follows a working device: "
+                        + ("it skips this branch, which ends the program" if ending
+                           else "it takes this branch" if take
+                           else "it skips this branch (the reply is as expected)"),
+                        test_node)
+                    if not take:
+                        continue
+                    return body(frame)
+                if _truth(value, rt, test_node):
                     return body(frame)
             if orelse is not None:
                 return orelse(frame)
@@ -590,7 +753,27 @@ class _Compiler:
         test_node = node.test
 
         def run(frame):
-            while _truth(test(frame), rt, test_node):
+            rt.loop_node = node
+            unknown_passes = 0
+            while True:
+                value = test(frame)
+                if type(value) is Unknown:
+                    unknown_passes += 1
+                    if value.lean is False:  # the expected reply came at once
+                        rt.warn_once(
+                            f"this loop's condition depends on {value.source}, which is "
+                            "unknown offline; the check follows a working device, whose "
+                            "reply ends the loop", test_node)
+                        break
+                    if unknown_passes == 1:
+                        rt.warn_once(
+                            f"this loop's condition depends on {value.source}, which is "
+                            "unknown offline; the check follows a working device and leaves "
+                            f"the loop after at most {UNKNOWN_LOOP_PASSES} passes", test_node)
+                    if unknown_passes > UNKNOWN_LOOP_PASSES:
+                        break
+                elif not _truth(value, rt, test_node):
+                    break
                 signal = body(frame)
                 if signal == BREAK:
                     break
@@ -636,9 +819,15 @@ class _Compiler:
                 target = container(frame)
                 keys = [idx(frame) for idx in indices]
                 kind = type(target)
+                if kind is Unknown:  # an element of an unknown value: still unknown
+                    return
                 try:
                     positions = [_index(k) for k in keys]
                 except TypeError as error:
+                    found = _first_unknown_key(keys)
+                    if found is not None:  # which element changed is unknown
+                        store_container(frame, found)
+                        return
                     raise rt.error("type", f"an index must be an int, not a {error}", node) \
                         from None
                 try:
@@ -650,6 +839,9 @@ class _Compiler:
                             target[positions[0]] = value
                     elif kind is PoseValue:
                         _check_bounds(positions[0], 6, rt, node)
+                        if type(value) is Unknown:
+                            store_container(frame, value)
+                            return
                         if not is_number(value):
                             raise rt.error("type", f"a pose holds numbers, not a "
                                            f"{type_name(value)}", node)
@@ -670,6 +862,8 @@ class _Compiler:
 
             def store_field(frame, value):
                 target = container(frame)
+                if type(target) is Unknown:
+                    return
                 if type(target) is not StructValue:
                     raise rt.error("type", f"a {type_name(target)} has no field '{attr}'", node)
                 if attr not in target.members:
@@ -716,11 +910,26 @@ class _Compiler:
         return read
 
     def e_List(self, node: n.List):
+        rt = self.rt
         constants = _constants(node.items)
         if constants is not None:  # a literal list: copy it, as every evaluation must
             return lambda frame: ListValue(constants)
         items = [self.expr(i) for i in node.items]
-        return lambda frame: ListValue([copy_value(item(frame)) for item in items])
+
+        def make(frame):
+            values = [copy_value(item(frame)) for item in items]
+            rows = 0
+            for value in values:
+                if type(value) is ListValue:
+                    if value and type(value[0]) is ListValue:
+                        raise rt.error("type", "a list cannot hold a matrix: lists have at "
+                                       "most two levels (a matrix)", node)
+                    rows += len(value)
+            if rows > LIST_LIMIT:
+                raise rt.error("index", f"a matrix of more than {LIST_LIMIT:,} values", node)
+            return ListValue(values)
+
+        return make
 
     def e_Pose(self, node: n.Pose):
         rt = self.rt
@@ -734,6 +943,8 @@ class _Compiler:
             values = [item(frame) for item in items]
             for value, item in zip(values, node.items, strict=True):
                 if not is_number(value):
+                    if type(value) is Unknown:  # a pose with an unknown part is unknown
+                        return value
                     raise rt.error("type", f"a pose holds numbers, not a {type_name(value)}",
                                    item)
             return PoseValue(values)
@@ -747,6 +958,8 @@ class _Compiler:
             def negate(frame):
                 value = operand(frame)
                 if type(value) is not bool:
+                    if type(value) is Unknown:
+                        return value.leaning(None if value.lean is None else not value.lean)
                     raise rt.error("type", f"'{node.op}' needs a bool, not a "
                                    f"{type_name(value)}", node)
                 return not value
@@ -760,6 +973,8 @@ class _Compiler:
                 return sign * value
             if kind is ListValue and all(is_number(v) for v in value):
                 return ListValue([sign * v for v in value])
+            if has_unknown(value) is not None:
+                return has_unknown(value).leaning(None)
             raise rt.error("type", f"unary '{node.op}' needs a number, not a "
                            f"{type_name(value)}", node)
 
@@ -774,17 +989,52 @@ class _Compiler:
         op = node.op
         if op == "and":
             def conj(frame):
-                if not _bool_operand(left(frame), rt, node):
+                a = left(frame)
+                if type(a) is Unknown:  # unknown, unless the right side is false
+                    b = right(frame)
+                    if b is False:
+                        return b
+                    if type(b) is not Unknown:
+                        _bool_operand(b, rt, node)  # a known operand must be a bool
+                    else:
+                        return a.leaning(False if False in (a.lean, b.lean) else
+                                         a.lean and b.lean)
+                    return a
+                if not _bool_operand(a, rt, node):
                     return False
-                return _bool_operand(right(frame), rt, node)
+                b = right(frame)
+                return b if type(b) is Unknown else _bool_operand(b, rt, node)
             return conj
         if op == "or":
             def disj(frame):
-                if _bool_operand(left(frame), rt, node):
+                a = left(frame)
+                if type(a) is Unknown:  # unknown, unless the right side is true
+                    b = right(frame)
+                    if b is True:
+                        return b
+                    if type(b) is not Unknown:
+                        _bool_operand(b, rt, node)  # a known operand must be a bool
+                    else:
+                        return a.leaning(True if True in (a.lean, b.lean) else
+                                         None if None in (a.lean, b.lean) else False)
+                    return a
+                if _bool_operand(a, rt, node):
                     return True
-                return _bool_operand(right(frame), rt, node)
+                b = right(frame)
+                return b if type(b) is Unknown else _bool_operand(b, rt, node)
             return disj
         operation = binary(op)
+        if op in ("==", "!="):
+            lean = op == "=="  # a working device answers what the program expects
+
+            def compare(frame):
+                a = left(frame)
+                b = right(frame)
+                found = has_unknown(a) or has_unknown(b)
+                if found is not None:
+                    return found.leaning(lean)
+                return operation(a, b)
+            return compare
 
         def apply(frame):
             a = left(frame)
@@ -794,6 +1044,10 @@ class _Compiler:
             except ZeroDivisionError:
                 raise rt.error("arithmetic", "division by zero", node) from None
             except (TypeError, ValueError) as error:
+                found = has_unknown(a) or has_unknown(b)
+                if found is not None and not (op == "xor" and type(a if found is b else b)
+                                              is not bool):
+                    return found.leaning(None)
                 raise rt.error("type", f"'{op}' cannot combine a {type_name(a)} and a "
                                f"{type_name(b)}" + (f": {error}" if str(error) else ""),
                                node, _operator_hint(op, a, b)) from None
@@ -811,9 +1065,14 @@ class _Compiler:
             try:
                 positions = [_index(k) for k in keys]
             except TypeError as error:
+                found = has_unknown(target) or _first_unknown_key(keys)
+                if found is not None:
+                    return found
                 raise rt.error("type", f"an index must be an int, not a {error}", node) \
                     from None
             kind = type(target)
+            if kind is Unknown:
+                return target
             if kind is ListValue or kind is PoseValue:
                 size = len(target)
                 first = positions[0]
@@ -846,6 +1105,8 @@ class _Compiler:
                 except KeyError:
                     raise rt.error("undefined", f"the struct has no member '{attr}'",
                                    node) from None
+            if type(target) is Unknown:
+                return target
             raise rt.error("type", f"a {type_name(target)} has no field '{attr}'", node)
 
         return get
@@ -883,6 +1144,8 @@ class _Compiler:
                  if (value := _constants([k.value])) is not None}
         keywords = [(k.name, self.expr(k.value)) for k in node.keywords if k.name not in fixed]
 
+        unknown = rt.unknown
+
         def call(frame):
             values = [a(frame) for a in args]
             named = dict(fixed)
@@ -890,7 +1153,14 @@ class _Compiler:
                 named[k] = v(frame)
             function = functions.get(name)
             if function is not None:
+                rt.calls += 1  # recursion without loops meets the wall-clock bound here
+                if not rt.calls & 1023:
+                    rt.check_deadline(node)
                 return self.call_user(function, values, named, node)
+            if unknown:
+                found = first_unknown(values, named)
+                if found is not None:
+                    return unknown_call(rt, name, values, named, found, node, builtin)
             return builtin(values, named, node)
 
         return call
@@ -926,6 +1196,13 @@ class _Compiler:
 
 class _Halt(Exception):
     """``halt``: the program ends here."""
+
+
+def _first_unknown_key(keys: list) -> Unknown | None:
+    for key in keys:
+        if type(key) is Unknown:
+            return key
+    return None
 
 
 def _check_bounds(position: int, size: int, rt: Interpreter, node: n.Node) -> None:

@@ -5,7 +5,8 @@ strings (real programs do this though only ``str_cat`` is documented). Lists com
 element-wise with an equal-length list or with a number; ``matrix * matrix`` and
 ``matrix * list`` are matrix products (../shared/reference/URSCRIPT_LANGUAGE.md §4).
 
-Each operation raises TypeError (or ValueError) for values it cannot combine and
+Each operation raises TypeError (or ValueError) for values it cannot combine (or a string
+longer than :data:`STRING_LIMIT` bytes) and
 ZeroDivisionError for a division by zero; the interpreter turns these into messages that name
 the line. ``int / int`` gives a float (true division) and ``%`` takes the sign of the
 divisor, as in Python: the controller does not document either [U].
@@ -19,7 +20,11 @@ from typing import Any
 
 from .values import ListValue, is_number
 
-__all__ = ["binary"]
+__all__ = ["binary", "STRING_LIMIT"]
+
+STRING_LIMIT = 1023
+"""Bytes a string may hold: the controller's limit for ``str_cat``/``to_str`` results
+(URSCRIPT_LANGUAGE §2), applied to ``+`` of strings as well [U]."""
 
 
 def _is_matrix(value: Any) -> bool:
@@ -51,7 +56,10 @@ def _arithmetic(function: Callable[[Any, Any], Any], strings: bool = False):
         if (kind_a is int or kind_a is float) and (kind_b is int or kind_b is float):
             return function(a, b)
         if strings and kind_a is str and kind_b is str:
-            return a + b
+            joined = a + b
+            if len(joined) > 255 and len(joined.encode("utf-8")) > STRING_LIMIT:
+                raise ValueError(f"the string would be longer than {STRING_LIMIT} bytes")
+            return joined
         return _elementwise(function, a, b)
 
     return apply

@@ -13,6 +13,9 @@ list       :class:`ListValue` (a list with a capacity)
 matrix     :class:`ListValue` of equal-length :class:`ListValue` rows
 struct     :class:`StructValue`
 thread     :class:`ThreadHandle`
+(unknown)  :class:`Unknown`: a value read from the outside world that the
+           checker cannot know (a device's reply, an input, an operator's
+           answer); see :mod:`urdsl.runtime.unknown`
 ========== =============================================================
 
 URScript passes and assigns values *by value*: :func:`copy_value` makes the copy that an
@@ -26,7 +29,7 @@ from typing import Any
 
 __all__ = [
     "PoseValue", "ListValue", "StructValue", "ThreadHandle", "copy_value", "type_name",
-    "format_value", "is_number",
+    "format_value", "is_number", "Unknown", "has_unknown", "exceeds",
 ]
 
 
@@ -88,6 +91,76 @@ class ThreadHandle:
         return f"<thread {self.thread.name}>"
 
 
+class Unknown:
+    """A value the program read from the outside world, which the checker cannot know.
+
+    ``source`` says where it came from, for messages ("the reply of socket_read_byte_list()
+    at line 12"); ``span`` is that read's place in the program. Operations on an unknown
+    value give an unknown value (the first one's source is kept); immutable.
+
+    ``lean``: for a condition, the truth a working device would give, when there is one: a
+    reply compared with ``==`` to what the program expects is taken as equal (True), with
+    ``!=`` as not different (False); ``not`` flips it; None: no lean.
+    """
+
+    __slots__ = ("source", "span", "lean")
+
+    def __init__(self, source: str, span: Any = None, lean: bool | None = None) -> None:
+        self.source = source
+        self.span = span
+        self.lean = lean
+
+    def leaning(self, lean: bool | None) -> Unknown:
+        """The same unknown value with another lean."""
+        return self if lean is self.lean else Unknown(self.source, self.span, lean)
+
+    def __repr__(self) -> str:
+        return f"<unknown: {self.source}>"
+
+
+def has_unknown(value: Any) -> Unknown | None:
+    """The first :class:`Unknown` in ``value`` (itself, or inside a list, matrix or struct),
+    or None."""
+    kind = type(value)
+    if kind is Unknown:
+        return value
+    if kind is ListValue:
+        for item in value:
+            item_kind = type(item)
+            if item_kind is Unknown:
+                return item
+            if item_kind is ListValue or item_kind is StructValue:
+                found = has_unknown(item)
+                if found is not None:
+                    return found
+        return None
+    if kind is StructValue:
+        for item in value.members.values():
+            found = has_unknown(item)
+            if found is not None:
+                return found
+    return None
+
+
+def exceeds(value: Any, limit: int) -> bool:
+    """Whether ``value`` holds more than ``limit`` values, counted through nested lists and
+    structs (stops counting once past the limit)."""
+    count = 0
+    stack = [value]
+    while stack:
+        item = stack.pop()
+        kind = type(item)
+        if kind is ListValue:
+            count += len(item)
+            stack.extend(v for v in item if type(v) is ListValue or type(v) is StructValue)
+        elif kind is StructValue:
+            count += len(item.members)
+            stack.extend(item.members.values())
+        if count > limit:
+            return True
+    return False
+
+
 def is_number(value: Any) -> bool:
     kind = type(value)
     return kind is int or kind is float
@@ -124,6 +197,8 @@ def type_name(value: Any) -> str:
         return "struct"
     if kind is ThreadHandle:
         return "thread"
+    if kind is Unknown:
+        return "unknown value"
     return kind.__name__
 
 
@@ -150,4 +225,6 @@ def format_value(value: Any) -> str:
         return "p[" + ", ".join(_format_float(v) for v in value) + "]"
     if kind is ListValue:
         return "[" + ", ".join(format_value(v) for v in value) + "]"
+    if kind is Unknown:
+        return "?"
     return repr(value)

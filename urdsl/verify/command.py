@@ -46,6 +46,17 @@ def parse_vector(text: str, count: int, what: str, degrees: bool = False) -> tup
     return tuple(math.radians(v) for v in values) if degrees else values
 
 
+def _seconds(text: str) -> float:
+    """A positive, finite number of seconds (``--timeout``)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds, got {text!r}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+    return value
+
+
 def add_commands(commands) -> None:
     p = commands.add_parser(
         "check", help="run programs offline on a simulated robot and report problems",
@@ -85,6 +96,9 @@ def add_commands(commands) -> None:
                    help="do not check the arm against itself")
     p.add_argument("--max-time", type=float, default=3600.0, metavar="S",
                    help="stop a program that runs longer than this robot time (default 3600)")
+    p.add_argument("--timeout", type=_seconds, default=60.0, metavar="S",
+                   help="wall-clock time in s each program's check may take (default 60); "
+                   "a check that reaches it stops and says how far it got (URS313)")
     p.add_argument("--json", action="store_true",
                    help="print the report as one JSON document on stdout (one per file, in "
                    "a list when several files are given)")
@@ -112,6 +126,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         tcp_speed_limit=args.tcp_speed_limit,
         joint_acceleration_limit=args.joint_acceleration_limit,
         singularity_scale=args.singularity_scale, max_time=args.max_time,
+        timeout=args.timeout,
         self_collision=not args.no_self_collision)
     if args.cell:
         options.cell = _load_cell(robot, args.cell)

@@ -19,6 +19,10 @@ URS309   warning   Overlapping Blends: the robot skips the move
 URS310   warning   a blend radius larger than half of a neighbouring segment
 URS311   warning   the program ended while threads were still running
 URS312   info      the program was stopped at the time limit (it loops forever)
+URS313   warning   the check stopped early: the program waits for ever (a read with
+                   timeout 0 nothing answers) or the wall-clock bound was reached
+URS210   warning   what follows depends on a value from outside (a device's reply, an
+                   input, an operator's answer) that is unknown offline
 =======  ========  =============================================================
 """
 
@@ -44,6 +48,8 @@ RULES: dict[str, tuple[str, str]] = {
     "URS310": ("warning", "blend radius larger than half a segment"),
     "URS311": ("warning", "threads still running at program end"),
     "URS312": ("info", "stopped at the time limit"),
+    "URS313": ("warning", "check stopped early (waits for ever, wall-clock bound)"),
+    "URS210": ("warning", "depends on a device value unknown offline"),
 }
 
 

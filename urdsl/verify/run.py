@@ -8,10 +8,16 @@ The steps, each reported as findings at the statement that caused them:
    an unreachable target as URS301) stop it as they would stop the controller;
 3. sample the planned trajectory at the controller rate (:func:`urdsl.motion.trace.sample`);
 4. run the checks of :mod:`urdsl.verify.checks` over the samples.
+
+Reads from outside the controller (devices, inputs, operator answers) are unknown values
+(:mod:`urdsl.runtime.unknown`): what depends on them is a URS210 warning, not an error.
+Every check ends within its wall-clock bound (``CheckOptions.timeout``): the run stops where
+it got to and says so (URS313), and checks left undone are named.
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -28,7 +34,15 @@ from . import checks
 from .findings import Finding
 from .report import Move, Report
 
-__all__ = ["CheckOptions", "check_text", "check_tree", "check_file", "DEFAULT_START"]
+__all__ = ["CheckOptions", "check_text", "check_tree", "check_file", "DEFAULT_START",
+           "DEFAULT_TIMEOUT"]
+
+DEFAULT_TIMEOUT = 60.0
+"""Wall-clock time (s) one program's check may take by default (``urdsl check --timeout``)."""
+
+RUN_SHARE = 0.8
+"""The part of the wall-clock bound the program's run may use; the trace checks get the
+rest (each check is skipped, and named, once the bound has passed)."""
 
 DEFAULT_START = (0.0, -1.5707963267948966, 1.5707963267948966, -1.5707963267948966,
                  -1.5707963267948966, 0.0)
@@ -48,7 +62,9 @@ class CheckOptions:
     :func:`urdsl.verify.checks.singularities`; ``max_time``: robot time (s) after which a
     program that runs on is stopped; ``sample_time``: trace step in s (default: the
     controller's, 0.002 e-Series / 0.008 CB3); ``collision_step``: robot time (s) between
-    collision samples.
+    collision samples; ``timeout``: wall-clock time (s) the whole check may take (None: no
+    bound); ``environment``: the world the program reads (default: every device unknown,
+    see :mod:`urdsl.runtime.unknown`).
     """
 
     robot: str = "ur5e"
@@ -64,6 +80,7 @@ class CheckOptions:
     sample_time: float | None = None
     collision_step: float = 0.02
     self_collision: bool = True
+    timeout: float | None = DEFAULT_TIMEOUT
     environment: Environment | None = field(default=None, repr=False)
 
 
@@ -71,6 +88,7 @@ def check_text(text: str, filename: str = "<script>", *, robot: str = "ur5e",
                options: CheckOptions | None = None) -> Report:
     """Check URScript ``text``; ``filename`` names it in messages."""
     options = options or CheckOptions(robot=robot)
+    started = time.monotonic()
     try:
         module = parse(text, filename=filename)
     except ScriptSyntaxError as error:
@@ -79,7 +97,7 @@ def check_text(text: str, filename: str = "<script>", *, robot: str = "ur5e",
                                        error.diagnostic.message, error.span or NO_SPAN,
                                        None, error.diagnostic.hint))
         return report
-    return check_tree(module, filename, options)
+    return check_tree(module, filename, options, started)
 
 
 def check_file(path: str | Path, options: CheckOptions | None = None) -> Report:
@@ -100,22 +118,28 @@ def _robot_model(name: str):
     return Robot.model(name)
 
 
-def check_tree(module, filename: str, options: CheckOptions) -> Report:
-    """Run and check a parsed program (:class:`urdsl.script.nodes.Module`)."""
+def check_tree(module, filename: str, options: CheckOptions,
+               started: float | None = None) -> Report:
+    """Run and check a parsed program (:class:`urdsl.script.nodes.Module`); ``started``:
+    the ``time.monotonic()`` the wall-clock bound counts from (default: now)."""
     with gc_paused():  # the tree, closures and segments are long-lived and acyclic
-        return _check_tree(module, filename, options)
+        return _check_tree(module, filename, options,
+                           time.monotonic() if started is None else started)
 
 
-def _check_tree(module, filename: str, options: CheckOptions) -> Report:
+def _check_tree(module, filename: str, options: CheckOptions, started: float) -> Report:
     robot = _robot_model(options.robot)
     cb3 = getattr(robot.spec, "generation", "") == "cb3"
     step = 0.008 if cb3 else 0.002
     planner = MotionPlanner(robot, options.start_joints, step_time=step, lazy_ik=True)
     if options.tcp is not None:
         planner.tcp = np.asarray(options.tcp, dtype=float)
-    config = RuntimeConfig(step_time=step, max_time=options.max_time)
-    interpreter = Interpreter(module, robot=planner, environment=options.environment,
-                              config=config)
+    deadline = None if options.timeout is None else started + RUN_SHARE * options.timeout
+    config = RuntimeConfig(step_time=step, max_time=options.max_time, deadline=deadline)
+    environment = options.environment
+    if environment is None:
+        environment = Environment(devices="unknown")
+    interpreter = Interpreter(module, robot=planner, environment=environment, config=config)
     result = interpreter.run()
 
     report = Report(filename, options.robot)
@@ -143,20 +167,48 @@ def _check_tree(module, filename: str, options: CheckOptions) -> Report:
         report.findings.append(Finding.of(
             "URS311", f"the program ended while thread(s) {names} still ran; the controller "
             "stops them", module.span, result.time, "join or kill threads before the end"))
+    for warning in result.warnings:
+        report.findings.append(Finding.of("URS210", warning.message, warning.span,
+                                          warning.time))
+    if result.stopped_early is not None:
+        report.findings.append(_stopped_finding(result.stopped_early, options))
+    for event in result.events:
+        if event.kind == "blocked":  # a thread that waits for ever; the others went on
+            report.findings.append(Finding.of(
+                "URS313", f"{event.message}; this thread was not checked further",
+                event.span, event.time, "give the read a timeout, or make sure something "
+                "answers"))
     if result.stopped_at_max_time:
         report.findings.append(Finding.of(
             "URS312", f"the program still ran after {options.max_time:g} s of robot time and "
             "was stopped there (a cell program that loops forever?)", module.span,
             options.max_time, "use --max-time to check longer"))
 
-    trace = sample(planner, options.sample_time or step)
+    # sampled while the arm moves (after the last move it rests: nothing to check), and
+    # never past --max-time
+    last = max((s.end for s in planner.segments), default=0.0)
+    trace = sample(planner, options.sample_time or step, until=min(last, options.max_time))
     report.trace = trace
-    report.cycle_time = float(max(result.time, trace.duration))
+    report.cycle_time = float(min(max(result.time, trace.duration), options.max_time))
     report.moves = [Move(s.kind, s.span, s.start, s.duration, s.params.get("lead"))
                     for s in planner.segments]
-    report.findings.extend(_trace_findings(trace, planner, robot, options))
+    final = None if options.timeout is None else started + options.timeout
+    report.findings.extend(_trace_findings(trace, planner, robot, options, final,
+                                           module.span))
     report.sort()
     return report
+
+
+def _stopped_finding(event, options: CheckOptions) -> Finding:
+    """URS313 for a run that stopped early: it names the robot time and the statement."""
+    if event.kind == "deadline":
+        message = (f"the check reached its wall-clock bound of {options.timeout:g} s and "
+                   f"{event.message}, here; what follows was not checked")
+        hint = "use --timeout to allow more time"
+    else:
+        message = f"{event.message}; the check stops here at robot time {event.time:.3f} s"
+        hint = "give the read a timeout, or make sure something answers"
+    return Finding.of("URS313", message, event.span, event.time, hint)
 
 
 def _runtime_finding(error) -> Finding:
@@ -168,7 +220,10 @@ def _runtime_finding(error) -> Finding:
                    diagnostic.hint)
 
 
-def _trace_findings(trace, planner, robot, options: CheckOptions) -> list[Finding]:
+def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: float | None,
+                    span) -> list[Finding]:
+    """The trace checks, in order; once ``deadline`` (``time.monotonic()``) has passed the
+    remaining ones are skipped and a URS313 finding names them."""
     findings: list[Finding] = []
     if len(trace.times) == 0 or not planner.segments:
         return findings
@@ -176,15 +231,29 @@ def _trace_findings(trace, planner, robot, options: CheckOptions) -> list[Findin
     findings += jumps.findings
     q_min = np.asarray(options.q_min if options.q_min is not None else robot.q_min)
     q_max = np.asarray(options.q_max if options.q_max is not None else robot.q_max)
-    findings += checks.joint_limits(trace, q_min, q_max)
-    findings += checks.joint_speeds(trace, np.asarray(robot.qd_max), exclude=jumps.samples)
+    steps = [
+        ("joint limits", lambda: checks.joint_limits(trace, q_min, q_max)),
+        ("joint speeds", lambda: checks.joint_speeds(trace, np.asarray(robot.qd_max),
+                                                     exclude=jumps.samples)),
+    ]
     if options.joint_acceleration_limit is not None:
         limits = np.broadcast_to(np.asarray(options.joint_acceleration_limit, float), (6,))
-        findings += checks.joint_accelerations(trace, limits, exclude=jumps.samples)
-    findings += checks.blend_radii(planner.segments)
+        steps.append(("joint accelerations", lambda: checks.joint_accelerations(
+            trace, limits, exclude=jumps.samples)))
+    steps.append(("blend radii", lambda: checks.blend_radii(planner.segments)))
     if options.tcp_speed_limit is not None:
-        findings += checks.tcp_speed(trace, robot, options.tcp_speed_limit)
-    findings += checks.singularities(trace, robot, options.singularity_scale)
-    findings += checks.collisions(trace, robot, options.cell, options.collision_step,
-                                  options.self_collision)
+        steps.append(("TCP speed", lambda: checks.tcp_speed(trace, robot,
+                                                            options.tcp_speed_limit)))
+    steps.append(("singularities", lambda: checks.singularities(trace, robot,
+                                                                options.singularity_scale)))
+    steps.append(("collisions", lambda: checks.collisions(
+        trace, robot, options.cell, options.collision_step, options.self_collision)))
+    for index, (_name, run) in enumerate(steps):
+        if deadline is not None and time.monotonic() > deadline:
+            skipped = ", ".join(n for n, _ in steps[index:])
+            findings.append(Finding.of(
+                "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s; "
+                f"not checked: {skipped}", span, None, "use --timeout to allow more time"))
+            break
+        findings += run()
     return findings

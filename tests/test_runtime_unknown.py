@@ -1,0 +1,243 @@
+"""Reads from the outside world are unknown offline: the interpreter follows a working device,
+warns once per statement, and never turns a device's reply into an error."""
+
+from __future__ import annotations
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from urdsl import parse
+from urdsl.runtime import Environment, Interpreter, RuntimeConfig
+from urdsl.runtime.unknown import DEVICE_REPLY_TIME, OPERATOR_REPLY_TIME, UNKNOWN_LOOP_PASSES
+from urdsl.runtime.values import ListValue, Unknown
+
+
+def run(text: str, devices: str = "unknown", **config):
+    environment = Environment(devices=devices)
+    interpreter = Interpreter(parse(text, "prog.script"), environment=environment,
+                              config=RuntimeConfig(**config))
+    return interpreter.run()
+
+
+def lines(warnings) -> list[int]:
+    return [w.span.line for w in warnings]
+
+
+ROBOTIQ_STYLE = """\
+rq = rpc_factory("xmlrpc", "http://127.0.0.1:4242/RPC2")
+if not rq.is_ready():
+  popup("the gripper is not ready", error=True)
+  halt
+end
+ready = rq.status() == 3 and rq.fault() == 0
+done = 1
+"""
+
+
+def test_xmlrpc_reply_is_unknown_and_not_ready_branch_is_not_taken():
+    result = run(ROBOTIQ_STYLE)
+    assert result.error is None
+    assert result.globals["done"] == 1  # the error branch (popup, halt) was skipped
+    assert type(result.globals["ready"]) is Unknown
+    assert lines(result.warnings) == [2]
+    message = result.warnings[0].message
+    assert "is_ready() at line 2" in message and "skips this branch" in message
+    assert result.time >= 3 * DEVICE_REPLY_TIME  # each call waits for the reply
+
+
+def test_the_same_program_with_quiet_devices_fails_as_before():
+    result = run(ROBOTIQ_STYLE, devices="quiet")
+    assert result.error is not None and result.error.diagnostic.code == "URS203"
+
+
+def test_blocking_socket_read_takes_robot_time_and_its_wait_loop_ends():
+    result = run('socket_open("127.0.0.1", 63352, "gripper")\n'
+                 'reply = socket_read_byte_list(1, "gripper", 0)\n'
+                 'while reply[0] < 1:\n'
+                 '  reply = socket_read_byte_list(1, "gripper", 0)\n'
+                 'end\n'
+                 'done = True\n')
+    assert result.error is None and result.stopped_early is None
+    assert result.globals["done"] is True
+    assert lines(result.warnings) == [3]
+    assert f"at most {UNKNOWN_LOOP_PASSES} passes" in result.warnings[0].message
+    assert "socket_read_byte_list() at line" in result.warnings[0].message
+    passes = round(result.time / DEVICE_REPLY_TIME) - 1
+    assert 1 <= passes <= UNKNOWN_LOOP_PASSES
+
+
+def test_queued_socket_replies_stay_known():
+    environment = Environment(devices="unknown", socket_replies={"s": ["ok"]})
+    program = 'socket_open("127.0.0.1", 1, "s")\nx = socket_read_string("s")\n'
+    result = Interpreter(parse(program, "p.script"), environment=environment).run()
+    assert result.globals["x"] == "ok" and not result.warnings
+
+
+def test_register_read_wait_loop_warns_once_and_goes_on():
+    result = run("n = 0\n"
+                 "while read_input_integer_register(0) < 1:\n"
+                 "  n = n + 1\n"
+                 "  sync()\n"
+                 "end\n"
+                 "after = 1\n")
+    assert result.error is None and result.globals["after"] == 1
+    assert result.globals["n"] == UNKNOWN_LOOP_PASSES
+    assert lines(result.warnings) == [2]
+
+
+def test_a_wait_for_the_expected_reply_ends_at_once():
+    result = run("n = 0\n"
+                 "while read_input_integer_register(0) != 1:\n"
+                 "  n = n + 1\n"
+                 "  sync()\n"
+                 "end\n")
+    assert result.error is None and result.globals["n"] == 0
+    assert "reply ends the loop" in result.warnings[0].message
+
+
+def test_a_reply_check_function_sees_the_expected_reply():
+    result = run("def is_ack(b):\n"
+                 "  if b[0] != 3:\n"
+                 "    return False\n"
+                 "  end\n"
+                 "  if b[1] != 97 or b[2] != 99:\n"
+                 "    return False\n"
+                 "  end\n"
+                 "  return True\n"
+                 "end\n"
+                 'socket_open("127.0.0.1", 1, "s")\n'
+                 "tries = 0\n"
+                 'while not is_ack(socket_read_byte_list(3, "s", 0)):\n'
+                 "  tries = tries + 1\n"
+                 "end\n")
+    assert result.error is None and result.globals["tries"] == 0
+    assert lines(result.warnings) == [2, 5]
+
+
+def test_one_warning_per_statement_not_per_pass():
+    result = run("i = 0\n"
+                 "while i < 10:\n"
+                 "  if get_standard_digital_in(0):\n"
+                 "    set_standard_digital_out(1, True)\n"
+                 "  end\n"
+                 "  i = i + 1\n"
+                 "  sync()\n"
+                 "end\n")
+    assert result.error is None
+    assert lines(result.warnings) == [3]
+
+
+def test_unknown_flows_through_expressions_without_errors():
+    result = run("r = read_input_float_register(2)\n"
+                 "a = r * 2 + 1\n"
+                 "b = [r, 1, 2][0]\n"
+                 "c = -r < 3\n"
+                 "d = not (r == 1)\n"
+                 "e = str_cat(\"r=\", r)\n"
+                 "f = sqrt(r)\n"
+                 "g = p[r, 0, 0, 0, 0, 0]\n"
+                 "h = [r, r] + [1, 2]\n"
+                 "k = False and r > 1\n")
+    assert result.error is None, result.error
+    for name in "abcdefgh":
+        assert type(result.globals[name]) is Unknown, name
+    assert result.globals["k"] is False  # decided without the unknown value
+    assert "read_input_float_register() at line 1" in result.globals["a"].source
+
+
+def test_own_outputs_flags_and_globals_stay_known():
+    result = run("set_standard_digital_out(2, True)\n"
+                 "write_output_integer_register(3, 7)\n"
+                 "set_flag(1, True)\n"
+                 "a = get_standard_digital_out(2)\n"
+                 "b = read_output_integer_register(3)\n"
+                 "c = get_flag(1)\n")
+    assert (result.globals["a"], result.globals["b"], result.globals["c"]) == (True, 7, True)
+    assert not result.warnings
+
+
+def test_operator_prompt_takes_robot_time():
+    result = run('n = request_integer_from_primary_client("How many parts?")\n')
+    assert result.error is None and type(result.globals["n"]) is Unknown
+    assert result.time >= OPERATOR_REPLY_TIME
+
+
+def test_a_thread_looping_on_an_input_without_sync_is_still_stopped():
+    result = run("thread watch():\n"
+                 "  while True:\n"
+                 "    if get_standard_digital_in(0):\n"
+                 "      x = 1\n"
+                 "    end\n"
+                 "  end\n"
+                 "end\n"
+                 "run watch()\n"
+                 "sleep(1)\n", runaway_limit=5_000)
+    assert result.error is not None and result.error.diagnostic.code == "URS207"
+
+
+def test_real_errors_on_known_values_stay_errors():
+    result = run("r = read_input_integer_register(0)\nx = [1, 2][5]\n")
+    assert result.error is not None and result.error.diagnostic.code == "URS202"
+
+
+def test_unknown_index_makes_the_list_unknown_not_wrong():
+    result = run("l = [1, 2, 3]\nl[read_input_integer_register(0)] = 9\n")
+    assert result.error is None and type(result.globals["l"]) is Unknown
+
+
+def test_quiet_socket_read_with_timeout_0_waits_for_ever():
+    result = run('x = socket_read_byte_list(1, "g", 0)\n', devices="quiet")
+    assert result.error is None
+    assert result.stopped_early is not None and result.stopped_early.kind == "blocked"
+    assert "waits for ever" in result.stopped_early.message
+    assert result.stopped_early.span.line == 1
+
+
+def test_list_values_keep_their_type():
+    result = run("x = [1, 2]\n")
+    assert result.globals["x"] == ListValue([1, 2])
+
+
+def test_and_or_with_an_unknown_on_either_side():
+    result = run("r = get_standard_digital_in(0)\n"
+                 "a = True and r\nb = r and False\nc = False or r\nd = r or True\n")
+    assert result.error is None, result.error
+    assert type(result.globals["a"]) is Unknown and result.globals["b"] is False
+    assert type(result.globals["c"]) is Unknown and result.globals["d"] is True
+
+
+def test_textmsg_of_an_unknown_prints_a_question_mark():
+    result = run('textmsg("reply: ", read_input_integer_register(1))\n')
+    assert result.error is None and result.events[-1].message == "reply: ?"
+
+
+_KNOWN = {
+    "int": "3", "float": "2.5", "bool": "True", "string": '"ok"', "list": "[1, 2, 3]",
+    "matrix": "[[1, 2], [3, 4]]", "pose": "p[0.1, 0, 0.2, 0, 3.14, 0]",
+}
+
+
+@settings(max_examples=60, deadline=None)
+@given(op=st.sampled_from(["+", "-", "*", "/", "%", "<", ">", "<=", ">=", "==", "!=", "and",
+                           "or", "xor"]),
+       known=st.sampled_from(sorted(_KNOWN)), unknown_left=st.booleans())
+def test_an_operation_with_an_unknown_operand_never_fails(op, known, unknown_left):
+    """Law: an operator on an unknown value gives an unknown value, or (and/or) the value
+    it is decided by; it fails only when the known operand is wrong on its own (a boolean
+    operator on something that is not a bool)."""
+    left, right = ("r", _KNOWN[known]) if unknown_left else (_KNOWN[known], "r")
+    result = run(f"r = read_input_integer_register(0)\nx = {left} {op} {right}\n")
+    if op in ("and", "or", "xor") and known != "bool":
+        assert result.error is not None and result.error.diagnostic.code == "URS203"
+        return
+    assert result.error is None, result.error
+    x = result.globals["x"]
+    assert type(x) is Unknown or (op in ("and", "or") and type(x) is bool)
+
+
+def test_boolean_registers_go_up_to_127():
+    result = run("write_output_boolean_register(100, True)\n"
+                 "a = read_output_boolean_register(100)\n"
+                 "b = read_input_boolean_register(127)\n")
+    assert result.error is None and result.globals["a"] is True
+    assert type(result.globals["b"]) is Unknown

@@ -1,0 +1,164 @@
+"""``urdsl check`` always ends: the wall-clock bound, the controller's limits, and every
+hang of issue 14 as a regression test; device replies are unknown, not none."""
+
+from __future__ import annotations
+
+import pytest
+
+from urdsl.cli import main
+from urdsl.verify.run import CheckOptions, check_text
+
+Q = "[0, -1.5, 1.5, -1.5, -1.5, 0.5]"
+
+
+def check(text: str, **options):
+    options.setdefault("self_collision", False)
+    return check_text(text, "prog.script", options=CheckOptions(**options))
+
+
+def codes(report) -> list[str]:
+    return [f.code for f in report.findings]
+
+
+def only(report, code: str):
+    found = [f for f in report.findings if f.code == code]
+    assert len(found) == 1, report.findings
+    return found[0]
+
+
+# ---- the wall-clock bound ----------------------------------------------------------------------
+
+
+def test_an_endless_program_stops_at_the_wall_clock_bound_and_says_where(tmp_path, capsys):
+    path = tmp_path / "endless.script"
+    path.write_text("i = 0\nwhile True:\n  i = i + 1\n  sync()\nend\n")
+    status = main(["check", str(path), "--max-time", "1e9", "--timeout", "0.3"])
+    out = capsys.readouterr().out
+    assert status == 0  # a warning: the program has no error that was found
+    assert "URS313" in out and "wall-clock bound of 0.3 s" in out
+    assert "endless.script:2:1" in out and "robot time" in out
+
+
+def test_timeout_must_be_positive(tmp_path, capsys):
+    path = tmp_path / "p.script"
+    path.write_text("x = 1\n")
+    with pytest.raises(SystemExit) as stop:
+        main(["check", str(path), "--timeout", "0"])
+    assert stop.value.code == 2
+    assert "--timeout" in capsys.readouterr().err
+
+
+# ---- issue 14: reproducers that hung or ate memory -------------------------------------------
+
+
+def test_sleep_0_loop_is_a_runaway_not_a_hang():
+    report = check("while True:\n  sleep(0)\nend\n")
+    assert only(report, "URS207").span.line == 1
+
+
+def test_socket_read_with_timeout_0_on_a_socket_nobody_opened_waits_for_ever():
+    report = check('while True:\n  socket_read_byte_list(1, "g", 0)\nend\n')
+    finding = only(report, "URS313")
+    assert finding.span.line == 2 and "waits for ever" in finding.message
+    assert "socket 'g' is not open" in finding.message
+
+
+def test_the_same_read_in_a_thread_while_main_sleeps():
+    report = check('thread t():\n  while True:\n    socket_read_byte_list(1, "g", 0)\n'
+                   '  end\nend\nrun t()\nsleep(10)\n')
+    assert only(report, "URS313").span.line == 3
+    assert report.cycle_time == pytest.approx(10.0)
+
+
+def test_a_thread_that_loops_on_sleep_0_while_main_sleeps_is_a_runaway():
+    report = check("thread t():\n  while True:\n    sleep(0)\n  end\nend\nrun t()\nsleep(10)\n")
+    assert only(report, "URS207").span.line == 2
+
+
+def test_a_thread_that_runs_itself_ends():
+    report = check("thread t():\n  run t()\nend\nrun t()\nsleep(100)\n", max_time=200)
+    assert "URS313" not in codes(report)
+    assert report.cycle_time == pytest.approx(100.0)
+
+
+def test_a_thread_per_command_never_ended_hits_the_thread_limit():
+    report = check("thread w():\n  while True:\n    sync()\n  end\nend\n"
+                   "while True:\n  run w()\n  sleep(0.01)\nend\n", max_time=3600)
+    finding = only(report, "URS208")
+    assert finding.span.line == 7 and "threads would run at once" in finding.message
+
+
+def test_threads_that_end_do_not_pile_up():
+    report = check("thread w():\n  sleep(0.001)\nend\n"
+                   "i = 0\nwhile i < 2000:\n  h = run w()\n  join h\n  i = i + 1\nend\n")
+    assert not [f for f in report.findings if f.severity == "error"], report.findings
+
+
+def test_a_list_that_doubles_is_stopped_at_the_line():
+    report = check("x = [1, 2]\nwhile True:\n  x = [x, x]\n  sync()\nend\n")
+    finding = only(report, "URS203")
+    assert finding.span.line == 3 and "matrix" in finding.message
+
+
+def test_a_string_that_doubles_is_stopped_at_the_line():
+    report = check('s = "ab"\nwhile True:\n  s = s + s\n  sync()\nend\n')
+    finding = only(report, "URS203")
+    assert finding.span.line == 3 and "1023 bytes" in finding.message
+
+
+def test_a_struct_that_doubles_is_stopped_at_the_line():
+    report = check("s = struct(a=1)\nwhile True:\n  s = struct(a=s, b=s)\n  sync()\nend\n")
+    assert only(report, "URS202").span.line == 3
+
+
+def test_huge_make_list_is_stopped():
+    assert only(check("x = make_list(1000000000, 0)\n"), "URS202").span.line == 1
+
+
+@pytest.mark.parametrize("arguments", ["t=1e4", "t=1e6", "t=1e300", "a=1e-300, v=1e-300"])
+def test_slow_moves_are_sampled_only_up_to_max_time(arguments):
+    report = check(f"movej({Q}, {arguments})\n", max_time=10)
+    assert report.trace.duration <= 10.0 + 1e-9
+    assert len(report.trace.times) <= 10.0 / 0.002 + 2
+    assert report.cycle_time == pytest.approx(10.0)
+    assert "URS312" in codes(report)
+
+
+# ---- unknown device values in a whole check -----------------------------------------------------
+
+
+def test_robotiq_style_preamble_checks_without_errors():
+    report = check('rq = rpc_factory("xmlrpc", "http://127.0.0.1:4242/RPC2")\n'
+                   "if not rq.activated():\n"
+                   '  popup("activate the gripper", error=True)\n'
+                   "  halt\n"
+                   "end\n"
+                   f"movej({Q})\n")
+    assert codes(report) == ["URS210"]
+    assert report.findings[0].severity == "warning"
+    assert len(report.moves) == 1  # the move after the check of the reply was planned
+
+
+def test_a_move_to_an_unknown_pose_is_noted_once_and_not_checked():
+    report = check("i = 0\nwhile i < 5:\n"
+                   "  target = p[read_input_float_register(0), 0.3, 0.2, 0, 3.14, 0]\n"
+                   "  movel(target)\n  i = i + 1\nend\n")
+    finding = only(report, "URS210")
+    assert finding.span.line == 4 and "not checked" in finding.message
+    assert not report.moves and "URS301" not in codes(report)
+
+
+def test_exponential_recursion_meets_the_wall_clock_bound():
+    report = check("def f(n):\n  if n > 0:\n    f(n - 1)\n    f(n - 1)\n  end\nend\nf(60)\n",
+                   timeout=0.5)
+    finding = only(report, "URS313")
+    assert "wall-clock bound of 0.5 s" in finding.message and finding.span.line in (3, 4)
+
+
+def test_a_message_at_every_pass_does_not_fill_memory():
+    from urdsl.runtime.interpreter import EVENT_LIMIT
+
+    report = check('while True:\n  textmsg("tick")\n  sync()\nend\n', max_time=30)
+    assert len(report.events) == EVENT_LIMIT + 1  # 15,000 passes; the rest are counted
+    assert report.events[-1].message.startswith("5,0")
+    assert len(report.trace.times) <= 1  # the arm never moved: nothing to sample

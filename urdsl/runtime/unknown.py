@@ -1,0 +1,226 @@
+"""Values from the outside world that an offline check cannot know, and how they are followed.
+
+When the environment's ``devices`` is ``"unknown"`` (``urdsl check``), everything a program
+reads from outside the controller is an :class:`~urdsl.runtime.values.Unknown`:
+
+* socket reads (``socket_read_*``, ``socket_get_var``) and XML-RPC calls (``rpc_factory``
+  handles), Modbus signals, fieldbus (Euromap, ``read_port_*``), tool communication,
+  conveyor ticks;
+* digital and analog inputs (standard, configurable, tool) and the RTDE input registers
+  (``read_input_*_register``);
+* the operator's answers (``request_*_from_primary_client``).
+
+What stays known: the program's own variables, outputs and output registers it wrote itself,
+flags, the arm's own state (``get_actual_joint_positions`` and the like come from the
+simulated arm), socket replies a caller queued in the environment.
+
+An unknown value flows through expressions (arithmetic, comparisons, ``not``, indexing, string
+and list builtins give an unknown value). Where the program decides on one, the checker
+follows the path of a *working* device and says so once per statement (a URS210 warning that
+names the read and its line), never with an error:
+
+* ``if``/``elif`` on an unknown condition takes the branch unless the branch ends the program
+  (``halt``, a ``popup``, a protective stop): an error branch is what a failing device causes;
+* ``while`` on an unknown condition runs at most :data:`UNKNOWN_LOOP_PASSES` passes and then
+  leaves the loop, as a wait loop does when the device answers;
+* a move or a builtin with an unknown argument is not checked (noted once); an unchecked move
+  takes :data:`UNCHECKED_MOVE_TIME` of robot time (a servo or speed command one controller
+  frame) and leaves the arm where it was; string and maths builtins give an unknown result.
+
+Robot time of device replies (chosen, not measured; a real device may be faster or slower):
+:data:`DEVICE_REPLY_TIME` for a reply over a link (a socket read, also with timeout 0, which
+waits for the reply; an XML-RPC call; ``socket_get_var``), :data:`OPERATOR_REPLY_TIME` for an
+operator's answer to a prompt or a blocking popup.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+from ..script import nodes as n
+from .values import ListValue, StructValue, Unknown, has_unknown
+
+__all__ = [
+    "DEVICE_REPLY_TIME", "OPERATOR_REPLY_TIME", "UNCHECKED_MOVE_TIME", "UNKNOWN_LOOP_PASSES",
+    "DEVICE_READS", "OPERATOR_PROMPTS", "ends_program", "unknown_from", "describe",
+]
+
+DEVICE_REPLY_TIME = 0.1
+"""Robot time (s) a device takes to answer a read over a link (socket, XML-RPC)."""
+
+OPERATOR_REPLY_TIME = 10.0
+"""Robot time (s) an operator takes to answer a prompt or close a blocking popup."""
+
+UNCHECKED_MOVE_TIME = 1.0
+"""Robot time (s) a move to an unknown target is assumed to take (it is not planned)."""
+
+UNKNOWN_LOOP_PASSES = 3
+"""Passes a ``while`` loop makes while its condition is unknown before the check leaves it."""
+
+DEVICE_READS = frozenset({
+    "get_standard_digital_in", "get_digital_in", "get_configurable_digital_in",
+    "get_tool_digital_in", "get_standard_analog_in", "get_analog_in", "get_tool_analog_in",
+    "read_input_integer_register", "read_input_float_register",
+    "read_input_boolean_register",
+    "socket_read_string", "socket_read_line", "socket_read_ascii_float",
+    "socket_read_binary_integer", "socket_read_byte_list", "socket_get_var",
+    "modbus_get_signal_status", "modbus_get_error", "modbus_get_time_since_signal_invalid",
+    "read_port_bit", "read_port_register", "get_euromap_input",
+    "get_conveyor_tick_count", "tool_contact",
+})
+"""Builtins whose result comes from outside the controller (unknown offline)."""
+
+OPERATOR_PROMPTS = frozenset({
+    "request_boolean_from_primary_client", "request_float_from_primary_client",
+    "request_integer_from_primary_client", "request_string_from_primary_client",
+})
+"""Builtins that wait for an operator's answer."""
+
+_ENDING_CALLS = frozenset({"popup", "protective_stop", "powerdown", "halt"})
+
+
+def describe(name: str, node: Any) -> str:
+    """How a read is named in messages: ``"socket_read_byte_list() at line 12"``."""
+    line = getattr(getattr(node, "span", None), "line", 0)
+    return f"{name}() at line {line}" if line else f"{name}()"
+
+
+_READS: dict[tuple[str, int], tuple[Any, Unknown]] = {}
+
+
+def unknown_from(name: str, node: Any) -> Unknown:
+    """The unknown result of the read ``name`` at ``node`` (one object per read site: it is
+    immutable, and a loop reads the same site at every pass)."""
+    key = (name, id(node))
+    cached = _READS.get(key)
+    if cached is not None and cached[0] is node:
+        return cached[1]
+    value = Unknown(describe(name, node), getattr(node, "span", None))
+    if len(_READS) > 4096:
+        _READS.clear()
+    _READS[key] = (node, value)
+    return value
+
+
+def ends_program(body: Any) -> bool:
+    """Whether a block ends or stops the program in a way a failing device causes: it holds
+    (outside nested definitions) a ``halt``, a ``popup`` or a protective stop."""
+    stack = list(body or ())
+    while stack:
+        item = stack.pop()
+        if isinstance(item, n.Halt):
+            return True
+        if isinstance(item, (n.FunctionDef, n.ThreadDef, n.SecDef)):
+            continue
+        if isinstance(item, n.ExprStmt):
+            call = item.expr
+            if (isinstance(call, n.Call) and isinstance(call.func, n.Name)
+                    and call.func.id in _ENDING_CALLS):
+                return True
+        elif isinstance(item, n.If):
+            stack.extend(item.body)
+            for branch in item.elifs:
+                stack.extend(branch.body)
+            stack.extend(item.orelse or ())
+        elif isinstance(item, n.While):
+            stack.extend(item.body)
+    return False
+
+
+def first_unknown(values: Any, named: dict | None = None) -> Unknown | None:
+    """The first unknown among call arguments (positional list and keyword dict)."""
+    for value in values:
+        kind = type(value)
+        if kind is Unknown:
+            return value
+        if kind is ListValue or kind is StructValue:
+            found = has_unknown(value)
+            if found is not None:
+                return found
+    if named:
+        return first_unknown(list(named.values()))
+    return None
+
+
+_PASS_THROUGH = frozenset({
+    "textmsg", "popup", "socket_send_string", "socket_send_line", "socket_send_byte",
+    "socket_send_int", "socket_set_var",
+})
+"""Builtins that take an unknown argument as it is (they print or send it)."""
+
+_STORES = frozenset({
+    "set_standard_digital_out", "set_digital_out", "set_configurable_digital_out",
+    "set_tool_digital_out", "set_flag", "set_standard_analog_out", "set_analog_out",
+    "write_output_integer_register", "write_output_float_register",
+    "write_output_boolean_register",
+})
+"""Builtins that store an unknown value where the program reads it back unknown."""
+
+
+def _is_motion(name: str) -> bool:
+    return name.startswith(("move", "servo", "speed")) or name in ("stopj", "stopl")
+
+
+def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, node: Any,
+                 call: Any) -> Any:
+    """Call the builtin ``name`` whose arguments hold the unknown value ``found``: a move is
+    not planned (noted once, it takes :data:`UNCHECKED_MOVE_TIME`), a procedure is skipped
+    (noted once), a function gives an unknown result."""
+    kind = _kind(name, len(values), tuple(named))
+    if kind == "call":
+        return call(values, named, node)
+    if kind == "store":
+        where = values[0] if values else next(iter(named.values()), None)
+        if type(where) is not Unknown:
+            return call(values, named, node)
+        rt.warn_once(f"which output {name}() writes depends on {found.source}, which is "
+                     "unknown offline; not checked", node)
+        return None
+    if kind == "motion":
+        # a servo or speed command lasts a controller frame; a move is taken as
+        # UNCHECKED_MOVE_TIME
+        frame = name.startswith(("servo", "speed"))
+        took = f"{rt.config.step_time:g}" if frame else f"{UNCHECKED_MOVE_TIME:g}"
+        rt.warn_once(f"this move depends on {found.source}, which is unknown offline; the "
+                     f"move is not checked (taken as {took} s where the arm stays)", node)
+        if rt.robot is not None:
+            rt.robot.stop_blending(rt.time)
+        if frame:
+            rt.sync()
+        else:
+            rt.wait(UNCHECKED_MOVE_TIME)
+        return None
+    if kind == "sleep":
+        rt.warn_once(f"this wait depends on {found.source}, which is unknown offline; taken "
+                     "as one controller frame", node)
+        rt.sync()
+        return None
+    if kind == "procedure":
+        rt.warn_once(f"{name}() depends on {found.source}, which is unknown offline; not "
+                     "checked", node)
+        return None
+    return found
+
+
+@functools.lru_cache(maxsize=1024)
+def _kind(name: str, positional: int, keywords: tuple[str, ...]) -> str:
+    """How :func:`unknown_call` treats a call shape: ``call`` (as usual: it takes unknown
+    values, or the call is wrong and reports it), ``store``, ``motion``, ``sleep``,
+    ``procedure`` (skipped) or ``function`` (an unknown result)."""
+    from ..script.builtins import lookup
+
+    row = lookup(name)
+    if row is None or row.argument_problem(positional, keywords) is not None:
+        return "call"  # reports the unknown name or the bad call
+    if name in _PASS_THROUGH:
+        return "call"
+    if name in _STORES:
+        return "store"
+    if _is_motion(name):
+        return "motion"
+    if name == "sleep":
+        return "sleep"
+    if not row.returns or row.returns[0] == "None":
+        return "procedure"
+    return "function"
