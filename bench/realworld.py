@@ -395,7 +395,7 @@ def run(projects: list[Project], root: Path, timeout: float, json_out: Path | No
                         "verdict": s.label.verdict if s.label else None} for s in scored],
             "lost": [dict(zip(LABEL_COLUMNS, (lab.project, lab.tool, lab.file, lab.line,
                                               lab.code, lab.verdict, lab.reason, lab.baseline,
-                                              lab.message))) for lab in lost],
+                                              lab.message), strict=True)) for lab in lost],
         }
         json_out.write_text(json.dumps(document, indent=1), encoding="utf-8")
 
