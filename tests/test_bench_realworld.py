@@ -1,0 +1,93 @@
+"""bench/realworld.py: the manifest and labels are consistent, extraction reads a pinned commit
+from a git directory (no network), and scoring matches findings to labels."""
+
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parent.parent / "bench" / "realworld.py"
+
+
+def _load():
+    spec = importlib.util.spec_from_file_location("realworld_bench", BENCH)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+rw = _load()
+
+
+def test_manifest_split_is_every_third_project_and_commits_are_pinned():
+    projects = rw.read_manifest()
+    assert len(projects) >= 21
+    for project in projects:
+        assert len(project.commit) == 40 and int(project.commit, 16) >= 0
+        assert project.split == ("held" if int(project.id) % 3 == 0 else "tune")
+        assert project.generation in ("cb3", "e-series", "unknown")
+    repos = [project.repo for project in projects]
+    assert max(repos.count(repo) for repo in repos) <= 2
+
+
+def test_every_label_names_a_project_a_tool_and_a_reason():
+    ids = {project.id for project in rw.read_manifest()}
+    labels = rw.read_labels()
+    assert labels
+    for label in labels.values():
+        assert label.project in ids
+        assert label.tool in ("lint", "check")
+        assert label.verdict in ("true", "false")
+        assert label.reason.strip()
+        assert label.baseline in ("yes", "no")
+
+
+@pytest.mark.skipif(shutil.which("git") is None, reason="needs git")
+def test_extract_reads_the_pinned_commit_from_a_nested_git_dir(tmp_path):
+    work = tmp_path / "src"
+    (work / "progs" / "lib").mkdir(parents=True)
+    (work / "progs" / "main.script").write_text("def main():\n  helper()\nend\n")
+    (work / "progs" / "lib" / "helper.script").write_text("def helper():\n  sync()\nend\n")
+    (work / "progs" / "notes.md").write_text("not a program file\n")
+
+    def git(*args: str) -> str:
+        return subprocess.run(["git", "-C", str(work), *args], check=True, capture_output=True,
+                              text=True).stdout.strip()
+
+    git("init", "-q")
+    git("-c", "user.email=a@b", "-c", "user.name=a", "add", ".")
+    git("-c", "user.email=a@b", "-c", "user.name=a", "commit", "-qm", "one")
+    commit = git("rev-parse", "HEAD")
+    (work / "progs" / "main.script").write_text("changed after the pinned commit\n")
+    git("-c", "user.email=a@b", "-c", "user.name=a", "commit", "-qam", "two")
+    repos = tmp_path / "repos"
+    (repos / "someone+cell").mkdir(parents=True)
+    shutil.move(str(work), str(repos / "someone+cell" / "repo"))  # nested clone
+
+    project = rw.Project("7", "someone/cell", commit, "progs", ("*",), "none", "cb3", "none",
+                         "tune", "")
+    out = tmp_path / "out"
+    assert rw.extract([project], repos, out) == 0
+    assert (out / "7" / "main.script").read_text() == "def main():\n  helper()\nend\n"
+    assert (out / "7" / "lib" / "helper.script").exists()
+    assert not (out / "7" / "notes.md").exists()
+
+    missing = rw.Project("8", "someone/absent", commit, ".", ("*",), "none", "cb3", "none",
+                         "tune", "")
+    assert rw.extract([missing], repos, out) == 1
+
+
+def test_precision_counts_labelled_true_and_false_and_leaves_the_rest_unlabelled():
+    label_true = rw.Label("1", "lint", "a.script", 3, "URS101", "true", "real", "yes", "")
+    label_false = rw.Label("1", "lint", "a.script", 4, "URS101", "false", "host", "yes", "")
+    scored = [rw.Scored("1", "tune", "lint", "a.script", 3, "URS101", "", label_true),
+              rw.Scored("1", "tune", "lint", "a.script", 4, "URS101", "", label_false),
+              rw.Scored("1", "tune", "lint", "a.script", 5, "URS101", "", None)]
+    table = "\n".join(rw.precision_table(scored, "t"))
+    assert "URS101        3     1     1     1     50.0%" in table
