@@ -1,0 +1,131 @@
+"""Installation variables: the ``*.variables`` file PolyScope keeps beside an installation
+(``default.variables``), one ``name=value`` line per variable, the value a URScript
+expression (``counter=0``, ``home=p[0.1, -0.4, 0.3, 0, 3.14, 0]``).
+
+Every program run with that installation sees these names as globals. :func:`parse_variables`
+reads the file without ever raising for bad content: a line that is not ``name=value`` or
+whose value is not URScript becomes a diagnostic with ``file:line:col``, the other lines are
+kept.
+
+>>> [(v.name, v.line) for v in parse_variables("a=1\\nb=p[0,0,0,0,0,0]\\n").variables]
+[('a', 1), ('b', 2)]
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..script import nodes as n
+from ..script.diagnostics import Diagnostic, ScriptError
+from ..script.parser import parse
+
+__all__ = ["InstallationVariable", "VariablesFile", "parse_variables", "read_variables"]
+
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_CODE = "URS001"
+
+
+@dataclass(frozen=True)
+class InstallationVariable:
+    """One ``name=value`` line. ``value`` is the parsed URScript expression; ``span`` the
+    place of the name in the file (its line and column are 1-based)."""
+
+    name: str
+    value: n.Expr
+    span: n.Span
+    statement: n.Assign
+
+    @property
+    def line(self) -> int:
+        return self.span.line
+
+
+@dataclass
+class VariablesFile:
+    """A parsed ``.variables`` file: the variables in file order and the problems found."""
+
+    filename: str
+    variables: list[InstallationVariable] = field(default_factory=list)
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+    def names(self) -> dict[str, InstallationVariable]:
+        """Each variable by name (the last line wins, as PolyScope reads the file)."""
+        return {variable.name: variable for variable in self.variables}
+
+
+def parse_variables(text: str, filename: str = "<variables>") -> VariablesFile:
+    """The variables of ``.variables`` text; bad lines become URS001 diagnostics."""
+    result = VariablesFile(filename)
+    source = n.Source(text, filename)
+    lines = text.split("\n")
+    kept = list(lines)
+    good_lines: list[int] = []  # 0-based indices of lines that look like name=value
+    for index, line in enumerate(lines):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            kept[index] = " " * len(line)
+        else:
+            name, equals, _value = line.partition("=")
+            if not equals or not _NAME.fullmatch(name.strip()):
+                column = len(line) - len(line.lstrip()) + 1
+                result.diagnostics.append(Diagnostic(
+                    filename, index + 1, column, "error", _CODE,
+                    "an installation variable line must be name=value",
+                    "write one variable a line, e.g. counter=0", line.rstrip("\r"),
+                    None))
+                kept[index] = " " * len(line)
+            else:
+                good_lines.append(index)
+    # The usual file parses in one go (offsets stay those of the file). Otherwise each line is
+    # parsed alone, after as many line breaks as precede it, so that its line number holds.
+    statements: list[n.Stmt] = []
+    try:
+        module = parse("\n".join(kept), filename)
+        statements = [item for item in module.body if isinstance(item, n.Stmt)]
+    except ScriptError:
+        for index in good_lines:
+            try:
+                module = parse("\n" * index + lines[index], filename)
+            except ScriptError as error:
+                result.diagnostics.append(error.diagnostic)
+                continue
+            statements.extend(item for item in module.body if isinstance(item, n.Stmt))
+    for item in statements:
+        place = n.Span(source, *_file_offsets(source, item.span))  # type: ignore[attr-defined]
+        if isinstance(item, n.Assign) and isinstance(item.target, n.Name):
+            name_place = n.Span(source, *_file_offsets(source, item.target.span))
+            result.variables.append(InstallationVariable(
+                item.target.id, item.value, name_place, item))
+        else:
+            result.diagnostics.append(Diagnostic.at(
+                place, "an installation variable line must be name=value", code=_CODE,
+                hint="write one variable a line, e.g. counter=0"))
+    result.diagnostics.sort(key=lambda d: (d.line, d.column))
+    return result
+
+
+def _file_offsets(source: n.Source, span: n.Span) -> tuple[int, int]:
+    """``span``'s offsets in the file ``source`` (the span may come from a text that holds
+    only its line, after the same number of line breaks)."""
+    if span.source is None:
+        return 0, 0
+    if len(span.source.text) == len(source.text):  # parsed in place: the same offsets
+        return span.start, span.end
+    line, column = span.line, span.column
+    start = len("\n".join(source.text.split("\n")[:line - 1])) + (line > 1) + column - 1
+    return start, start + (span.end - span.start)
+
+
+def read_variables(path: str | Path) -> VariablesFile:
+    """Read and parse a ``.variables`` file; an unreadable file is one diagnostic."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError as error:
+        result = VariablesFile(str(path))
+        result.diagnostics.append(Diagnostic(str(path), 1, 1, "error", _CODE,
+                                             f"cannot read {path}: {error.strerror}"))
+        return result
+    return parse_variables(text, str(path))
