@@ -89,7 +89,21 @@ def lint_document(uri: str, text: str) -> list[types.Diagnostic]:
         tree = parse(text, name)
     except ScriptError as error:
         return [to_lsp_diagnostic(error.diagnostic)]
-    return [to_lsp_diagnostic(d) for d in lint_tree(tree, _settings(uri))]
+    return [to_lsp_diagnostic(d) for d in lint_tree(tree, _settings(uri),
+                                                    _project(path, text, name))]
+
+
+def _project(path: str | None, text: str, name: str):
+    """The project context of a file on disk (with the editor's text for the file itself),
+    or None for a buffer that is not a file or a project urdsl cannot read."""
+    if not path or not Path(path).parent.is_dir():
+        return None
+    from ..project import Project, ProjectError
+
+    try:
+        return Project.discover(path).context(path, text, name)
+    except (ProjectError, OSError):
+        return None
 
 
 def hover_text(text: str, word: str) -> str | None:

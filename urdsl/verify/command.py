@@ -90,13 +90,19 @@ def add_commands(commands) -> None:
                    help="write a plot of joint positions, speeds and the TCP path")
     p.add_argument("--all-moves", action="store_true",
                    help="list every move in the text report (default: the first 20)")
+    p.add_argument("--include", action="append", default=[], metavar="FILE",
+                   help="another file of the project whose definitions the program uses "
+                   "(a script file, a .variables file); repeatable")
+    p.add_argument("--no-project", action="store_true",
+                   help="check the file alone, not in the context of its project (host "
+                   "program, sibling script files, installation variables)")
     p.set_defaults(run=cmd_check)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
     from ..kinematics import MODELS
-    from .run import DEFAULT_START, CheckOptions, check_text
+    from .run import DEFAULT_START, CheckOptions
 
     robot = args.robot.lower()
     if robot not in MODELS:
@@ -128,7 +134,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                 continue
         else:
             source = read_input(name)
-            report = check_text(source.text, source.name, options=options)
+            report = _check_script(source, args, options)
         reports.append(report)
         if not args.json:
             _print(report, args.all_moves)
@@ -142,6 +148,33 @@ def cmd_check(args: argparse.Namespace) -> int:
         reports[0].plot(args.plot)
         print(f"plot written to {args.plot}", file=sys.stderr)
     return EXIT_PROBLEMS if failed or any(r.has_errors for r in reports) else EXIT_OK
+
+
+def _check_script(source, args: argparse.Namespace, options):
+    """Check a script file in its project's context (a fragment runs with the definitions
+    it takes from its host program, sibling files and installation variables)."""
+    from ..cli import UsageError
+    from ..project import ProjectError
+    from ..project.check import in_context
+    from ..script.diagnostics import ScriptError
+    from ..script.parser import parse
+    from .run import check_text, check_tree
+
+    if args.no_project or source.path is None:
+        return check_text(source.text, source.name, options=options)
+    try:
+        module = parse(source.text, source.name)
+    except ScriptError:
+        return check_text(source.text, source.name, options=options)  # reports the syntax
+    try:
+        context = in_context(source.path, source.text, module, source.name, args.include)
+    except ProjectError as error:
+        raise UsageError(str(error)) from None
+    if context is None:
+        return check_tree(module, source.name, options)
+    report = check_tree(context.module, source.name, options)
+    report.context = context.note
+    return report
 
 
 def _load_cell(robot: str, path: str):
