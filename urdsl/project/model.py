@@ -20,6 +20,7 @@ fragment's file, or when the fragment's code lines are found inlined in the host
 
 from __future__ import annotations
 
+import os
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -124,6 +125,14 @@ class FileContext:
     def host_names(self) -> list[str]:
         return [host.filename for host in self.hosts]
 
+    def near(self, filename: str) -> str:
+        """``filename`` as seen from this file's folder (``robotiq.script``,
+        ``../lib/math.script``)."""
+        try:
+            return os.path.relpath(filename, os.path.dirname(self.file.filename) or ".")
+        except ValueError:
+            return filename
+
     def resolve_read(self, name: str) -> Resolution | None:
         """A variable read here that this file does not define (None: defined nowhere)."""
         return self._resolve(name, _READ_KINDS)
@@ -168,22 +177,23 @@ class FileContext:
         if not found:
             return None
         relation, definition = found[0]
-        where = definition.where
+        where = f"{self.near(definition.filename)}:{definition.line}"
+        other = self.near(definition.filename)
         if relation in ("variables", "host", "included", "explicit"):
             return Resolution(definition, None, f"'{name}' is defined in {where}")
         if self.hosts:
-            hosts = _join(self.host_names)
+            hosts = _join([self.near(h) for h in self.host_names])
             return Resolution(
                 definition, "info",
                 f"'{name}' is defined in {where}, which {hosts} does not include",
-                f"{hosts} includes this file; if it should run {definition.filename} too, "
+                f"{hosts} includes this file; if it should run {other} too, "
                 "add it to the program (a Script node in PolyScope)")
         if self.role == "host":
             return Resolution(
                 definition, "error",
                 f"'{name}' is not defined in this program ({where} defines it, but this "
                 "program does not include it)",
-                f"add {definition.filename} to the program (a Script node in PolyScope)")
+                f"add {other} to the program (a Script node in PolyScope)")
         return Resolution(
             definition, "warning",
             f"'{name}' is defined in {where}; this file looks like a fragment that a program "

@@ -1,0 +1,93 @@
+"""``urdsl check`` of a fragment: it runs with the definitions it takes from its host
+program, sibling files and installation variables, and the report says so."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from urdsl.cli import main
+from urdsl.project.check import in_context, needed_names
+from urdsl.script.parser import parse
+
+DATA = Path(__file__).parent / "data" / "projects"
+
+HOST = """def cell():
+  $ 1 "Robot Program"
+  global far = p[2.0, 0.0, 0.3, 0.0, 3.1416, 0.0]
+  def reach_far():
+    movel(far, a=1.0, v=0.1)
+  end
+  $ 2 "Script: task.script"
+  textmsg("task")
+  reach_far()
+end
+"""
+
+
+def check(capsys, *argv) -> tuple[int, dict]:
+    status = main(["check", "--json", *argv])
+    out, _ = capsys.readouterr()
+    return status, json.loads(out)
+
+
+def test_a_fragment_runs_in_its_hosts_context(capsys):
+    status, report = check(capsys, str(DATA / "cell" / "pick.script"))
+    assert status == 0
+    assert report["findings"] == []
+    assert report["context"].startswith("checked in the context of ")
+    assert "main.script" in report["context"]
+    assert [m["kind"] for m in report["moves"]] == ["movej", "movel"]
+
+
+def test_alone_the_fragment_fails_on_the_hosts_names(capsys):
+    status, report = check(capsys, "--no-project", str(DATA / "cell" / "pick.script"))
+    assert status == 1
+    assert report["context"] is None
+    assert report["findings"][0]["message"] == "name 'home_q' is not defined"
+
+
+def test_a_subprogram_file_runs_with_its_callers_globals(capsys):
+    status, report = check(capsys, str(DATA / "subprogram" / "SubProgram_1.script"))
+    assert status == 0 and len(report["moves"]) == 1
+
+
+def test_a_message_about_a_host_definition_names_the_host_file(tmp_path, capsys):
+    (tmp_path / "cell.script").write_text(HOST)
+    (tmp_path / "task.script").write_text('textmsg("task")\nreach_far()\n')
+    status, report = check(capsys, str(tmp_path / "task.script"))
+    assert status == 1
+    finding = report["findings"][0]
+    assert finding["code"] == "URS301"
+    assert (Path(finding["file"]).name, finding["line"]) == ("cell.script", 5)
+    assert "cell.script" in report["context"]
+
+
+def test_text_report_says_which_host(capsys):
+    status = main(["check", str(DATA / "cell" / "pick.script")])
+    out, _ = capsys.readouterr()
+    assert status == 0
+    assert "checked in the context of" in out and "main.script" in out
+
+
+def test_installation_variables_reach_a_complete_program(capsys):
+    status, report = check(capsys, str(DATA / "cell" / "main.script"))
+    assert status == 0
+    assert "default.variables" in report["context"]
+    assert [e["message"] for e in report["events"] if e["kind"] == "textmsg"] == ["0"]
+
+
+def test_definitions_come_before_what_uses_them():
+    path = DATA / "cell" / "pick.script"
+    text = path.read_text()
+    context = in_context(path, text, parse(text, str(path)), use_config=False)
+    order = [d.name for d in context.definitions]
+    assert order.index("rq_speed") < order.index("rq_open")
+    assert set(order) == {"home_q", "pick_p", "part_count", "rq_speed", "rq_open", "rq_close"}
+    assert needed_names(context.module) == (set(), set(), set())
+
+
+def test_a_file_that_needs_nothing_is_left_alone(tmp_path):
+    (tmp_path / "a.script").write_text("textmsg(1)\n")
+    text = "textmsg(1)\n"
+    assert in_context(tmp_path / "a.script", text, parse(text), use_config=False) is None
