@@ -50,3 +50,12 @@ def test_any_text_gives_variables_or_diagnostics_never_an_exception(text):
             variable.name
     for diagnostic in result.diagnostics:
         assert diagnostic.line >= 1
+
+
+def test_polyscope_writes_a_java_properties_file():
+    text = '#\n#Mon May 11 15:45:38 CEST 2026\nheight=355\nlabel="a\\:b\\u00e9"\nok=True\n'
+    result = parse_variables(text, "default.variables")
+    assert result.diagnostics == []
+    assert [(v.name, v.line) for v in result.variables] == [
+        ("height", 3), ("label", 4), ("ok", 5)]
+    assert result.names()["label"].value == n.String("a:bé")

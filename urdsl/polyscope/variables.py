@@ -1,6 +1,7 @@
 """Installation variables: the ``*.variables`` file PolyScope keeps beside an installation
 (``default.variables``), one ``name=value`` line per variable, the value a URScript
-expression (``counter=0``, ``home=p[0.1, -0.4, 0.3, 0, 3.14, 0]``).
+expression (``counter=0``, ``home=p[0.1, -0.4, 0.3, 0, 3.14, 0]``). PolyScope writes it as a
+Java properties file: ``#`` comment lines (a time stamp), ``\\:`` and ``\\=`` escapes.
 
 Every program run with that installation sees these names as globals. :func:`parse_variables`
 reads the file without ever raising for bad content: a line that is not ``name=value`` or
@@ -61,10 +62,11 @@ def parse_variables(text: str, filename: str = "<variables>") -> VariablesFile:
     source = n.Source(text, filename)
     lines = text.split("\n")
     kept = list(lines)
+    escaped = False
     good_lines: list[int] = []  # 0-based indices of lines that look like name=value
     for index, line in enumerate(lines):
         stripped = line.strip()
-        if not stripped or stripped.startswith("#"):
+        if not stripped or stripped.startswith(("#", "!")):
             kept[index] = " " * len(line)
         else:
             name, equals, _value = line.partition("=")
@@ -78,10 +80,16 @@ def parse_variables(text: str, filename: str = "<variables>") -> VariablesFile:
                 kept[index] = " " * len(line)
             else:
                 good_lines.append(index)
+                if "\\" in line:  # a Java properties escape (\:, \=, \uXXXX)
+                    lines[index] = name + "=" + _unescape(_value)
+                    kept[index] = " " * len(line)
+                    escaped = True
     # The usual file parses in one go (offsets stay those of the file). Otherwise each line is
     # parsed alone, after as many line breaks as precede it, so that its line number holds.
     statements: list[n.Stmt] = []
     try:
+        if escaped:
+            raise ScriptError(Diagnostic(filename, 1, 1, "error", _CODE, "escapes"))
         module = parse("\n".join(kept), filename)
         statements = [item for item in module.body if isinstance(item, n.Stmt)]
     except ScriptError:
@@ -104,6 +112,22 @@ def parse_variables(text: str, filename: str = "<variables>") -> VariablesFile:
                 hint="write one variable a line, e.g. counter=0"))
     result.diagnostics.sort(key=lambda d: (d.line, d.column))
     return result
+
+
+_ESCAPE = re.compile(r"\\(u[0-9a-fA-F]{4}|.)")
+_ESCAPES = {"t": "\t", "n": "\n", "r": "\r", "f": "\f"}
+
+
+def _unescape(value: str) -> str:
+    """A value as Java's ``Properties`` reads it (PolyScope writes the file with it):
+    ``\\:`` is ``:``, ``\\u00e9`` is ``é``."""
+    def replace(match: re.Match) -> str:
+        code = match.group(1)
+        if len(code) == 5:
+            return chr(int(code[1:], 16))
+        return _ESCAPES.get(code, code)
+
+    return _ESCAPE.sub(replace, value)
 
 
 def _file_offsets(source: n.Source, span: n.Span) -> tuple[int, int]:
