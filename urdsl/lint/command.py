@@ -180,7 +180,7 @@ def cmd_lint(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
     from . import report
     from .config import ConfigError, settings_for
-    from .linter import lint_text
+    from .linter import lint_text, lint_tree
 
     select = [c for group in args.select or [] for c in group] or None
     ignore = [c for group in args.ignore or [] for c in group]
@@ -210,7 +210,12 @@ def cmd_lint(args: argparse.Namespace) -> int:
             if name == "-":
                 context = context.project.context(path, source.text, label)
             found.extend(extra)
-        found.extend(lint_text(source.text, label, settings, project=context))
+        parsed = context.file if context is not None else None
+        if (parsed is not None and parsed.module is not None and parsed.filename == label
+                and parsed.text == source.text):
+            found.extend(lint_tree(parsed.module, settings, project=context))  # parsed once
+        else:
+            found.extend(lint_text(source.text, label, settings, project=context))
     if args.format == "json":
         sys.stdout.write(report.render_json(found))
     elif args.format == "sarif":

@@ -21,6 +21,7 @@ fragment's file, or when the fragment's code lines are found inlined in the host
 from __future__ import annotations
 
 import os
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -73,8 +74,8 @@ class Definition:
 @dataclass(eq=False)
 class ScriptFile:
     """One script file of the project, parsed. ``program`` is the name of the wrapping
-    ``def`` when the file is a host, else None; ``labels`` the file names of its
-    ``Script:`` labels; ``module`` None when the file does not parse."""
+    ``def`` when the file is a host, else None; ``labels`` the file names (without folders)
+    of its ``Script:`` labels; ``module`` None when the file does not parse."""
 
     path: Path
     filename: str
@@ -158,18 +159,17 @@ class FileContext:
                     found.append(("variables", Definition(
                         name, "installation variable", variables.filename, variable.span,
                         variable.statement)))
-        seen = {id(self.file)}
-        explicit = [s for s in self.project.files if self.project.is_explicit(s)]
-        groups = (("host", self.hosts), ("included", self.included), ("explicit", explicit),
-                  ("other", self.project.files))
-        for relation, files in groups:
-            for script in files:
-                if id(script) in seen:
-                    continue
-                seen.add(id(script))
-                for definition in script.definitions.get(name, []):
-                    if definition.kind in kinds:
-                        found.append((relation, definition))
+        hosts = {id(s) for s in self.hosts}
+        included = {id(s) for s in self.included}
+        order = {"host": 0, "included": 1, "explicit": 2, "other": 3}
+        ranked = []
+        for index, (script, definition) in enumerate(self.project.defined(name)):
+            if script is self.file or definition.kind not in kinds:
+                continue
+            relation = ("host" if id(script) in hosts else "included" if id(script) in included
+                        else "explicit" if self.project.is_explicit(script) else "other")
+            ranked.append((order[relation], index, relation, definition))
+        found.extend((relation, definition) for _o, _i, relation, definition in sorted(ranked))
         return found
 
     def _resolve(self, name: str, kinds: frozenset[str]) -> Resolution | None:
@@ -177,10 +177,10 @@ class FileContext:
         if not found:
             return None
         relation, definition = found[0]
-        where = f"{self.near(definition.filename)}:{definition.line}"
-        other = self.near(definition.filename)
         if relation in ("variables", "host", "included", "explicit"):
-            return Resolution(definition, None, f"'{name}' is defined in {where}")
+            return Resolution(definition, None, f"'{name}' is defined in {definition.where}")
+        other = self.near(definition.filename)
+        where = f"{other}:{definition.line}"
         if self.hosts:
             hosts = _join([self.near(h) for h in self.host_names])
             return Resolution(
@@ -216,6 +216,10 @@ class Project:
     explicit: frozenset[str] = frozenset()
     """Resolved paths of the files named with ``include`` or in the configuration."""
     _hosts: dict[int, list[ScriptFile]] | None = field(default=None, repr=False)
+    _by_path: dict[str, ScriptFile] | None = field(default=None, repr=False)
+    _explicit_ids: dict[int, bool] = field(default_factory=dict, repr=False)
+    _by_name: dict[str, list[tuple[ScriptFile, Definition]]] | None = field(
+        default=None, repr=False)
 
     # -- discovery ---------------------------------------------------------------------------
 
@@ -232,8 +236,9 @@ class Project:
         else:
             root = path.parent if str(path.parent) else Path(".")
             found = [p for p in sorted(root.iterdir()) if _wanted(p)] if root.is_dir() else []
-            if path.is_file() and not any(_same(path, p) for p in found):
+            if path.is_file() and _key(path) not in {_key(p) for p in found}:
                 found.append(path)
+        known = {_key(p) for p in found}
         extra = [Path(p) for p in include]
         if use_config:
             extra += configured_includes(root)
@@ -243,8 +248,10 @@ class Project:
             for candidate in candidates:
                 if not candidate.is_file():
                     continue
-                explicit.add(_key(candidate))
-                if not any(_same(candidate, p) for p in found):
+                key = _key(candidate)
+                explicit.add(key)
+                if key not in known:
+                    known.add(key)
                     found.append(candidate)
         scripts = [load_script(p) for p in found if p.suffix in SCRIPT_SUFFIXES]
         variables = [read_variables(p) for p in found if p.suffix == VARIABLES_SUFFIX]
@@ -254,14 +261,26 @@ class Project:
 
     def is_explicit(self, script: ScriptFile) -> bool:
         """Whether ``script`` was named with ``include`` or in the configuration."""
-        return bool(self.explicit) and _key(script.path) in self.explicit
+        if not self.explicit:
+            return False
+        if id(script) not in self._explicit_ids:
+            self._explicit_ids[id(script)] = _key(script.path) in self.explicit
+        return self._explicit_ids[id(script)]
 
     def find(self, path: str | Path) -> ScriptFile | None:
         """The project's script file at ``path``, if it is one."""
-        for script in self.files:
-            if _same(script.path, Path(path)):
-                return script
-        return None
+        if self._by_path is None:
+            self._by_path = {_key(script.path): script for script in self.files}
+        return self._by_path.get(_key(Path(path)))
+
+    def defined(self, name: str) -> list[tuple[ScriptFile, Definition]]:
+        """Every definition of ``name`` in the project's script files, in file order."""
+        if self._by_name is None:
+            self._by_name = {}
+            for script in self.files:
+                for key, found in script.definitions.items():
+                    self._by_name.setdefault(key, []).extend((script, d) for d in found)
+        return self._by_name.get(name, [])
 
     def hosts_of(self, script: ScriptFile) -> list[ScriptFile]:
         """The hosts that include ``script`` (by ``Script:`` label or inlined code)."""
@@ -291,7 +310,7 @@ class Project:
                 self.files = [replacement if s is script else s for s in self.files]
             else:
                 self.files = [*self.files, replacement]
-            self._hosts = None
+            self._hosts = self._by_path = self._by_name = None
             script = replacement
         hosts = self.hosts_of(script)
         included = [s for s in self.files if s is not script and script.is_host
@@ -334,13 +353,6 @@ def _key(path: Path) -> str:
         return str(path)
 
 
-def _same(a: Path, b: Path) -> bool:
-    try:
-        return a.resolve() == b.resolve()
-    except OSError:
-        return a == b
-
-
 _CACHE: dict[tuple[str, str, int, int], ScriptFile] = {}
 
 
@@ -376,14 +388,14 @@ def script_file(path: Path, filename: str, text: str) -> ScriptFile:
     except (ScriptError, RecursionError):
         return ScriptFile(path, filename, text, None, code_lines=frozenset(lines),
                           code_line_list=lines)
-    program = program_name(module)
-    labels = tuple(_labels(module))
+    program = program_name(module, text)
+    labels = tuple(_labels(text))
     definitions, top_level = _definitions(module, filename, program)
     return ScriptFile(path, filename, text, module, program, labels, definitions, top_level,
                       frozenset(lines), lines)
 
 
-def program_name(module: n.Module) -> str | None:
+def program_name(module: n.Module, text: str | None = None) -> str | None:
     """The name of the wrapping ``def`` when ``module`` is a complete program: one
     ``def`` without parameters followed by a call of it, or alone with PolyScope's ``$``
     labels in it (as PolyScope exports a program). A lone ``def`` without labels is taken
@@ -396,6 +408,8 @@ def program_name(module: n.Module) -> str | None:
         return None
     rest = statements[1:]
     if not rest:  # PolyScope writes the def alone, with its $ labels
+        if text is not None:
+            return program.name if _MARKER_LINE.search(text) else None
         return program.name if any(isinstance(x, n.Marker) for x in n.walk(program)) else None
     if len(rest) == 1 and isinstance(rest[0], n.ExprStmt):
         call = rest[0].expr
@@ -405,14 +419,16 @@ def program_name(module: n.Module) -> str | None:
     return None
 
 
-def _labels(module: n.Module) -> list[str]:
-    labels = []
-    for node in n.walk(module):
-        if isinstance(node, n.Marker):
-            text = node.text.strip()
-            if text.lower().startswith("script:"):
-                labels.append(text.split(":", 1)[1].strip())
-    return labels
+_MARKER_LINE = re.compile(r"^[ \t]*\$[ \t]*\d", re.MULTILINE)
+_SCRIPT_LABEL = re.compile(
+    r'^[ \t]*\$[ \t]*\d+[ \t]*"?[ \t]*Script:[ \t]*([^"\r\n]+?)[ \t]*"?[ \t]*'
+    r'(?:"[^"\r\n]*"[ \t]*)?\r?$', re.MULTILINE | re.IGNORECASE)
+
+
+def _labels(text: str) -> list[str]:
+    """The file names (without folders) of the ``$ N "Script: name.script"`` labels in
+    ``text``."""
+    return [re.split(r"[\\/]", match.group(1))[-1] for match in _SCRIPT_LABEL.finditer(text)]
 
 
 def _definitions(module: n.Module, filename: str, program: str | None
@@ -472,7 +488,7 @@ def _code_lines(text: str) -> list[str]:
 def _includes(host: ScriptFile, fragment: ScriptFile) -> bool:
     """Whether ``host`` includes ``fragment`` (a ``Script:`` label, or its code inlined)."""
     name = fragment.path.name.lower()
-    if any(Path(label).name.lower() == name for label in host.labels):
+    if any(label.lower() == name for label in host.labels):
         return True
     lines = fragment.code_line_list
     if not lines:
