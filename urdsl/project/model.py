@@ -20,6 +20,7 @@ fragment's file, or when the fragment's code lines are found inlined in the host
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import tomllib
@@ -235,7 +236,10 @@ class Project:
             found = _tree(path)
         else:
             root = path.parent if str(path.parent) else Path(".")
-            found = [p for p in sorted(root.iterdir()) if _wanted(p)] if root.is_dir() else []
+            try:
+                found = [p for p in sorted(root.iterdir()) if _wanted(p)]
+            except OSError:  # no such folder, or not allowed to list it
+                found = []
             if path.is_file() and _key(path) not in {_key(p) for p in found}:
                 found.append(path)
         known = {_key(p) for p in found}
@@ -331,9 +335,11 @@ def _wanted(path: Path) -> bool:
 def _tree(folder: Path) -> list[Path]:
     if not folder.is_dir():
         return []
-    return sorted(
-        p for p in folder.rglob("*")
-        if _wanted(p) and not any(part.startswith(".") for part in p.parts[len(folder.parts):]))
+    with contextlib.suppress(OSError):
+        return sorted(
+            p for p in folder.rglob("*")
+            if _wanted(p) and not any(part.startswith(".") for part in p.parts[len(folder.parts):]))
+    return []
 
 
 def _display(path: Path) -> str:
