@@ -117,3 +117,17 @@ def test_the_language_server_lints_a_file_on_disk_in_its_project():
     text = path.read_text() + "no_such_function()\n"
     found = lint_document(uri, text)
     assert [(d.code, d.range.start.line) for d in found] == [("URS102", 6)]
+
+
+def test_the_language_server_goes_to_a_definition_in_another_file():
+    from urdsl.lint.lsp import project_definition
+
+    path = DATA / "cell" / "pick.script"
+    uri = "file://" + os.path.abspath(path)
+    location = project_definition(uri, path.read_text(), "rq_open")
+    assert location.uri == (DATA / "cell" / "main.script").resolve().as_uri()
+    assert location.range.start.line == 6  # 0-based: line 7, the name after 'def '
+    assert location.range.start.character == 6
+    variable = project_definition(uri, path.read_text(), "part_count")
+    assert variable.uri.endswith("default.variables")
+    assert project_definition(uri, path.read_text(), "no_such_name") is None

@@ -168,6 +168,26 @@ def definition_of(text: str, word: str) -> n.Span | None:
     return None
 
 
+def project_definition(uri: str, text: str, word: str) -> types.Location | None:
+    """Where another file of the document's project (its host program, a sibling script
+    file, the installation variables) defines ``word``."""
+    path = _path(uri)
+    context = _project(path, text, Path(path).name) if path else None
+    if context is None:
+        return None
+    kinds = frozenset(("function", "thread", "global", "installation variable"))
+    found = context.definitions(word, kinds)
+    if not found:
+        return None
+    definition = found[0][1]
+    span = definition.span
+    if definition.kind in ("function", "thread"):
+        span = _name_span(definition.node)
+    if span.source is None:
+        return None
+    return types.Location(Path(definition.filename).resolve().as_uri(), _range(span))
+
+
 def _name_span(node: n.Node) -> n.Span:
     span = node.span  # type: ignore[attr-defined]
     match = re.compile(rf"\b{re.escape(node.name)}\b").search(  # type: ignore[attr-defined]
@@ -229,7 +249,8 @@ def build_server():
         word = word_at(document.source, params.position.line, params.position.character)
         span = definition_of(document.source, word) if word else None
         if span is None or span.source is None:
-            return None
+            return project_definition(params.text_document.uri, document.source, word) \
+                if word else None
         return types.Location(params.text_document.uri, _range(span))
 
     @server.feature(types.TEXT_DOCUMENT_FORMATTING)
