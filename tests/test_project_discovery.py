@@ -110,3 +110,14 @@ def test_an_editor_buffer_replaces_the_file_on_disk():
     context = project.context(DATA / "cell" / "spare.script",
                               "def spare_wiggle():\n  rq_open()\nend\n", "spare.script")
     assert context.resolve_call("rq_open").severity == "warning"
+
+
+def test_two_copies_of_a_program_are_two_hosts(tmp_path):
+    program = (DATA / "subprogram" / "main.script").read_text()
+    (tmp_path / "cell_v1.script").write_text(program)
+    (tmp_path / "cell_v2.script").write_text(program.replace('textmsg("at home")',
+                                                             'textmsg("home")'))
+    project = Project.discover(tmp_path, use_config=False)
+    for name in ("cell_v1.script", "cell_v2.script"):
+        context = project.context(tmp_path / name)
+        assert (context.role, context.hosts) == ("host", [])

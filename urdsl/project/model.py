@@ -499,12 +499,18 @@ def _includes(host: ScriptFile, fragment: ScriptFile) -> bool:
     lines = fragment.code_line_list
     if not lines:
         return False
-    share = sum(1 for line in lines if line in host.code_lines) / len(lines)
-    if len(lines) >= 2 and share >= _INLINE_SHARE:
-        return True
-    if fragment.program is not None and share >= _SUBPROGRAM_SHARE:
-        return any(d.kind == "function" for d in host.definitions.get(fragment.program, []))
-    return False
+    if fragment.program is not None:
+        # a complete program is included only as a subprogram: the host has its def (two
+        # copies of one program are two programs, however alike)
+        if not any(d.kind == "function" for d in host.definitions.get(fragment.program, [])):
+            return False
+        return _share(lines, host.code_lines) >= _SUBPROGRAM_SHARE
+    return len(lines) >= 2 and _share(lines, host.code_lines) >= _INLINE_SHARE
+
+
+def _share(lines: tuple[str, ...], within: frozenset[str]) -> float:
+    """The share of ``lines`` found in ``within``."""
+    return sum(1 for line in lines if line in within) / len(lines)
 
 
 # ---- configuration ---------------------------------------------------------------------------
