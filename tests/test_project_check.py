@@ -91,3 +91,12 @@ def test_a_file_that_needs_nothing_is_left_alone(tmp_path):
     (tmp_path / "a.script").write_text("textmsg(1)\n")
     text = "textmsg(1)\n"
     assert in_context(tmp_path / "a.script", text, parse(text), use_config=False) is None
+
+
+def test_include_gives_a_fragment_the_definitions_it_needs(capsys):
+    target = str(DATA / "included" / "prog" / "run.script")
+    assert check(capsys, target)[0] == 1  # clamp() is defined nowhere it can see
+    status, report = check(capsys, target, "--include", str(DATA / "included" / "lib"))
+    assert status == 0
+    assert "math.script" in report["context"]
+    assert main(["check", target, "--include", "no/such/file.script"]) == 2

@@ -89,7 +89,8 @@ def add_commands(commands) -> None:
                    "looked for)")
     p.add_argument("--include", action="append", default=[], metavar="FILE",
                    help="another file of the project (a script file a program includes, a "
-                   ".variables file) whose names the linted files may use; repeatable")
+                   ".variables file, or a folder of them) whose names the linted files may "
+                   "use; repeatable")
     p.add_argument("--no-project", action="store_true",
                    help="lint each file alone, without its project (the other script files "
                    "of its folder, installation variables, includes)")
@@ -187,7 +188,7 @@ def cmd_lint(args: argparse.Namespace) -> int:
     pairs = _expand_with_roots(args.files)
     files = [file for file, _root in pairs]
     for extra in args.include:
-        if not os.path.isfile(extra):
+        if not os.path.exists(extra):
             raise UsageError(f"--include {extra}: no such file")
     projects = None if args.no_project else _Projects(args.include, not args.no_config)
     found = []

@@ -153,6 +153,8 @@ def cmd_check(args: argparse.Namespace) -> int:
 def _check_script(source, args: argparse.Namespace, options):
     """Check a script file in its project's context (a fragment runs with the definitions
     it takes from its host program, sibling files and installation variables)."""
+    import os
+
     from ..cli import UsageError
     from ..project import ProjectError
     from ..project.check import in_context
@@ -166,6 +168,9 @@ def _check_script(source, args: argparse.Namespace, options):
         module = parse(source.text, source.name)
     except ScriptError:
         return check_text(source.text, source.name, options=options)  # reports the syntax
+    missing = [extra for extra in args.include if not os.path.exists(extra)]
+    if missing:
+        raise UsageError(f"--include {missing[0]}: no such file")
     try:
         context = in_context(source.path, source.text, module, source.name, args.include)
     except ProjectError as error:
