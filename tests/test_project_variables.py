@@ -59,3 +59,37 @@ def test_polyscope_writes_a_java_properties_file():
     assert [(v.name, v.line) for v in result.variables] == [
         ("height", 3), ("label", 4), ("ok", 5)]
     assert result.names()["label"].value == n.String("a:bé")
+
+
+XML = """<InstallationVariables timestamp="Mon Jan 05 10:00:00 CET 2026">
+  <variable name="parts_done" value="12" favourite="false"/>
+  <variable name="drop_pose" value="p[0.4, -0.2, 0.1, 0.0, 3.14, 0.0]" favourite="true"/>
+  <variable name="label" value="&quot;line A&quot;" favourite="false"/>
+  <variable name="broken" value="[1, 2" favourite="false"/>
+</InstallationVariables>
+"""
+
+
+def test_the_xml_form_of_polyscope_5():
+    result = parse_variables(XML, "default.variables")
+    assert [(v.name, v.line, v.span.column) for v in result.variables] == [
+        ("parts_done", 2, 19), ("drop_pose", 3, 19), ("label", 4, 19)]
+    assert result.names()["label"].value == n.String("line A")
+    assert isinstance(result.names()["drop_pose"].value, n.Pose)
+    [problem] = result.diagnostics
+    assert (problem.line, problem.code) == (5, "URS001")
+    assert 'value="[1, 2"' in problem.source_line
+
+
+def test_gzip_compressed_files_are_read_and_damaged_ones_reported(tmp_path):
+    import gzip
+
+    (tmp_path / "a.variables").write_bytes(gzip.compress(XML.encode()))
+    (tmp_path / "b.variables").write_bytes(gzip.compress(b"#stamp\nspeed=0.25\n"))
+    (tmp_path / "c.variables").write_bytes(gzip.compress(b"speed=0.25\n")[:12])
+    assert [v.name for v in read_variables(tmp_path / "a.variables").variables] == [
+        "parts_done", "drop_pose", "label"]
+    assert [v.name for v in read_variables(tmp_path / "b.variables").variables] == ["speed"]
+    damaged = read_variables(tmp_path / "c.variables")
+    assert damaged.variables == []
+    assert "damaged gzip" in damaged.diagnostics[0].message

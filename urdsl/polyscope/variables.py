@@ -1,7 +1,9 @@
 """Installation variables: the ``*.variables`` file PolyScope keeps beside an installation
 (``default.variables``), one ``name=value`` line per variable, the value a URScript
 expression (``counter=0``, ``home=p[0.1, -0.4, 0.3, 0, 3.14, 0]``). PolyScope writes it as a
-Java properties file: ``#`` comment lines (a time stamp), ``\\:`` and ``\\=`` escapes.
+Java properties file (``#`` comment lines with a time stamp, ``\\:`` and ``\\=`` escapes)
+on CB3; from 5.x an XML document, ``<InstallationVariables><variable name="count" value="0"
+favourite="false"/></InstallationVariables>``; either often gzip-compressed.
 
 Every program run with that installation sees these names as globals. :func:`parse_variables`
 reads the file without ever raising for bad content: a line that is not ``name=value`` or
@@ -14,7 +16,11 @@ kept.
 
 from __future__ import annotations
 
+import dataclasses
+import gzip
+import html
 import re
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -57,7 +63,10 @@ class VariablesFile:
 
 
 def parse_variables(text: str, filename: str = "<variables>") -> VariablesFile:
-    """The variables of ``.variables`` text; bad lines become URS001 diagnostics."""
+    """The variables of ``.variables`` text, in either form PolyScope writes; bad lines
+    become URS001 diagnostics."""
+    if text.lstrip().startswith("<"):
+        return _parse_xml(text, filename)
     result = VariablesFile(filename)
     source = n.Source(text, filename)
     lines = text.split("\n")
@@ -114,6 +123,60 @@ def parse_variables(text: str, filename: str = "<variables>") -> VariablesFile:
     return result
 
 
+_ELEMENT = re.compile(r"<variable\b([^>]*?)/?>", re.DOTALL)
+_ATTRIBUTE = re.compile(r"""([A-Za-z_][\w.-]*)\s*=\s*(?:"([^"]*)"|'([^']*)')""")
+
+
+def _parse_xml(text: str, filename: str) -> VariablesFile:
+    """The XML form (PolyScope 5.x): ``<InstallationVariables><variable name="count"
+    value="0" .../></InstallationVariables>``. Each ``value`` is parsed as URScript at its
+    place in the file."""
+    result = VariablesFile(filename)
+    source = n.Source(text, filename)
+    if "<InstallationVariables" not in text:
+        result.diagnostics.append(Diagnostic.at(
+            n.Span(source, 0, 1), "not an installation variables file (no "
+            "<InstallationVariables> element)", code=_CODE))
+        return result
+    for element in _ELEMENT.finditer(text):
+        attributes = {m.group(1): (m.group(2) if m.group(2) is not None else m.group(3),
+                                   m.start(2) if m.group(2) is not None else m.start(3))
+                      for m in _ATTRIBUTE.finditer(element.group(1))}
+        base = element.start(1)
+        if "name" not in attributes or "value" not in attributes:
+            result.diagnostics.append(Diagnostic.at(
+                n.Span(source, element.start(), element.end()),
+                "a <variable> element needs a name and a value", code=_CODE))
+            continue
+        name, name_at = attributes["name"]
+        raw, value_at = attributes["value"]
+        name_span = n.Span(source, base + name_at, base + name_at + len(name))
+        if not _NAME.fullmatch(name):
+            result.diagnostics.append(Diagnostic.at(
+                name_span, f"'{name}' is not a URScript variable name", code=_CODE))
+            continue
+        value_text = html.unescape(raw)
+        line, column = source.line_col(base + value_at)
+        try:
+            module = parse("\n" * (line - 1) + " " * (column - 1) + value_text, filename)
+        except ScriptError as error:  # shown with the file's own line
+            diagnostic = error.diagnostic
+            result.diagnostics.append(dataclasses.replace(
+                diagnostic, source_line=source.line_text(diagnostic.line)))
+            continue
+        items = [item for item in module.body if isinstance(item, n.Stmt)]
+        if len(items) != 1 or not isinstance(items[0], n.ExprStmt):
+            result.diagnostics.append(Diagnostic.at(
+                n.Span(source, base + value_at, base + value_at + len(raw)),
+                f"the value of '{name}' is not one URScript expression", code=_CODE))
+            continue
+        value = items[0].expr
+        statement = n.Assign(n.Name(name, span=name_span), value,
+                             span=n.Span(source, element.start(), element.end()))
+        result.variables.append(InstallationVariable(name, value, name_span, statement))
+    return result
+
+
 _ESCAPE = re.compile(r"\\(u[0-9a-fA-F]{4}|.)")
 _ESCAPES = {"t": "\t", "n": "\n", "r": "\r", "f": "\f"}
 
@@ -146,10 +209,22 @@ def read_variables(path: str | Path) -> VariablesFile:
     """Read and parse a ``.variables`` file; an unreadable file is one diagnostic."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8", errors="replace")
+        data = path.read_bytes()
     except OSError as error:
-        result = VariablesFile(str(path))
-        result.diagnostics.append(Diagnostic(str(path), 1, 1, "error", _CODE,
-                                             f"cannot read {path}: {error.strerror}"))
-        return result
+        return _unreadable(path, f"cannot read {path}: {error.strerror}")
+    if data[:2] == b"\x1f\x8b":  # PolyScope often saves it gzip-compressed
+        try:
+            data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error) as error:
+            return _unreadable(path, f"{path} is a damaged gzip file: {error}")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        text = data.decode("latin-1")  # Java writes properties files in ISO 8859-1
     return parse_variables(text, str(path))
+
+
+def _unreadable(path: Path, message: str) -> VariablesFile:
+    result = VariablesFile(str(path))
+    result.diagnostics.append(Diagnostic(str(path), 1, 1, "error", _CODE, message))
+    return result
