@@ -100,3 +100,10 @@ def test_include_gives_a_fragment_the_definitions_it_needs(capsys):
     assert status == 0
     assert "math.script" in report["context"]
     assert main(["check", target, "--include", "no/such/file.script"]) == 2
+
+
+def test_a_fragment_in_a_subfolder_is_checked_with_the_program_above(capsys):
+    status, report = check(capsys, str(DATA / "nested" / "scripts" / "start_seam.script"))
+    assert status == 0
+    assert "weld.script" in report["context"]
+    assert [e["message"] for e in report["events"] if e["kind"] == "textmsg"] == ["0.01"]

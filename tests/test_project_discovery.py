@@ -121,3 +121,15 @@ def test_two_copies_of_a_program_are_two_hosts(tmp_path):
     for name in ("cell_v1.script", "cell_v2.script"):
         context = project.context(tmp_path / name)
         assert (context.role, context.hosts) == ("host", [])
+
+
+def test_a_file_in_a_subfolder_finds_the_program_above_that_includes_it(capsys):
+    target = DATA / "nested" / "scripts" / "start_seam.script"
+    project = Project.discover(target, use_config=False)
+    assert project.root.resolve() == (DATA / "nested").resolve()
+    context = project.context(target)
+    assert names(context.hosts) == ["weld.script"]
+    assert context.resolve_read("seam_speed").severity is None
+    # a file no program above includes keeps its own folder
+    lonely = DATA / "configured" / "lib" / "tools.script"
+    assert Project.discover(lonely, use_config=False).root == lonely.parent

@@ -42,6 +42,11 @@ VARIABLES_SUFFIX = ".variables"
 MAX_FILE_BYTES = 5_000_000
 """Larger files are not read as part of a project (they are not hand-written programs)."""
 
+MAX_TREE_FILES = 2000
+"""A project found above a file takes at most this many files of that folder's tree."""
+HOST_LEVELS = 3
+"""How many folders above a file urdsl looks for the program that includes it."""
+
 _INLINE_SHARE = 0.8
 _SUBPROGRAM_SHARE = 0.5
 
@@ -227,8 +232,10 @@ class Project:
     @classmethod
     def discover(cls, path: str | Path, include: tuple[str | Path, ...] | list = (),
                  use_config: bool = True) -> Project:
-        """The project of ``path``: a folder's whole tree, or a file's folder (not its
-        subfolders), with the ``include`` files and the configured includes. Files that
+        """The project of ``path``: a folder's whole tree; for a file, its folder (not its
+        subfolders), or, when a program in a folder up to three levels above includes the
+        file (PolyScope keeps script files in subfolders of the programs folder), that
+        folder's tree. With the ``include`` files and the configured includes. Files that
         cannot be read are left out; a bad configuration raises :class:`ProjectError`."""
         path = Path(path)
         if path.is_dir():
@@ -236,12 +243,18 @@ class Project:
             found = _tree(path)
         else:
             root = path.parent if str(path.parent) else Path(".")
-            try:
-                found = [p for p in sorted(root.iterdir()) if _wanted(p)]
-            except OSError:  # no such folder, or not allowed to list it
-                found = []
+            found = _listing(root)
             if path.is_file() and _key(path) not in {_key(p) for p in found}:
                 found.append(path)
+            above = _host_folder(path, found)
+            if above is not None:  # the program that includes the file is further up
+                root = above
+                tree = _tree(above, MAX_TREE_FILES + 1)
+                if len(tree) <= MAX_TREE_FILES:
+                    found = tree
+                else:
+                    keys = {_key(p) for p in found}
+                    found += [p for p in _listing(above) if _key(p) not in keys]
         known = {_key(p) for p in found}
         extra = [Path(p) for p in include]
         if use_config:
@@ -332,14 +345,61 @@ def _wanted(path: Path) -> bool:
     return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix == VARIABLES_SUFFIX)
 
 
-def _tree(folder: Path) -> list[Path]:
+def _tree(folder: Path, limit: int | None = None) -> list[Path]:
+    """The project files in ``folder``'s tree (hidden folders left out), at most ``limit``."""
     if not folder.is_dir():
         return []
+    found: list[Path] = []
     with contextlib.suppress(OSError):
-        return sorted(
-            p for p in folder.rglob("*")
-            if _wanted(p) and not any(part.startswith(".") for part in p.parts[len(folder.parts):]))
-    return []
+        for p in folder.rglob("*"):
+            if _wanted(p) and not any(part.startswith(".")
+                                      for part in p.parts[len(folder.parts):]):
+                found.append(p)
+                if limit is not None and len(found) >= limit:
+                    break
+    return sorted(found)
+
+
+def _listing(folder: Path) -> list[Path]:
+    """The project files directly in ``folder``."""
+    try:
+        return [p for p in sorted(folder.iterdir()) if _wanted(p)]
+    except OSError:  # no such folder, or not allowed to list it
+        return []
+
+
+def _host_folder(path: Path, beside: list[Path]) -> Path | None:
+    """The folder, up to :data:`HOST_LEVELS` above ``path``'s, whose programs include the
+    script file ``path`` — None when a program beside it does, or none does. The search
+    does not leave the repository (a folder holding ``.git``)."""
+    if path.suffix not in SCRIPT_SUFFIXES:
+        return None
+    fragment = load_script(path)
+    if fragment is None or fragment.module is None:
+        return None
+
+    def includes(candidates: list[Path]) -> bool:
+        for candidate in candidates:
+            if candidate.suffix not in SCRIPT_SUFFIXES or _key(candidate) == _key(path):
+                continue
+            host = load_script(candidate)
+            if host is not None and host.is_host and _includes(host, fragment):
+                return True
+        return False
+
+    if includes(beside):
+        return None
+    try:
+        folder = path.resolve().parent
+    except OSError:
+        return None
+    for _level in range(HOST_LEVELS):
+        if (folder / ".git").exists() or folder.parent == folder:
+            return None
+        folder = folder.parent
+        if includes(_listing(folder)):
+            return Path(_display(folder))
+    return None
 
 
 def _display(path: Path) -> str:
