@@ -131,3 +131,10 @@ def test_the_language_server_goes_to_a_definition_in_another_file():
     variable = project_definition(uri, path.read_text(), "part_count")
     assert variable.uri.endswith("default.variables")
     assert project_definition(uri, path.read_text(), "no_such_name") is None
+
+
+def test_a_subfolder_of_a_project_is_linted_with_the_program_above(capsys):
+    folder = str(DATA / "nested" / "scripts")
+    assert lint(capsys, folder) == (0, [])
+    status, found = lint(capsys, folder, "--no-project")
+    assert status == 1 and found[0]["message"] == "name 'seam_speed' is not defined"

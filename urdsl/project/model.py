@@ -241,6 +241,12 @@ class Project:
         if path.is_dir():
             root = path
             found = _tree(path)
+            scripts_here = [p for p in found if p.suffix in SCRIPT_SUFFIXES]
+            if len(scripts_here) <= MAX_TREE_FILES:
+                above = _folder_above(path, scripts_here, scripts_here)
+                if above is not None:  # a subfolder of a project: add the program above
+                    keys = {_key(p) for p in found}
+                    found += [p for p in _listing(above) if _key(p) not in keys]
         else:
             root = path.parent if str(path.parent) else Path(".")
             found = _listing(root)
@@ -374,30 +380,39 @@ def _host_folder(path: Path, beside: list[Path]) -> Path | None:
     does not leave the repository (a folder holding ``.git``)."""
     if path.suffix not in SCRIPT_SUFFIXES:
         return None
-    fragment = load_script(path)
-    if fragment is None or fragment.module is None:
-        return None
+    return _folder_above(path.parent, [path], beside)
 
-    def includes(candidates: list[Path]) -> bool:
+
+def _folder_above(start: Path, paths: list[Path], beside: list[Path]) -> Path | None:
+    """The folder up to :data:`HOST_LEVELS` above ``start`` whose programs include one of
+    the script files ``paths`` — None when a program among ``beside`` does, or none does."""
+    fragments = [f for f in (load_script(p) for p in paths if p.suffix in SCRIPT_SUFFIXES)
+                 if f is not None and f.module is not None and not f.is_host]
+    if not fragments:
+        return None
+    own = {_key(p) for p in paths}
+
+    def includes(candidates: list[Path], skip: set[str]) -> bool:
         for candidate in candidates:
-            if candidate.suffix not in SCRIPT_SUFFIXES or _key(candidate) == _key(path):
+            if candidate.suffix not in SCRIPT_SUFFIXES or _key(candidate) in skip:
                 continue
             host = load_script(candidate)
-            if host is not None and host.is_host and _includes(host, fragment):
+            if host is not None and host.is_host and any(
+                    _includes(host, fragment) for fragment in fragments):
                 return True
         return False
 
-    if includes(beside):
+    if includes(beside, own if len(paths) == 1 else set()):
         return None
     try:
-        folder = path.resolve().parent
+        folder = start.resolve()
     except OSError:
         return None
     for _level in range(HOST_LEVELS):
         if (folder / ".git").exists() or folder.parent == folder:
             return None
         folder = folder.parent
-        if includes(_listing(folder)):
+        if includes(_listing(folder), own):
             return Path(_display(folder))
     return None
 
