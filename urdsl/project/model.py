@@ -1,6 +1,7 @@
 """The files of one PolyScope project and the names each file can see.
 
-A project is a folder tree (or, for one file, the file's folder) holding:
+A project is a folder tree (for one file, the file's folder, or the folder up to three
+levels above whose program includes the file) holding:
 
 * script files (``*.script``, ``*.urscript``, ``*.urs``). A **host** is a complete program as
   PolyScope exports it: one top-level ``def`` without parameters wrapping the program,
