@@ -138,3 +138,13 @@ def test_a_subfolder_of_a_project_is_linted_with_the_program_above(capsys):
     assert lint(capsys, folder) == (0, [])
     status, found = lint(capsys, folder, "--no-project")
     assert status == 1 and found[0]["message"] == "name 'seam_speed' is not defined"
+
+
+def test_a_python_name_defined_in_another_file_is_no_habit(tmp_path, capsys):
+    (tmp_path / "util.script").write_text("def abs(x):\n  return norm(x)\nend\n")
+    (tmp_path / "use.script").write_text("textmsg(abs(-2))\n")
+    status, found = lint(capsys, str(tmp_path / "use.script"))
+    assert [f["code"] for f in found] == ["URS102"]  # where abs is defined, as a warning
+    assert found[0]["severity"] == "warning"
+    status, found = lint(capsys, str(tmp_path / "use.script"), "--no-project")
+    assert [f["code"] for f in found] == ["URS119"]

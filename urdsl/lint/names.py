@@ -51,8 +51,14 @@ PYTHON_HABITS: dict[str, str] = {
 """Names from Python (and C) that are not URScript, with the URScript way."""
 
 
+_ANY_KIND = frozenset(("function", "thread", "global", "installation variable"))
+
+
 def _habit(name: str, ctx: LintContext, scope: Scope) -> str | None:
     if name in PYTHON_HABITS and not ctx.analysis.defined(name, scope) and lookup(name) is None:
+        project = ctx.project
+        if project is not None and project.definitions(name, _ANY_KIND):  # type: ignore
+            return None  # another file of the project defines it
         return PYTHON_HABITS[name]
     return None
 
