@@ -107,3 +107,34 @@ def test_a_fragment_in_a_subfolder_is_checked_with_the_program_above(capsys):
     assert status == 0
     assert "weld.script" in report["context"]
     assert [e["message"] for e in report["events"] if e["kind"] == "textmsg"] == ["0.01"]
+
+
+LOOP_HOST = """def loop_cell():
+  $ 1 "Robot Program"
+  def measure():
+    offset = 0.1
+    global shifted = offset * 2
+  end
+  while True:
+    $ 2 "Script: use.script"
+    global here = get_actual_tcp_pose()
+    textmsg(here)
+    textmsg(shifted)
+    measure()
+  end
+end
+"""
+
+
+def test_a_global_given_a_value_in_a_loop_is_run_first_when_it_can_be(tmp_path, capsys):
+    (tmp_path / "cell.script").write_text(LOOP_HOST)
+    (tmp_path / "use.script").write_text("textmsg(here)\n")
+    status, report = check(capsys, str(tmp_path / "use.script"))
+    assert status == 0 and "here" in report["context"]
+    # a value that needs a local of its function cannot be computed first: the name stays
+    # undefined, as an honest runtime error
+    (tmp_path / "use.script").write_text("textmsg(shifted)\n")
+    status, report = check(capsys, str(tmp_path / "use.script"))
+    assert status == 1
+    assert report["findings"][0]["message"] == "name 'shifted' is not defined"
+    assert "gives shifted a value only inside a function or loop" in report["context"]

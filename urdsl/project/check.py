@@ -79,8 +79,8 @@ def in_context(path: str | Path, text: str, module: n.Module, filename: str | No
     from its project in front, or None when it needs none that the project has."""
     project = project or Project.discover(path, include, use_config)
     context = project.context(path, text, filename)
-    chosen = _collect(context, module)
-    if not chosen:
+    chosen, without_value = _collect(context, module)
+    if not chosen and not without_value:
         return None
     variables = [d for d in chosen if d.kind == "installation variable"]
     assignments = [d for d in chosen if d.kind == "global"]
@@ -101,11 +101,33 @@ def in_context(path: str | Path, text: str, module: n.Module, filename: str | No
         others = [f for f in files if f not in hosts]
         if others:
             note += f", with definitions from {', '.join(others)}"
-    else:
+    elif files:
         note = f"checked with definitions from {', '.join(files)}"
-    note += f" ({len(chosen)} definition(s): {', '.join(d.name for d in chosen[:8])}" + \
-        (", ..." if len(chosen) > 8 else "") + ")"
+    else:
+        note = "checked alone"
+    if chosen:
+        note += f" ({len(chosen)} definition(s): {', '.join(d.name for d in chosen[:8])}" + \
+            (", ..." if len(chosen) > 8 else "") + ")"
+    if without_value:
+        note += ("; the project gives " + ", ".join(without_value) + " a value only inside a "
+                 "function or loop, from values not known before this file runs")
     return CheckContext(combined, tuple(chosen), hosts, note)
+
+
+def _given_later(statement: n.Stmt | None, name: str, resolvable) -> n.Stmt | None:
+    """A global's first value given inside a block or function (``global wp =
+    get_actual_tcp_pose()`` in a loop), as a ``global`` declaration to run first — when
+    everything its value needs is defined in the project or built in (not a local of the
+    function it was written in)."""
+    if statement is None:
+        return None
+    value = statement.value  # type: ignore[attr-defined]
+    declaration = n.Declare("global", name, value, span=statement.span)  # type: ignore
+    reads, calls, threads = needed_names(n.Module((declaration,)))
+    if all(resolvable(r, _READ) for r in reads) and all(
+            resolvable(c, _CALL) for c in calls) and all(resolvable(t, _THREAD) for t in threads):
+        return declaration
+    return None
 
 
 def _program_def(module: n.Module) -> n.FunctionDef | None:
@@ -115,10 +137,12 @@ def _program_def(module: n.Module) -> n.FunctionDef | None:
     return program if isinstance(program, n.FunctionDef) else None
 
 
-def _collect(context: FileContext, module: n.Module) -> list[Definition]:
-    """The definitions ``module`` needs, dependencies before their users."""
+def _collect(context: FileContext, module: n.Module) -> tuple[list[Definition], list[str]]:
+    """The definitions ``module`` needs, dependencies before their users; and the globals it
+    reads that the project gives a value only where it cannot be computed first."""
     host_only = context.role == "host"
     chosen: list[Definition] = []
+    without_value: list[str] = []
     visited: set[tuple[str, str]] = set()
     files = {script.filename: script for script in context.project.files}
 
@@ -128,13 +152,20 @@ def _collect(context: FileContext, module: n.Module) -> list[Definition]:
                 continue
             if definition.kind == "global":
                 script = files.get(definition.filename)
-                statement = script.top_level.get(name) if script is not None else None
+                if script is None:
+                    continue
+                statement = script.top_level.get(name) or _given_later(
+                    script.assigned_later.get(name), name, resolvable)
                 if statement is None:
-                    continue  # assigned only inside a function: nothing to run first
+                    continue  # no value that can be computed before the file runs
                 return dataclasses.replace(definition, node=statement,
                                            span=statement.span)  # type: ignore[attr-defined]
             return definition
         return None
+
+    def resolvable(name: str, kinds: frozenset[str]) -> bool:
+        return any(not host_only or relation in ("variables", "explicit")
+                   for relation, _d in context.definitions(name, kinds))
 
     def need(name: str, kinds: frozenset[str], use: str) -> None:
         if (use, name) in visited or len(chosen) >= _MAX_DEFINITIONS:
@@ -142,6 +173,9 @@ def _collect(context: FileContext, module: n.Module) -> list[Definition]:
         visited.add((use, name))
         definition = pick(name, kinds, use)
         if definition is None:
+            if use == "read" and any(d.kind == "global" for _r, d in
+                                     context.definitions(name, kinds)):
+                without_value.append(name)
             return
         follow(_alone(definition.node) if definition.kind in ("function", "thread")
                else n.Module((definition.node,)))
@@ -157,4 +191,4 @@ def _collect(context: FileContext, module: n.Module) -> list[Definition]:
             need(name, _THREAD, "thread")
 
     follow(module)
-    return chosen
+    return chosen, without_value

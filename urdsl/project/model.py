@@ -92,6 +92,7 @@ class ScriptFile:
     labels: tuple[str, ...] = ()
     definitions: dict[str, list[Definition]] = field(default_factory=dict)
     top_level: dict[str, n.Stmt] = field(default_factory=dict)
+    assigned_later: dict[str, n.Stmt] = field(default_factory=dict)
     code_lines: frozenset[str] = frozenset()
     code_line_list: tuple[str, ...] = ()
 
@@ -472,8 +473,9 @@ def script_file(path: Path, filename: str, text: str) -> ScriptFile:
                           code_line_list=lines)
     program = program_name(module, text)
     labels = tuple(_labels(text))
-    definitions, top_level = _definitions(module, filename, program)
+    definitions, top_level, late = _definitions(module, filename, program)
     return ScriptFile(path, filename, text, module, program, labels, definitions, top_level,
+                      late,
                       frozenset(lines), lines)
 
 
@@ -514,13 +516,17 @@ def _labels(text: str) -> list[str]:
 
 
 def _definitions(module: n.Module, filename: str, program: str | None
-                 ) -> tuple[dict[str, list[Definition]], dict[str, n.Stmt]]:
-    from ..lint.scope import analyse  # the controller's scoping rules
+                 ) -> tuple[dict[str, list[Definition]], dict[str, n.Stmt], dict[str, n.Stmt]]:
+    """The names ``module`` defines for other files, the first-level assignment of each
+    global, and the first assignment anywhere of each global (``global x = v`` in a loop or
+    a function)."""
+    from ..lint.scope import analyse, statements  # the controller's scoping rules
 
+    late: dict[str, n.Stmt] = {}
     try:
         analysis = analyse(module)
     except RecursionError:
-        return {}, {}
+        return {}, {}, late
     found: dict[str, list[Definition]] = {}
 
     def add(name: str, kind: str, node: n.Stmt, span: n.Span) -> None:
@@ -548,12 +554,27 @@ def _definitions(module: n.Module, filename: str, program: str | None
         if node is not None:
             add(name, "global", node, node.span)  # type: ignore[arg-type, attr-defined]
     top_level: dict[str, n.Stmt] = {}
+    for scope in analysis.scopes:  # a global given a value only inside a block or function
+        for statement in statements(scope.body):
+            name = _assigned_name(statement)
+            if name is not None and name in analysis.globals and name not in late \
+                    and analysis.is_global_in(name, scope):
+                late[name] = statement
     for item in analysis.top.body:
         if isinstance(item, n.Assign) and isinstance(item.target, n.Name):
             top_level.setdefault(item.target.id, item)
         elif isinstance(item, n.Declare) and item.value is not None:
             top_level.setdefault(item.name, item)
-    return found, top_level
+    return found, top_level, late
+
+
+def _assigned_name(statement: n.Stmt) -> str | None:
+    """The variable a statement gives a value to (``x = v``, ``global x = v``), if any."""
+    if isinstance(statement, n.Assign) and isinstance(statement.target, n.Name):
+        return statement.target.id
+    if isinstance(statement, n.Declare) and statement.value is not None:
+        return statement.name
+    return None
 
 
 def _code_lines(text: str) -> list[str]:
