@@ -436,19 +436,21 @@ def _key(path: Path) -> str:
         return str(path)
 
 
-_CACHE: dict[tuple[str, str, int, int], ScriptFile] = {}
+_CACHE: dict[tuple[str, str, int, int, str], ScriptFile] = {}
 
 
 def load_script(path: Path) -> ScriptFile | None:
     """The parsed script file at ``path`` (None when it cannot be read or is too large).
-    Parsed files are cached by path, size and modification time."""
+    Parsed files are cached by path, size and modification time (and, for an absolute path,
+    the working folder its shown name is relative to)."""
     try:
         stat = path.stat()
     except OSError:
         return None
     if stat.st_size > MAX_FILE_BYTES:
         return None
-    key = (str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns)
+    key = (str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns,
+           os.getcwd() if path.is_absolute() else "")  # the name shown depends on it
     cached = _CACHE.get(key)
     if cached is not None:
         return cached
