@@ -30,8 +30,8 @@ error; see "Real projects" in the README.
 
 Settings come from [tool.urdsl.lint] in the nearest pyproject.toml (select, ignore, robot,
 version); options given here win. [tool.urdsl] include = ["lib/*.script"] adds files to the
-project (paths relative to the pyproject.toml). '# noqa' or '# noqa: URS112' at the end of a line
-silences findings on it.
+project (paths relative to the pyproject.toml). '# noqa' or '# noqa: URS112' at the end of
+a line silences findings on it.
 
 Exit status: 0 no error-severity finding (warnings allowed), 1 errors found, 2 usage errors.
 """

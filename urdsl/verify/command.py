@@ -18,6 +18,10 @@ speeds (URS304), the cell's TCP speed limit (URS306), singularities (URS307), co
 the cell or the arm itself (URS308), Overlapping Blends (URS309), runtime errors (URS2xx).
 Also prints every move with its duration and the cycle time.
 
+A script file runs in its project's context: a file that a program includes (a PolyScope
+"Script: file" node, a subprogram) runs with the definitions it takes from that program,
+sibling script files and installation variables (*.variables), and the report says so.
+
 Exit status: 0 no errors (warnings allowed), 1 errors found, 2 usage errors.
 """
 
@@ -92,7 +96,7 @@ def add_commands(commands) -> None:
                    help="list every move in the text report (default: the first 20)")
     p.add_argument("--include", action="append", default=[], metavar="FILE",
                    help="another file of the project whose definitions the program uses "
-                   "(a script file, a .variables file); repeatable")
+                   "(a script file, a .variables file, or a folder of them); repeatable")
     p.add_argument("--no-project", action="store_true",
                    help="check the file alone, not in the context of its project (host "
                    "program, sibling script files, installation variables)")
