@@ -23,9 +23,15 @@ degrees where radians belong, speeds beyond the arm, blends that cannot happen, 
 variables, unreachable code, what a sec program must not do, loops that never yield, and
 habits from Python. 'urdsl rules' explains every rule.
 
+Each file is linted in its project: names defined in the host program that includes it, in
+the other script files of the folder tree named (or of a file's folder), in installation
+variables (*.variables) and in --include files are known. A name defined nowhere stays an
+error; see "Real projects" in the README.
+
 Settings come from [tool.urdsl.lint] in the nearest pyproject.toml (select, ignore, robot,
-version); options given here win. '# noqa' or '# noqa: URS112' at the end of a line
-silences findings on it.
+version); options given here win. [tool.urdsl] include = ["lib/*.script"] adds files to the
+project (paths relative to the pyproject.toml). '# noqa' or '# noqa: URS112' at the end of
+a line silences findings on it.
 
 Exit status: 0 no error-severity finding (warnings allowed), 1 errors found, 2 usage errors.
 """
@@ -38,8 +44,11 @@ examples:
   urdsl lint pick.script --format json | jq '.[] | .code'
   urdsl lint . --format sarif > urdsl.sarif       # GitHub code scanning
   urdsl lint . --format github                    # annotations in a GitHub Actions step
+  urdsl lint pick.script --include ../lib/robotiq.script
 
 pyproject.toml:
+  [tool.urdsl]
+  include = ["lib/*.script", "installation/default.variables"]
   [tool.urdsl.lint]
   select = ["URS0", "URS1"]
   ignore = ["URS113"]
@@ -78,6 +87,13 @@ def add_commands(commands) -> None:
     p.add_argument("--stdin-filename", metavar="NAME",
                    help="the name to report for '-' (also where the configuration is "
                    "looked for)")
+    p.add_argument("--include", action="append", default=[], metavar="FILE",
+                   help="another file of the project (a script file a program includes, a "
+                   ".variables file, or a folder of them) whose names the linted files may "
+                   "use; repeatable")
+    p.add_argument("--no-project", action="store_true",
+                   help="lint each file alone, without its project (the other script files "
+                   "of its folder, installation variables, includes)")
     p.set_defaults(run=cmd_lint)
 
     p = commands.add_parser(
@@ -106,9 +122,15 @@ def add_commands(commands) -> None:
 
 def _expand(names: list[str]) -> list[str]:
     """Files named on the command line; folders are searched for URScript files."""
+    return [file for file, _root in _expand_with_roots(names)]
+
+
+def _expand_with_roots(names: list[str]) -> list[tuple[str, str | None]]:
+    """Each file with the folder named on the command line it was found in (None for a
+    file named itself): a folder named on the command line is one project."""
     from ..cli import UsageError
 
-    files: list[str] = []
+    files: list[tuple[str, str | None]] = []
     for name in names:
         if name != "-" and os.path.isdir(name):
             found = sorted(
@@ -118,24 +140,60 @@ def _expand(names: list[str]) -> list[str]:
             )
             if not found:
                 raise UsageError(f"no URScript files (*.script, *.urscript) in {name}")
-            files.extend(found)
+            files.extend((file, name) for file in found)
         else:
-            files.append(name)
+            files.append((name, None))
     return files
+
+
+class _Projects:
+    """The project of each linted file, discovered once per folder named (or per folder of
+    a file named); the problems of its installation variables are reported once."""
+
+    def __init__(self, include: list[str], use_config: bool) -> None:
+        self.include = include
+        self.use_config = use_config
+        self.projects: dict[str, object] = {}
+        self.reported: set[int] = set()
+
+    def context(self, file: str, root: str | None):
+        """``(FileContext, new diagnostics of the project)`` for ``file``."""
+        from ..cli import UsageError
+        from ..project import Project, ProjectError
+
+        key = root if root is not None else str(Path(file).resolve().parent)
+        project = self.projects.get(key)
+        if project is None:
+            try:
+                project = Project.discover(root if root is not None else file,
+                                           self.include, self.use_config)
+            except ProjectError as error:
+                raise UsageError(str(error)) from None
+            self.projects[key] = project
+        extra = []
+        if id(project) not in self.reported:
+            self.reported.add(id(project))
+            extra = project.diagnostics()  # type: ignore[attr-defined]
+        return project.context(file), extra  # type: ignore[attr-defined]
 
 
 def cmd_lint(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
     from . import report
     from .config import ConfigError, settings_for
-    from .linter import lint_text
+    from .linter import lint_text, lint_tree
 
     select = [c for group in args.select or [] for c in group] or None
     ignore = [c for group in args.ignore or [] for c in group]
-    files = _expand(args.files)
+    pairs = _expand_with_roots(args.files)
+    files = [file for file, _root in pairs]
+    for extra in args.include:
+        if not os.path.exists(extra):
+            raise UsageError(f"--include {extra}: no such file")
+    projects = None if args.no_project else _Projects(args.include, not args.no_config)
     found = []
     ran: set[str] = set()
-    for name in files:
+    for name, root in pairs:
         source = read_input(name)
         label = args.stdin_filename if name == "-" and args.stdin_filename else source.name
         where = source.path if source.path is not None else args.stdin_filename
@@ -146,7 +204,19 @@ def cmd_lint(args: argparse.Namespace) -> int:
         except ConfigError as error:
             raise UsageError(str(error)) from None
         ran |= settings.codes
-        found.extend(lint_text(source.text, label, settings))
+        context = None
+        if projects is not None and (name != "-" or args.stdin_filename):
+            path = name if name != "-" else args.stdin_filename
+            context, extra = projects.context(path, root)
+            if name == "-":
+                context = context.project.context(path, source.text, label)
+            found.extend(extra)
+        parsed = context.file if context is not None else None
+        if (parsed is not None and parsed.module is not None and parsed.filename == label
+                and parsed.text == source.text):
+            found.extend(lint_tree(parsed.module, settings, project=context))  # parsed once
+        else:
+            found.extend(lint_text(source.text, label, settings, project=context))
     if args.format == "json":
         sys.stdout.write(report.render_json(found))
     elif args.format == "sarif":

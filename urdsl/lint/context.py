@@ -37,13 +37,16 @@ BLOCKING_CALLS = MOTION_CALLS | frozenset((
 class LintContext:
     """One file being linted. ``model`` is a :class:`urdsl.kinematics.ModelSpec` or None
     (then limits are those of the fastest UR arm); ``version`` a controller software version
-    ``(major, minor)`` or None (then version checks are off)."""
+    ``(major, minor)`` or None (then version checks are off); ``project`` the file's
+    :class:`urdsl.project.FileContext`, where names it does not define are looked up."""
 
     source: n.Source
     tree: n.Module
     analysis: Analysis
     model: object | None = None
     version: Version | None = None
+    project: object | None = None
+    """A :class:`urdsl.project.FileContext` (the file seen from its project) or None."""
     _literals: dict[str, n.Expr | None] = field(default_factory=dict, repr=False)
 
     # -- reporting ---------------------------------------------------------------------------

@@ -24,8 +24,9 @@ _SEVERITY_ORDER = {"error": 0, "warning": 1, "info": 2}
 
 
 def lint_text(text: str, filename: str = "<string>",
-              settings: LintSettings | None = None) -> list[Diagnostic]:
-    """All findings for URScript ``text``, sorted by place.
+              settings: LintSettings | None = None, project=None) -> list[Diagnostic]:
+    """All findings for URScript ``text``, sorted by place. ``project`` is the file's
+    :class:`urdsl.project.FileContext`: names defined elsewhere in the project resolve there.
 
     >>> [d.code for d in lint_text("movej([0, 0, 0, 0, 0])")]
     ['URS108']
@@ -34,11 +35,13 @@ def lint_text(text: str, filename: str = "<string>",
         tree = parse(text, filename)
     except ScriptError as error:
         return [error.diagnostic]
-    return lint_tree(tree, settings)
+    return lint_tree(tree, settings, project)
 
 
-def lint_tree(tree: n.Module, settings: LintSettings | None = None) -> list[Diagnostic]:
-    """All findings for a parsed file (its nodes must carry spans)."""
+def lint_tree(tree: n.Module, settings: LintSettings | None = None,
+              project=None) -> list[Diagnostic]:
+    """All findings for a parsed file (its nodes must carry spans); ``project`` as for
+    :func:`lint_text`."""
     settings = settings or build_settings()
     source = tree.span.source or n.Source("", "<generated>")
     found: list[Diagnostic] = []
@@ -49,7 +52,7 @@ def lint_tree(tree: n.Module, settings: LintSettings | None = None) -> list[Diag
         analysis = None
         skipped.append("all")
     if analysis is not None:
-        ctx = LintContext(source, tree, analysis, settings.model, settings.version)
+        ctx = LintContext(source, tree, analysis, settings.model, settings.version, project)
         for code, rule in sorted(RULES.items()):
             if rule.check is None or code not in settings.codes:
                 continue

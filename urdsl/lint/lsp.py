@@ -89,7 +89,21 @@ def lint_document(uri: str, text: str) -> list[types.Diagnostic]:
         tree = parse(text, name)
     except ScriptError as error:
         return [to_lsp_diagnostic(error.diagnostic)]
-    return [to_lsp_diagnostic(d) for d in lint_tree(tree, _settings(uri))]
+    return [to_lsp_diagnostic(d) for d in lint_tree(tree, _settings(uri),
+                                                    _project(path, text, name))]
+
+
+def _project(path: str | None, text: str, name: str):
+    """The project context of a file on disk (with the editor's text for the file itself),
+    or None for a buffer that is not a file or a project urdsl cannot read."""
+    if not path or not Path(path).parent.is_dir():
+        return None
+    from ..project import Project, ProjectError
+
+    try:
+        return Project.discover(path).context(path, text, name)
+    except (ProjectError, OSError):
+        return None
 
 
 def hover_text(text: str, word: str) -> str | None:
@@ -154,6 +168,26 @@ def definition_of(text: str, word: str) -> n.Span | None:
     return None
 
 
+def project_definition(uri: str, text: str, word: str) -> types.Location | None:
+    """Where another file of the document's project (its host program, a sibling script
+    file, the installation variables) defines ``word``."""
+    path = _path(uri)
+    context = _project(path, text, Path(path).name) if path else None
+    if context is None:
+        return None
+    kinds = frozenset(("function", "thread", "global", "installation variable"))
+    found = context.definitions(word, kinds)
+    if not found:
+        return None
+    definition = found[0][1]
+    span = definition.span
+    if definition.kind in ("function", "thread"):
+        span = _name_span(definition.node)
+    if span.source is None:
+        return None
+    return types.Location(Path(definition.filename).resolve().as_uri(), _range(span))
+
+
 def _name_span(node: n.Node) -> n.Span:
     span = node.span  # type: ignore[attr-defined]
     match = re.compile(rf"\b{re.escape(node.name)}\b").search(  # type: ignore[attr-defined]
@@ -215,7 +249,8 @@ def build_server():
         word = word_at(document.source, params.position.line, params.position.character)
         span = definition_of(document.source, word) if word else None
         if span is None or span.source is None:
-            return None
+            return project_definition(params.text_document.uri, document.source, word) \
+                if word else None
         return types.Location(params.text_document.uri, _range(span))
 
     @server.feature(types.TEXT_DOCUMENT_FORMATTING)

@@ -51,8 +51,14 @@ PYTHON_HABITS: dict[str, str] = {
 """Names from Python (and C) that are not URScript, with the URScript way."""
 
 
+_ANY_KIND = frozenset(("function", "thread", "global", "installation variable"))
+
+
 def _habit(name: str, ctx: LintContext, scope: Scope) -> str | None:
     if name in PYTHON_HABITS and not ctx.analysis.defined(name, scope) and lookup(name) is None:
+        project = ctx.project
+        if project is not None and project.definitions(name, _ANY_KIND):  # type: ignore
+            return None  # another file of the project defines it
         return PYTHON_HABITS[name]
     return None
 
@@ -79,6 +85,27 @@ def _owner(ctx: LintContext, name: str) -> Scope | None:
     return None
 
 
+def _elsewhere(ctx: LintContext, code: str, at: n.Node, use: str,
+               name: str) -> tuple[bool, Diagnostic | None]:
+    """A name this file uses but does not define, looked up in its project: ``(False,
+    None)`` when the project does not define it either (the rule's own error stands);
+    ``(True, None)`` when the program gets it (its host, a file the program includes, an
+    installation variable); ``(True, finding)`` with the severity the project decides
+    (info, warning, or error for a program that does not include the file) otherwise."""
+    project = ctx.project
+    if project is None:
+        return False, None
+    resolve = {"read": project.resolve_read, "call": project.resolve_call,  # type: ignore
+               "thread": project.resolve_thread}[use]  # type: ignore[attr-defined]
+    found = resolve(name)
+    if found is None:
+        return False, None
+    if found.severity is None:
+        return True, None
+    return True, Diagnostic.at(at.span, found.message, code=code,  # type: ignore[attr-defined]
+                               severity=found.severity, hint=found.hint)
+
+
 @rule(
     "URS101", "undefined-name", "error",
     "A name is read that no assignment, parameter or declaration visible here defines.",
@@ -86,7 +113,14 @@ def _owner(ctx: LintContext, name: str) -> Scope | None:
 The controller compiles the whole program before it runs and stops with "Compile error:
 name 'x' is not defined". Variables at the first level of the program and names declared
 `global` (in a function or a thread too) are visible everywhere; a variable assigned inside a
-function or thread without `global` is local to it and invisible elsewhere.""",
+function or thread without `global` is local to it and invisible elsewhere.
+
+In a project (see "Real projects" in the README) a name defined in another file is no error
+when the program gets it: from the host program that includes this file, a file that program
+includes, or the installation variables. A name defined only in a file the program does not
+include is an info (this file has a host), a warning (this file looks like a fragment that no
+program of the project includes) or still an error (this file is a complete program); the
+message says where the name is defined.""",
     """
 thread blink():
   on = True
@@ -110,6 +144,11 @@ def undefined_name(ctx: LintContext) -> Iterator[Diagnostic]:
                 continue
             if ctx.string_prefix(name) is not None:
                 continue  # URS119 reports the prefixed string
+            handled, finding = _elsewhere(ctx, "URS101", name, "read", name.id)
+            if handled:
+                if finding is not None:
+                    yield finding
+                continue
             hint = None
             owner = _owner(ctx, name.id)
             if owner is not None:
@@ -122,6 +161,11 @@ def undefined_name(ctx: LintContext) -> Iterator[Diagnostic]:
             yield ctx.diagnostic("URS101", name, f"name '{name.id}' is not defined", hint)
         for run in scope.runs:
             if run.thread not in analysis.threads:
+                handled, finding = _elsewhere(ctx, "URS101", run, "thread", run.thread)
+                if handled:
+                    if finding is not None:
+                        yield finding
+                    continue
                 what = "a function, not a thread" if run.thread in analysis.functions else \
                     "not defined"
                 hint = _suggest(run.thread, analysis.threads) if what == "not defined" else \
@@ -135,7 +179,8 @@ def undefined_name(ctx: LintContext) -> Iterator[Diagnostic]:
     """
 The controller rejects the program ("name 'f' is not defined"). The builtin catalog of urdsl
 lists every function of the URScript manuals from CB3 to PolyScope X; the hint names the
-closest builtin or function of the file.""",
+closest builtin or function of the file. A function defined in another file of the project is
+judged as URS101 judges names.""",
     "textmesg(\"hello\")",
     "textmsg(\"hello\")",
 )
@@ -159,6 +204,11 @@ def unknown_function(ctx: LintContext) -> Iterator[Diagnostic]:
             continue
         if scope.binds(name) or name in analysis.globals:
             yield ctx.diagnostic("URS102", call.func, f"'{name}' is a variable, not a function")
+            continue
+        handled, finding = _elsewhere(ctx, "URS102", call.func, "call", name)
+        if handled:
+            if finding is not None:
+                yield finding
             continue
         if name in methods():
             hint = f"{name} is a method: write my_list.{name}(...)"

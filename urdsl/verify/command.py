@@ -18,6 +18,10 @@ speeds (URS304), the cell's TCP speed limit (URS306), singularities (URS307), co
 the cell or the arm itself (URS308), Overlapping Blends (URS309), runtime errors (URS2xx).
 Also prints every move with its duration and the cycle time.
 
+A script file runs in its project's context: a file that a program includes (a PolyScope
+"Script: file" node, a subprogram) runs with the definitions it takes from that program,
+sibling script files and installation variables (*.variables), and the report says so.
+
 Exit status: 0 no errors (warnings allowed), 1 errors found, 2 usage errors.
 """
 
@@ -106,6 +110,12 @@ def add_commands(commands) -> None:
                    help="write a plot of joint positions, speeds and the TCP path")
     p.add_argument("--all-moves", action="store_true",
                    help="list every move in the text report (default: the first 20)")
+    p.add_argument("--include", action="append", default=[], metavar="FILE",
+                   help="another file of the project whose definitions the program uses "
+                   "(a script file, a .variables file, or a folder of them); repeatable")
+    p.add_argument("--no-project", action="store_true",
+                   help="check the file alone, not in the context of its project (host "
+                   "program, sibling script files, installation variables)")
     p.set_defaults(run=cmd_check)
 
 
@@ -145,7 +155,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                 continue
         else:
             source = read_input(name)
-            report = _check_script(source, options, args)
+            report = _check_script(source, args, options)
         reports.append(report)
         if not args.json:
             _print(report, args.all_moves)
@@ -161,18 +171,36 @@ def cmd_check(args: argparse.Namespace) -> int:
     return EXIT_PROBLEMS if failed or any(r.has_errors for r in reports) else EXIT_OK
 
 
-def _check_script(source, options, args):
-    """Check one URScript file with what can be inferred from it (robot model, start joints,
-    TCP and payload; see :mod:`urdsl.verify.infer`) where the command line leaves it open."""
-    from ..script.diagnostics import ScriptSyntaxError
+def _check_script(source, args: argparse.Namespace, options):
+    """Check a script file in its project's context (a fragment runs with the definitions
+    it takes from its host program, sibling files and installation variables), with what can
+    be inferred from it (robot model, start joints, TCP and payload; see
+    :mod:`urdsl.verify.infer`) where the command line leaves it open."""
+    import os
+
+    from ..cli import UsageError
+    from ..project import ProjectError
+    from ..project.check import in_context
+    from ..script.diagnostics import ScriptError
     from ..script.parser import parse
     from .infer import apply, infer
     from .run import check_text, check_tree
 
     try:
-        module = parse(source.text, filename=source.name)
-    except ScriptSyntaxError:
-        return check_text(source.text, source.name, options=options)  # reports it
+        module = parse(source.text, source.name)
+    except ScriptError:
+        return check_text(source.text, source.name, options=options)  # reports the syntax
+    context = None
+    if not args.no_project and source.path is not None:
+        missing = [extra for extra in args.include if not os.path.exists(extra)]
+        if missing:
+            raise UsageError(f"--include {missing[0]}: no such file")
+        try:
+            context = in_context(source.path, source.text, module, source.name, args.include)
+        except ProjectError as error:
+            raise UsageError(str(error)) from None
+    if context is not None:
+        module = context.module
     inference = infer(module, source.path, robot=options.robot if args.robot else None,
                       start_joints=args.start_joints or args.start_joints_deg, tcp=args.tcp,
                       default_robot=options.robot)
@@ -181,6 +209,8 @@ def _check_script(source, options, args):
         file_options.cell = _load_cell(file_options.robot, args.cell)
     report = check_tree(module, source.name, file_options)
     report.inferred = inference
+    if context is not None:
+        report.context = context.note
     return report
 
 

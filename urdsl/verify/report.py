@@ -56,6 +56,7 @@ class Report:
     cycle_time: float = 0.0
     trace: Any = field(default=None, repr=False)
     inferred: Any = None  # urdsl.verify.infer.Inference: robot, start, TCP the check used
+    context: str | None = None  # the project context the program ran in, if any
 
     def sort(self) -> None:
         """Order findings by position in the file, then by time; a finding repeated word for
@@ -88,6 +89,7 @@ class Report:
             "robot": self.robot,
             "ok": not self.has_errors,
             "cycle_time": round(self.cycle_time, 6),
+            "context": self.context,
             "summary": {s: self.count(s) for s in ("error", "warning", "info")},
             "findings": [f.to_dict() for f in self.findings],
             "moves": [m.to_dict() for m in self.moves],
@@ -110,6 +112,8 @@ class Report:
                              f"start {move.start:8.3f} s  duration {move.duration:7.3f} s")
             if len(self.moves) > max_moves:
                 lines.append(f"  ... {len(self.moves) - max_moves} more")
+        if self.context:
+            lines.append(self.context)
         if self.inferred is not None:
             lines.extend(self.inferred.lines())
         lines.append(self.summary())
@@ -142,6 +146,8 @@ class Report:
             if len(self.moves) > max_moves:
                 table.add_row("…", f"{len(self.moves) - max_moves} more", "", "")
             console.print(table)
+        if self.context:
+            console.print(Text(self.context))
         for line in self.inferred.lines() if self.inferred is not None else ():
             console.print(Text(line, style="cyan"))
         style = "bold red" if self.has_errors else "bold green"

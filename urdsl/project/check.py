@@ -1,0 +1,194 @@
+"""Run a fragment where it runs: the definitions a file needs from the rest of its project,
+put before it so that ``urdsl check`` can execute it.
+
+A fragment (a file PolyScope inlines into a program) uses names of its host program, of
+sibling script files and of the installation variables. :func:`in_context` finds the ones the
+file uses (and, in turn, the ones those definitions use), and returns the file's tree with
+them in front: installation variables first, then the hosts' first-level assignments in the
+order their values need them, then the ``def``/``thread`` definitions. Each keeps its own
+span, so a message about it names its own file and line. A complete program (a host) gets
+only the installation variables: whatever else it lacks is its own error.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..script import nodes as n
+from .model import Definition, FileContext, Project
+
+__all__ = ["CheckContext", "in_context", "needed_names"]
+
+_READ = frozenset(("global", "installation variable"))
+_CALL = frozenset(("function",))
+_THREAD = frozenset(("thread",))
+_MAX_DEFINITIONS = 10_000
+
+
+@dataclass(frozen=True)
+class CheckContext:
+    """The tree to run (the file's own, with the definitions it needs in front), the
+    definitions added, and a sentence for the report."""
+
+    module: n.Module
+    definitions: tuple[Definition, ...]
+    hosts: tuple[str, ...]
+    note: str
+
+
+def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
+    """``(variables, functions, threads)`` that ``module`` uses without defining them
+    (builtins excluded)."""
+    from ..lint.scope import analyse
+    from ..script.builtins import lookup
+
+    try:
+        analysis = analyse(module)
+    except RecursionError:
+        return set(), set(), set()
+    reads: set[str] = set()
+    calls: set[str] = set()
+    threads: set[str] = set()
+    for scope in analysis.scopes:
+        for name in scope.reads:
+            if not analysis.defined(name.id, scope):
+                reads.add(name.id)
+        for call in scope.calls:
+            name = call.func.id  # type: ignore[union-attr]
+            if name in analysis.functions or name in analysis.threads:
+                continue
+            if lookup(name) is None and not analysis.defined(name, scope):
+                calls.add(name)
+        for run in scope.runs:
+            if run.thread not in analysis.threads:
+                threads.add(run.thread)
+    return reads, calls, threads
+
+
+def _alone(statement: n.Stmt) -> n.Module:
+    """A module holding one statement, never taken for a whole program."""
+    return n.Module((statement, n.ExprStmt(n.NoneLit())))
+
+
+def in_context(path: str | Path, text: str, module: n.Module, filename: str | None = None,
+               include: tuple[str | Path, ...] | list = (), use_config: bool = True,
+               project: Project | None = None) -> CheckContext | None:
+    """``module`` (parsed from ``text``, the file at ``path``) with the definitions it needs
+    from its project in front, or None when it needs none that the project has."""
+    project = project or Project.discover(path, include, use_config)
+    context = project.context(path, text, filename)
+    chosen, without_value = _collect(context, module)
+    if not chosen and not without_value:
+        return None
+    variables = [d for d in chosen if d.kind == "installation variable"]
+    assignments = [d for d in chosen if d.kind == "global"]
+    definitions = [d for d in chosen if d.kind in ("function", "thread")]
+    prelude = tuple(d.node for d in variables + assignments + definitions)
+    program = _program_def(module)
+    if program is not None:
+        index = module.body.index(program)
+        wrapped = dataclasses.replace(program, body=prelude + program.body)
+        combined = dataclasses.replace(module, body=(*module.body[:index], wrapped,
+                                                     *module.body[index + 1:]))
+    else:
+        combined = dataclasses.replace(module, body=prelude + module.body)
+    files = list(dict.fromkeys(d.filename for d in chosen))
+    hosts = tuple(context.host_names)
+    if hosts:
+        note = f"checked in the context of {', '.join(hosts)}"
+        others = [f for f in files if f not in hosts]
+        if others:
+            note += f", with definitions from {', '.join(others)}"
+    elif files:
+        note = f"checked with definitions from {', '.join(files)}"
+    else:
+        note = "checked alone"
+    if chosen:
+        note += f" ({len(chosen)} definition(s): {', '.join(d.name for d in chosen[:8])}" + \
+            (", ..." if len(chosen) > 8 else "") + ")"
+    if without_value:
+        note += ("; the project gives " + ", ".join(without_value) + " a value only inside a "
+                 "function or loop, from values not known before this file runs")
+    return CheckContext(combined, tuple(chosen), hosts, note)
+
+
+def _given_later(statement: n.Stmt | None, name: str, resolvable) -> n.Stmt | None:
+    """A global's first value given inside a block or function (``global wp =
+    get_actual_tcp_pose()`` in a loop), as a ``global`` declaration to run first — when
+    everything its value needs is defined in the project or built in (not a local of the
+    function it was written in)."""
+    if statement is None:
+        return None
+    value = statement.value  # type: ignore[attr-defined]
+    declaration = n.Declare("global", name, value, span=statement.span)  # type: ignore
+    reads, calls, threads = needed_names(n.Module((declaration,)))
+    if all(resolvable(r, _READ) for r in reads) and all(
+            resolvable(c, _CALL) for c in calls) and all(resolvable(t, _THREAD) for t in threads):
+        return declaration
+    return None
+
+
+def _program_def(module: n.Module) -> n.FunctionDef | None:
+    from ..lint.scope import program_def
+
+    program = program_def(module)
+    return program if isinstance(program, n.FunctionDef) else None
+
+
+def _collect(context: FileContext, module: n.Module) -> tuple[list[Definition], list[str]]:
+    """The definitions ``module`` needs, dependencies before their users; and the globals it
+    reads that the project gives a value only where it cannot be computed first."""
+    host_only = context.role == "host"
+    chosen: list[Definition] = []
+    without_value: list[str] = []
+    visited: set[tuple[str, str]] = set()
+    files = {script.filename: script for script in context.project.files}
+
+    def pick(name: str, kinds: frozenset[str], use: str) -> Definition | None:
+        for relation, definition in context.definitions(name, kinds):
+            if host_only and relation not in ("variables", "explicit"):
+                continue
+            if definition.kind == "global":
+                script = files.get(definition.filename)
+                if script is None:
+                    continue
+                statement = script.top_level.get(name) or _given_later(
+                    script.assigned_later.get(name), name, resolvable)
+                if statement is None:
+                    continue  # no value that can be computed before the file runs
+                return dataclasses.replace(definition, node=statement,
+                                           span=statement.span)  # type: ignore[attr-defined]
+            return definition
+        return None
+
+    def resolvable(name: str, kinds: frozenset[str]) -> bool:
+        return any(not host_only or relation in ("variables", "explicit")
+                   for relation, _d in context.definitions(name, kinds))
+
+    def need(name: str, kinds: frozenset[str], use: str) -> None:
+        if (use, name) in visited or len(chosen) >= _MAX_DEFINITIONS:
+            return
+        visited.add((use, name))
+        definition = pick(name, kinds, use)
+        if definition is None:
+            if use == "read" and any(d.kind == "global" for _r, d in
+                                     context.definitions(name, kinds)):
+                without_value.append(name)
+            return
+        follow(_alone(definition.node) if definition.kind in ("function", "thread")
+               else n.Module((definition.node,)))
+        chosen.append(definition)
+
+    def follow(tree: n.Module) -> None:
+        reads, calls, threads = needed_names(tree)
+        for name in sorted(reads):
+            need(name, _READ, "read")
+        for name in sorted(calls):
+            need(name, _CALL, "call")
+        for name in sorted(threads):
+            need(name, _THREAD, "thread")
+
+    follow(module)
+    return chosen, without_value

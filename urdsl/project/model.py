@@ -1,0 +1,653 @@
+"""The files of one PolyScope project and the names each file can see.
+
+A project is a folder tree (for one file, the file's folder, or the folder up to three
+levels above whose program includes the file) holding:
+
+* script files (``*.script``, ``*.urscript``, ``*.urs``). A **host** is a complete program as
+  PolyScope exports it: one top-level ``def`` without parameters wrapping the program,
+  followed by a call of it or holding PolyScope's ``$`` labels. Everything else is a
+  **fragment**: bare statements or definitions meant to be inlined into a program
+  (PolyScope's "Script: file" node pastes the file's text at that place; a subprogram's
+  ``def`` is pasted into its callers);
+* installation variables (``*.variables``, see :mod:`urdsl.polyscope.variables`), globals of
+  every program run with the installation;
+* extra files named with ``--include`` or ``[tool.urdsl] include = [...]`` in the nearest
+  ``pyproject.toml`` (paths relative to that file, glob patterns allowed).
+
+A host **includes** a fragment when one of its ``$ N "Script: name.script"`` labels names the
+fragment's file, or when the fragment's code lines are found inlined in the host (at least
+80 % of them, or half of them for a subprogram whose ``def`` the host contains).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..polyscope.variables import VariablesFile, read_variables
+from ..script import nodes as n
+from ..script.diagnostics import Diagnostic, ScriptError
+from ..script.parser import parse
+
+__all__ = [
+    "SCRIPT_SUFFIXES", "Definition", "ScriptFile", "Project", "FileContext", "Resolution",
+    "ProjectError", "configured_includes",
+]
+
+SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
+VARIABLES_SUFFIX = ".variables"
+MAX_FILE_BYTES = 5_000_000
+"""Larger files are not read as part of a project (they are not hand-written programs)."""
+
+MAX_TREE_FILES = 2000
+"""A project found above a file takes at most this many files of that folder's tree."""
+HOST_LEVELS = 3
+"""How many folders above a file urdsl looks for the program that includes it."""
+
+_INLINE_SHARE = 0.8
+_SUBPROGRAM_SHARE = 0.5
+
+
+class ProjectError(ValueError):
+    """A project setting urdsl cannot use (a bad ``[tool.urdsl] include``)."""
+
+
+@dataclass(frozen=True)
+class Definition:
+    """A name defined in a file of the project. ``kind`` is ``"function"``, ``"thread"``,
+    ``"global"`` or ``"installation variable"``; ``node`` the defining statement (a
+    ``def``/``thread``, or the first assignment or declaration)."""
+
+    name: str
+    kind: str
+    filename: str
+    span: n.Span
+    node: n.Stmt
+
+    @property
+    def line(self) -> int:
+        return self.span.line
+
+    @property
+    def where(self) -> str:
+        """``file:line`` as a user would open it."""
+        return f"{self.filename}:{self.line}"
+
+
+@dataclass(eq=False)
+class ScriptFile:
+    """One script file of the project, parsed. ``program`` is the name of the wrapping
+    ``def`` when the file is a host, else None; ``labels`` the file names (without folders)
+    of its ``Script:`` labels; ``module`` None when the file does not parse."""
+
+    path: Path
+    filename: str
+    text: str
+    module: n.Module | None
+    program: str | None = None
+    labels: tuple[str, ...] = ()
+    definitions: dict[str, list[Definition]] = field(default_factory=dict)
+    top_level: dict[str, n.Stmt] = field(default_factory=dict)
+    assigned_later: dict[str, n.Stmt] = field(default_factory=dict)
+    code_lines: frozenset[str] = frozenset()
+    code_line_list: tuple[str, ...] = ()
+
+    @property
+    def is_host(self) -> bool:
+        return self.program is not None
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """What to say about a name a file uses but does not define: ``severity`` None means no
+    finding (it is defined where the program gets it); otherwise the severity and a message
+    naming where the name is defined."""
+
+    definition: Definition
+    severity: str | None
+    message: str
+    hint: str | None = None
+
+
+_READ_KINDS = frozenset(("global", "installation variable"))
+
+
+@dataclass
+class FileContext:
+    """One file seen from its project: its role, its hosts and every definition elsewhere."""
+
+    project: Project
+    file: ScriptFile
+    hosts: list[ScriptFile]
+    included: list[ScriptFile]  # fragments this file includes (when it is a host)
+
+    @property
+    def role(self) -> str:
+        """``"fragment"`` (included by a host, or no program of its own) or ``"host"``."""
+        return "host" if self.file.is_host and not self.hosts else "fragment"
+
+    @property
+    def host_names(self) -> list[str]:
+        return [host.filename for host in self.hosts]
+
+    def near(self, filename: str) -> str:
+        """``filename`` as seen from this file's folder (``robotiq.script``,
+        ``../lib/math.script``)."""
+        try:
+            return os.path.relpath(filename, os.path.dirname(self.file.filename) or ".")
+        except ValueError:
+            return filename
+
+    def resolve_read(self, name: str) -> Resolution | None:
+        """A variable read here that this file does not define (None: defined nowhere)."""
+        return self._resolve(name, _READ_KINDS)
+
+    def resolve_call(self, name: str) -> Resolution | None:
+        """A function called here that neither this file nor the builtins define."""
+        return self._resolve(name, frozenset(("function",)))
+
+    def resolve_thread(self, name: str) -> Resolution | None:
+        """A thread started (``run``) here that this file does not define."""
+        return self._resolve(name, frozenset(("thread",)))
+
+    def definitions(self, name: str, kinds: frozenset[str]) -> list[tuple[str, Definition]]:
+        """Where ``name`` is defined outside this file, best first, each with the relation
+        of its file to this one: ``"variables"``, ``"host"``, ``"included"`` (a file this
+        program includes), ``"explicit"`` (named with --include or in the configuration),
+        ``"other"``."""
+        found: list[tuple[str, Definition]] = []
+        if "installation variable" in kinds:
+            for variables in self.project.variables:
+                variable = variables.names().get(name)
+                if variable is not None:
+                    found.append(("variables", Definition(
+                        name, "installation variable", variables.filename, variable.span,
+                        variable.statement)))
+        hosts = {id(s) for s in self.hosts}
+        included = {id(s) for s in self.included}
+        order = {"host": 0, "included": 1, "explicit": 2, "other": 3}
+        ranked = []
+        for index, (script, definition) in enumerate(self.project.defined(name)):
+            if script is self.file or definition.kind not in kinds:
+                continue
+            relation = ("host" if id(script) in hosts else "included" if id(script) in included
+                        else "explicit" if self.project.is_explicit(script) else "other")
+            ranked.append((order[relation], index, relation, definition))
+        found.extend((relation, definition) for _o, _i, relation, definition in sorted(ranked))
+        return found
+
+    def _resolve(self, name: str, kinds: frozenset[str]) -> Resolution | None:
+        found = self.definitions(name, kinds)
+        if not found:
+            return None
+        relation, definition = found[0]
+        if relation in ("variables", "host", "included", "explicit"):
+            return Resolution(definition, None, f"'{name}' is defined in {definition.where}")
+        other = self.near(definition.filename)
+        where = f"{other}:{definition.line}"
+        if self.hosts:
+            hosts = _join([self.near(h) for h in self.host_names])
+            return Resolution(
+                definition, "info",
+                f"'{name}' is defined in {where}, which {hosts} does not include",
+                f"{hosts} includes this file; if it should run {other} too, "
+                "add it to the program (a Script node in PolyScope)")
+        if self.role == "host":
+            return Resolution(
+                definition, "error",
+                f"'{name}' is not defined in this program ({where} defines it, but this "
+                "program does not include it)",
+                f"add {other} to the program (a Script node in PolyScope)")
+        return Resolution(
+            definition, "warning",
+            f"'{name}' is defined in {where}; this file looks like a fragment that a program "
+            "includes, but no program of the project includes it",
+            "lint the program that includes this file with it, or name that program with "
+            "--include (or [tool.urdsl] include in pyproject.toml)")
+
+
+def _join(names: list[str]) -> str:
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
+@dataclass(eq=False)
+class Project:
+    """The script files and installation variables of one project."""
+
+    root: Path
+    files: list[ScriptFile]
+    variables: list[VariablesFile]
+    explicit: frozenset[str] = frozenset()
+    """Resolved paths of the files named with ``include`` or in the configuration."""
+    _hosts: dict[int, list[ScriptFile]] | None = field(default=None, repr=False)
+    _by_path: dict[str, ScriptFile] | None = field(default=None, repr=False)
+    _explicit_ids: dict[int, bool] = field(default_factory=dict, repr=False)
+    _by_name: dict[str, list[tuple[ScriptFile, Definition]]] | None = field(
+        default=None, repr=False)
+
+    # -- discovery ---------------------------------------------------------------------------
+
+    @classmethod
+    def discover(cls, path: str | Path, include: tuple[str | Path, ...] | list = (),
+                 use_config: bool = True) -> Project:
+        """The project of ``path``: a folder's whole tree; for a file, its folder (not its
+        subfolders), or, when a program in a folder up to three levels above includes the
+        file (PolyScope keeps script files in subfolders of the programs folder), that
+        folder's tree. With the ``include`` files and the configured includes. Files that
+        cannot be read are left out; a bad configuration raises :class:`ProjectError`."""
+        path = Path(path)
+        if path.is_dir():
+            root = path
+            found = _tree(path)
+            scripts_here = [p for p in found if p.suffix in SCRIPT_SUFFIXES]
+            if len(scripts_here) <= MAX_TREE_FILES:
+                above = _folder_above(path, scripts_here, scripts_here)
+                if above is not None:  # a subfolder of a project: add the program above
+                    keys = {_key(p) for p in found}
+                    found += [p for p in _listing(above) if _key(p) not in keys]
+        else:
+            root = path.parent if str(path.parent) else Path(".")
+            found = _listing(root)
+            if path.is_file() and _key(path) not in {_key(p) for p in found}:
+                found.append(path)
+            above = _host_folder(path, found)
+            if above is not None:  # the program that includes the file is further up
+                root = above
+                tree = _tree(above, MAX_TREE_FILES + 1)
+                if len(tree) <= MAX_TREE_FILES:
+                    found = tree
+                else:
+                    keys = {_key(p) for p in found}
+                    found += [p for p in _listing(above) if _key(p) not in keys]
+        known = {_key(p) for p in found}
+        extra = [Path(p) for p in include]
+        if use_config:
+            extra += configured_includes(root)
+        explicit: set[str] = set()
+        for item in extra:
+            candidates = _tree(item) if item.is_dir() else [item]
+            for candidate in candidates:
+                if not candidate.is_file():
+                    continue
+                key = _key(candidate)
+                explicit.add(key)
+                if key not in known:
+                    known.add(key)
+                    found.append(candidate)
+        scripts = [load_script(p) for p in found if p.suffix in SCRIPT_SUFFIXES]
+        variables = [read_variables(p) for p in found if p.suffix == VARIABLES_SUFFIX]
+        return cls(root, [s for s in scripts if s is not None], variables, frozenset(explicit))
+
+    # -- questions ---------------------------------------------------------------------------
+
+    def is_explicit(self, script: ScriptFile) -> bool:
+        """Whether ``script`` was named with ``include`` or in the configuration."""
+        if not self.explicit:
+            return False
+        if id(script) not in self._explicit_ids:
+            self._explicit_ids[id(script)] = _key(script.path) in self.explicit
+        return self._explicit_ids[id(script)]
+
+    def find(self, path: str | Path) -> ScriptFile | None:
+        """The project's script file at ``path``, if it is one."""
+        if self._by_path is None:
+            self._by_path = {_key(script.path): script for script in self.files}
+        return self._by_path.get(_key(Path(path)))
+
+    def defined(self, name: str) -> list[tuple[ScriptFile, Definition]]:
+        """Every definition of ``name`` in the project's script files, in file order."""
+        if self._by_name is None:
+            self._by_name = {}
+            for script in self.files:
+                for key, found in script.definitions.items():
+                    self._by_name.setdefault(key, []).extend((script, d) for d in found)
+        return self._by_name.get(name, [])
+
+    def hosts_of(self, script: ScriptFile) -> list[ScriptFile]:
+        """The hosts that include ``script`` (by ``Script:`` label or inlined code)."""
+        if self._hosts is None:
+            self._hosts = {}
+            hosts = [s for s in self.files if s.is_host and s.module is not None]
+            for fragment in self.files:
+                self._hosts[id(fragment)] = [
+                    h for h in hosts if h is not fragment and _includes(h, fragment)]
+        if id(script) not in self._hosts:
+            hosts = [s for s in self.files if s.is_host and s.module is not None]
+            return [h for h in hosts if h is not script and _includes(h, script)]
+        return self._hosts[id(script)]
+
+    def context(self, path: str | Path, text: str | None = None,
+                filename: str | None = None) -> FileContext:
+        """``path`` seen from the project. ``text`` replaces the file's text on disk (an
+        editor's unsaved buffer); a file outside the project is added to it."""
+        script = self.find(path)
+        if text is not None or script is None:
+            if text is None:
+                loaded = load_script(Path(path))
+                text = loaded.text if loaded is not None else ""
+            name = filename or (script.filename if script is not None else str(path))
+            replacement = script_file(Path(path), name, text)
+            if script is not None:
+                self.files = [replacement if s is script else s for s in self.files]
+            else:
+                self.files = [*self.files, replacement]
+            self._hosts = self._by_path = self._by_name = None
+            script = replacement
+        hosts = self.hosts_of(script)
+        included = [s for s in self.files if s is not script and script.is_host
+                    and script in self.hosts_of(s)]
+        return FileContext(self, script, hosts, included)
+
+    def diagnostics(self) -> list[Diagnostic]:
+        """Problems in the installation variables files (bad lines)."""
+        return [d for variables in self.variables for d in variables.diagnostics]
+
+
+# ---- files -----------------------------------------------------------------------------------
+
+def _wanted(path: Path) -> bool:
+    return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix == VARIABLES_SUFFIX)
+
+
+def _tree(folder: Path, limit: int | None = None) -> list[Path]:
+    """The project files in ``folder``'s tree (hidden folders left out), at most ``limit``."""
+    if not folder.is_dir():
+        return []
+    found: list[Path] = []
+    with contextlib.suppress(OSError):
+        for p in folder.rglob("*"):
+            if _wanted(p) and not any(part.startswith(".")
+                                      for part in p.parts[len(folder.parts):]):
+                found.append(p)
+                if limit is not None and len(found) >= limit:
+                    break
+    return sorted(found)
+
+
+def _listing(folder: Path) -> list[Path]:
+    """The project files directly in ``folder``."""
+    try:
+        return [p for p in sorted(folder.iterdir()) if _wanted(p)]
+    except OSError:  # no such folder, or not allowed to list it
+        return []
+
+
+def _host_folder(path: Path, beside: list[Path]) -> Path | None:
+    """The folder, up to :data:`HOST_LEVELS` above ``path``'s, whose programs include the
+    script file ``path`` — None when a program beside it does, or none does. The search
+    does not leave the repository (a folder holding ``.git``)."""
+    if path.suffix not in SCRIPT_SUFFIXES:
+        return None
+    return _folder_above(path.parent, [path], beside)
+
+
+def _folder_above(start: Path, paths: list[Path], beside: list[Path]) -> Path | None:
+    """The folder up to :data:`HOST_LEVELS` above ``start`` whose programs include one of
+    the script files ``paths`` — None when a program among ``beside`` does, or none does."""
+    fragments = [f for f in (load_script(p) for p in paths if p.suffix in SCRIPT_SUFFIXES)
+                 if f is not None and f.module is not None and not f.is_host]
+    if not fragments:
+        return None
+    own = {_key(p) for p in paths}
+
+    def includes(candidates: list[Path], skip: set[str]) -> bool:
+        for candidate in candidates:
+            if candidate.suffix not in SCRIPT_SUFFIXES or _key(candidate) in skip:
+                continue
+            host = load_script(candidate)
+            if host is not None and host.is_host and any(
+                    _includes(host, fragment) for fragment in fragments):
+                return True
+        return False
+
+    if includes(beside, own if len(paths) == 1 else set()):
+        return None
+    try:
+        folder = start.resolve()
+    except OSError:
+        return None
+    for _level in range(HOST_LEVELS):
+        if (folder / ".git").exists() or folder.parent == folder:
+            return None
+        folder = folder.parent
+        if includes(_listing(folder), own):
+            return Path(_display(folder))
+    return None
+
+
+def _display(path: Path) -> str:
+    """``path`` as a user would type it: relative to the working folder when inside it."""
+    if path.is_absolute():
+        try:
+            return str(path.relative_to(Path.cwd()))
+        except ValueError:
+            return str(path)
+    return str(path)
+
+
+def _key(path: Path) -> str:
+    try:
+        return str(path.resolve())
+    except OSError:
+        return str(path)
+
+
+_CACHE: dict[tuple[str, str, int, int, str], ScriptFile] = {}
+
+
+def load_script(path: Path) -> ScriptFile | None:
+    """The parsed script file at ``path`` (None when it cannot be read or is too large).
+    Parsed files are cached by path, size and modification time (and, for an absolute path,
+    the working folder its shown name is relative to)."""
+    try:
+        stat = path.stat()
+    except OSError:
+        return None
+    if stat.st_size > MAX_FILE_BYTES:
+        return None
+    key = (str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns,
+           os.getcwd() if path.is_absolute() else "")  # the name shown depends on it
+    cached = _CACHE.get(key)
+    if cached is not None:
+        return cached
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    script = script_file(path, _display(path), text)
+    if len(_CACHE) > 512:
+        _CACHE.clear()
+    _CACHE[key] = script
+    return script
+
+
+def script_file(path: Path, filename: str, text: str) -> ScriptFile:
+    """Parse ``text`` as the script file ``path`` (shown as ``filename``)."""
+    lines = tuple(_code_lines(text))
+    try:
+        module = parse(text, filename)
+    except (ScriptError, RecursionError):
+        return ScriptFile(path, filename, text, None, code_lines=frozenset(lines),
+                          code_line_list=lines)
+    program = program_name(module, text)
+    labels = tuple(_labels(text))
+    definitions, top_level, late = _definitions(module, filename, program)
+    return ScriptFile(path, filename, text, module, program, labels, definitions, top_level,
+                      late,
+                      frozenset(lines), lines)
+
+
+def program_name(module: n.Module, text: str | None = None) -> str | None:
+    """The name of the wrapping ``def`` when ``module`` is a complete program: one
+    ``def`` without parameters followed by a call of it, or alone with PolyScope's ``$``
+    labels in it (as PolyScope exports a program). A lone ``def`` without labels is taken
+    for a fragment (a helper function meant to be included)."""
+    statements = [item for item in module.body if isinstance(item, n.Stmt)]
+    if not statements or not isinstance(statements[0], n.FunctionDef):
+        return None
+    program = statements[0]
+    if program.params:
+        return None
+    rest = statements[1:]
+    if not rest:  # PolyScope writes the def alone, with its $ labels
+        if text is not None:
+            return program.name if _MARKER_LINE.search(text) else None
+        return program.name if any(isinstance(x, n.Marker) for x in n.walk(program)) else None
+    if len(rest) == 1 and isinstance(rest[0], n.ExprStmt):
+        call = rest[0].expr
+        if (isinstance(call, n.Call) and isinstance(call.func, n.Name)
+                and call.func.id == program.name and not call.args):
+            return program.name
+    return None
+
+
+_MARKER_LINE = re.compile(r"^[ \t]*\$[ \t]*\d", re.MULTILINE)
+_SCRIPT_LABEL = re.compile(
+    r'^[ \t]*\$[ \t]*\d+[ \t]*"?[ \t]*Script:[ \t]*([^"\r\n]+?)[ \t]*"?[ \t]*'
+    r'(?:"[^"\r\n]*"[ \t]*)?\r?$', re.MULTILINE | re.IGNORECASE)
+
+
+def _labels(text: str) -> list[str]:
+    """The file names (without folders) of the ``$ N "Script: name.script"`` labels in
+    ``text``."""
+    return [re.split(r"[\\/]", match.group(1))[-1] for match in _SCRIPT_LABEL.finditer(text)]
+
+
+def _definitions(module: n.Module, filename: str, program: str | None
+                 ) -> tuple[dict[str, list[Definition]], dict[str, n.Stmt], dict[str, n.Stmt]]:
+    """The names ``module`` defines for other files, the first-level assignment of each
+    global, and the first assignment anywhere of each global (``global x = v`` in a loop or
+    a function)."""
+    from ..lint.scope import analyse, statements  # the controller's scoping rules
+
+    late: dict[str, n.Stmt] = {}
+    try:
+        analysis = analyse(module)
+    except RecursionError:
+        return {}, {}, late
+    found: dict[str, list[Definition]] = {}
+
+    def add(name: str, kind: str, node: n.Stmt, span: n.Span) -> None:
+        found.setdefault(name, []).append(Definition(name, kind, filename, span, node))
+
+    for table, kind in ((analysis.functions, "function"), (analysis.threads, "thread")):
+        for name, nodes in table.items():
+            if name == program and kind == "function":
+                continue  # the program itself is not callable from the program
+            for node in nodes:
+                add(name, kind, node, node.span)
+    for name in sorted(analysis.globals):
+        node = None
+        writes = analysis.top.assigned.get(name)
+        if writes:
+            node = writes[0]
+        else:
+            for scope in analysis.scopes:
+                if name in scope.declared_global:
+                    node = scope.declared_global[name]
+                    break
+                if name in scope.assigned and analysis.is_global_in(name, scope):
+                    node = scope.assigned[name][0]
+                    break
+        if node is not None:
+            add(name, "global", node, node.span)  # type: ignore[arg-type, attr-defined]
+    top_level: dict[str, n.Stmt] = {}
+    for scope in analysis.scopes:  # a global given a value only inside a block or function
+        for statement in statements(scope.body):
+            name = _assigned_name(statement)
+            if name is not None and name in analysis.globals and name not in late \
+                    and analysis.is_global_in(name, scope):
+                late[name] = statement
+    for item in analysis.top.body:
+        if isinstance(item, n.Assign) and isinstance(item.target, n.Name):
+            top_level.setdefault(item.target.id, item)
+        elif isinstance(item, n.Declare) and item.value is not None:
+            top_level.setdefault(item.name, item)
+    return found, top_level, late
+
+
+def _assigned_name(statement: n.Stmt) -> str | None:
+    """The variable a statement gives a value to (``x = v``, ``global x = v``), if any."""
+    if isinstance(statement, n.Assign) and isinstance(statement.target, n.Name):
+        return statement.target.id
+    if isinstance(statement, n.Declare) and statement.value is not None:
+        return statement.name
+    return None
+
+
+def _code_lines(text: str) -> list[str]:
+    """The lines of ``text`` that carry code, without spaces (for finding inlined files)."""
+    lines = []
+    for line in text.splitlines():
+        compact = "".join(line.split())
+        if not compact or compact[0] in "#$" or compact in ("end", "else:"):
+            continue
+        lines.append(compact)
+    return lines
+
+
+def _includes(host: ScriptFile, fragment: ScriptFile) -> bool:
+    """Whether ``host`` includes ``fragment`` (a ``Script:`` label, or its code inlined)."""
+    name = fragment.path.name.lower()
+    if any(label.lower() == name for label in host.labels):
+        return True
+    lines = fragment.code_line_list
+    if not lines:
+        return False
+    if fragment.program is not None:
+        # a complete program is included only as a subprogram: the host has its def (two
+        # copies of one program are two programs, however alike)
+        if not any(d.kind == "function" for d in host.definitions.get(fragment.program, [])):
+            return False
+        return _share(lines, host.code_lines) >= _SUBPROGRAM_SHARE
+    return len(lines) >= 2 and _share(lines, host.code_lines) >= _INLINE_SHARE
+
+
+def _share(lines: tuple[str, ...], within: frozenset[str]) -> float:
+    """The share of ``lines`` found in ``within``."""
+    return sum(1 for line in lines if line in within) / len(lines)
+
+
+# ---- configuration ---------------------------------------------------------------------------
+
+def configured_includes(start: Path) -> list[Path]:
+    """The files named by ``[tool.urdsl] include`` in the nearest ``pyproject.toml`` that
+    has that key, walking up from folder ``start``; entries are paths or glob patterns
+    relative to that file."""
+    try:
+        folder = start.resolve()
+    except OSError:
+        return []
+    for candidate_folder in (folder, *folder.parents):
+        candidate = candidate_folder / "pyproject.toml"
+        if not candidate.is_file():
+            continue
+        try:
+            with open(candidate, "rb") as handle:
+                data = tomllib.load(handle)
+        except (OSError, tomllib.TOMLDecodeError) as error:
+            raise ProjectError(f"{candidate}: {error}") from None
+        table = data.get("tool", {}).get("urdsl", {})
+        if not isinstance(table, dict) or "include" not in table:
+            continue
+        entries = table["include"]
+        if isinstance(entries, str):
+            entries = [entries]
+        if not isinstance(entries, list) or not all(isinstance(e, str) for e in entries):
+            raise ProjectError(f"{candidate}: [tool.urdsl] include must be a list of paths")
+        paths: list[Path] = []
+        for entry in entries:
+            if any(ch in entry for ch in "*?["):
+                paths.extend(sorted(candidate_folder.glob(entry)))
+            else:
+                target = candidate_folder / entry
+                if not target.exists():
+                    raise ProjectError(f"{candidate}: [tool.urdsl] include names {entry}, "
+                                       "which does not exist")
+                paths.append(target)
+        return paths
+    return []
