@@ -195,3 +195,21 @@ def test_samples_out_of_reach_are_marked_and_the_trace_stays_finite():
     crossing = np.abs(trace.q[inside[0] - 1, 0])
     assert crossing == pytest.approx(np.sqrt(0.1 ** 2 - x ** 2), abs=0.01)
     assert np.allclose(trace.q[-1, :3], (0.5, 0.02, 0))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(0.0, 0.5), st.floats(0.0, 3.0), st.floats(0.05, 1.0), st.floats(0.2, 3.0))
+def test_a_line_takes_the_longer_of_its_path_and_rotation_profiles(length, angle, v, a):
+    from urdsl.motion.planner import ROTATION_PER_METRE, line_profile
+
+    start, end = pose(0, 0, 0), pose(length, 0, 0)
+    end[:3, :3] = rotvec_to_matrix(np.array([0.0, 0.0, angle]))
+    profile = line_profile(start, end, v, a, 0.0, ROTATION_PER_METRE * v,
+                           ROTATION_PER_METRE * a)
+    expected = max(closed_form(length, v, a) if length > 1e-9 else 0.0,
+                   closed_form(angle, ROTATION_PER_METRE * v, ROTATION_PER_METRE * a)
+                   if angle > 1e-9 else 0.0)
+    assert profile.duration == pytest.approx(expected, rel=1e-9, abs=1e-12)
+    if length > 1e-9:  # the path's distance, whatever profile leads
+        assert profile.distance == pytest.approx(length)
+        assert float(profile.position(profile.duration)) == pytest.approx(length)

@@ -263,3 +263,29 @@ def test_a_jump_is_found_wherever_it_lies_in_a_long_trace(at):
     (finding,) = found.findings
     assert f"t={at * dt:.3f} s" in finding.message and "wrist 1" in finding.message
     assert found.samples[at] and not found.samples[at + 3 if at + 3 < count else at - 3]
+
+
+# ---- issue 12, item 5: motion semantics found wrong on real programs -------------------------
+
+
+def test_a_short_movel_that_mostly_turns_the_tool_is_timed_on_its_rotation():
+    # 1 cm along the tool's x and 120° about its z: at the defaults (v = 0.25 m/s,
+    # a = 1.2 m/s²) the path alone would take 0.18 s and spin wrist 3 at over 20 rad/s
+    report = check(f"""
+        {READY}
+        movel(pose_trans(get_target_tcp_pose(), p[0.01, 0, 0, 0, 0, {math.radians(120)}]))
+        """)
+    assert "URS304" not in report.codes(), report.render_text()
+    assert not report.has_errors
+    turn = report.moves[1]
+    # rotation trapezoid: 2.094 rad at 1 rad/s with 4.8 rad/s²: 2.094 + 1/4.8 s
+    assert turn.duration == pytest.approx(math.radians(120) / 1.0 + 1.0 / 4.8, rel=1e-6)
+
+
+def test_a_move_that_mostly_translates_keeps_the_time_of_its_path():
+    report = check(f"""
+        {READY}
+        movel(pose_trans(get_target_tcp_pose(), p[0.3, 0, 0, 0, 0, 0.2]), a=1.2, v=0.25)
+        """)
+    # 0.3 m at 0.25 m/s with 1.2 m/s²: 0.3/0.25 + 0.25/1.2; 0.2 rad takes far less
+    assert report.moves[1].duration == pytest.approx(0.3 / 0.25 + 0.25 / 1.2, rel=1e-6)

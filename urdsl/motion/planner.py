@@ -5,8 +5,9 @@ Timing model
 ------------
 * ``movej``: joint-space line, trapezoid of the *leading axis* (the joint with the longest
   time at ``a``/``v``); all joints start and stop together. ``t`` > 0 overrides ``a``/``v``.
-* ``movel``: straight TCP line (orientation slerped), trapezoid on the path length (m); a
-  rotation-only move is timed on the rotation angle with the same ``a``/``v`` in rad.
+* ``movel``: straight TCP line (orientation slerped), trapezoid on the path length (m) and
+  one on the rotation angle (rad, with ``4·v`` and ``4·a`` [U]); the longer one sets the
+  time (:func:`line_profile`).
 * ``movep``: like ``movel`` (constant tool speed comes from blending consecutive moves).
 * ``movec``: circular arc through the via point's position, trapezoid on the arc length.
 
@@ -40,7 +41,7 @@ from ..script.nodes import Span
 from .profiles import Trapezoid
 
 __all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel", "JOINT_SPACE",
-           "UnreachableTarget"]
+           "UnreachableTarget", "line_profile", "ROTATION_PER_METRE"]
 
 BLENDABLE_INTO = frozenset({"movej", "movel", "movep", "movec"})
 """Moves the previous move may blend into (servoj and speedj start from rest)."""
@@ -314,15 +315,19 @@ class MotionPlanner:
                                        {"a": a, "v": v, "t": t, "lead": lead}), now)
 
     def movel(self, pose: np.ndarray, a: float, v: float, t: float, r: float, span: Span,
-              now: float, kind: str = "movel") -> float:
-        """Straight TCP line to ``pose`` (4x4): ``a`` m/s², ``v`` m/s, ``t`` s, ``r`` m."""
-        from .geometry import rotation_angle
+              now: float, kind: str = "movel", a_rot: float | None = None,
+              v_rot: float | None = None) -> float:
+        """Straight TCP line to ``pose`` (4x4): ``a`` m/s², ``v`` m/s, ``t`` s, ``r`` m.
 
+        The orientation has its own limits, ``v_rot`` rad/s and ``a_rot`` rad/s² (default
+        :data:`ROTATION_PER_METRE` times ``v`` and ``a``); the move takes the longer of the
+        two profiles (see :func:`line_profile`)."""
         pose_from = self._end_matrix()
-        length = _distance(pose, pose_from)
-        if length < 1e-9:  # rotation only: time it on the angle
-            length = rotation_angle(pose_from[:3, :3], pose[:3, :3])
-        profile = Trapezoid.plan(length, v, a, t)
+        if v_rot is None:
+            v_rot = ROTATION_PER_METRE * v
+        if a_rot is None:
+            a_rot = ROTATION_PER_METRE * a
+        profile = line_profile(pose_from, pose, v, a, t, v_rot, a_rot)
         return self._add_cartesian(kind, profile, pose_from, pose, r, span,
                                    {"a": a, "v": v, "t": t}, now)
 
@@ -392,7 +397,9 @@ class MotionPlanner:
         pose = pose_from.copy()
         pose[:3, 3] += xd[:3] * t
         pose[:3, :3] = rotvec_to_matrix(xd[3:] * t) @ pose_from[:3, :3]
-        end = self.movel(pose, a, speed, 0.0, 0.0, span, now, kind="speedl")
+        # speedl's rotational part is in rad/s and rad/s² as given (aRot defaults to a)
+        end = self.movel(pose, a, max(linear, 1e-12), 0.0, 0.0, span, now, kind="speedl",
+                         a_rot=a, v_rot=max(angular, 1e-12))
         return end - min(speed / a, end - now)
 
     def stop(self, now: float) -> float:
@@ -478,6 +485,46 @@ class MotionPlanner:
         self._pending = None
         self._free_at = end
         return end
+
+
+ROTATION_PER_METRE = 4.0
+"""Rotational speed and acceleration limits of a ``movel``/``movep`` per unit of its tool
+speed and acceleration: ``v_rot = 4·v`` rad/s and ``a_rot = 4·a`` rad/s² (1 rad/s and
+4.8 rad/s² at the defaults v = 0.25 m/s, a = 1.2 m/s²). [U] The script manual documents only
+the m/s and m/s² of the position; this rule is a user's measurement reported on the UR
+forum ("MoveL: Tool Angular Speed", forum.universal-robots.com/t/movel-tool-angular-speed/
+15912): position and orientation each get a trapezoid, the longer one sets the move's time
+and the other is slowed down to it."""
+
+
+def line_profile(pose_from: np.ndarray, pose_to: np.ndarray, v: float, a: float, t: float,
+                 v_rot: float, a_rot: float) -> Trapezoid:
+    """The speed profile of a straight TCP line from ``pose_from`` to ``pose_to`` (4x4, m).
+
+    The controller plans two trapezoids, one for the path length ``L`` (m) with ``v`` m/s and
+    ``a`` m/s², one for the rotation angle ``θ`` (rad) with ``v_rot`` rad/s and ``a_rot``
+    rad/s², and moves on the longer one; position and orientation progress by the same path
+    fraction, so the shorter one is slowed down to it [U: see :data:`ROTATION_PER_METRE`].
+    A time ``t`` > 0 stretches the result as for any move.
+
+    The profile's distance stays the path length in m (what blends and the TCP speed use);
+    a move that only turns the tool has its angle in rad as distance. A 1 cm move that turns
+    the tool by 120° at the defaults takes about 2.3 s, not the 0.18 s of its 1 cm.
+    """
+    from .geometry import rotation_angle
+
+    length = _distance(pose_to, pose_from)
+    angle = rotation_angle(pose_from[:3, :3], pose_to[:3, :3])
+    rotation = Trapezoid.plan(angle, v_rot, a_rot) if angle > 1e-9 else None
+    if length < 1e-9:  # the tool only turns: time it on the angle
+        return rotation.stretched(t) if rotation is not None and t > 0 else (
+            rotation if rotation is not None else Trapezoid.plan(0.0, v, a, t))
+    profile = Trapezoid.plan(length, v, a)
+    if rotation is not None and rotation.duration > profile.duration:
+        scale = length / angle  # the rotation's timing, with the path's distance
+        profile = Trapezoid(length, rotation.accel * scale, rotation.peak * scale,
+                            rotation.t_acc, rotation.t_flat)
+    return profile.stretched(t) if t > 0 else profile
 
 
 def _distance(pose: np.ndarray, other: np.ndarray) -> float:

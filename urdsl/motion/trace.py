@@ -144,9 +144,13 @@ class _Moves:
         p = self.profile[moves]
         t_acc, t_flat = p[:, 3], p[:, 4]
         ramp = np.where(t_acc > 0, np.ceil(t_acc / KNOT_TIME - 1e-9), 0).astype(np.int64)
-        cruise_step = np.maximum(KNOT_TIME, np.divide(KNOT_PATH, p[:, 2],
-                                                      out=np.full(len(p), np.inf),
-                                                      where=p[:, 2] > 0))
+        cruise_step = np.divide(KNOT_PATH, p[:, 2], out=np.full(len(p), np.inf),
+                                where=p[:, 2] > 0)
+        # a move that turns the tool far along a short path: KNOT_ANGLE of rotation at most
+        turn = self.paths.turn[moves] * np.divide(p[:, 2], p[:, 0], out=np.zeros(len(p)),
+                                                  where=p[:, 0] > 0)
+        cruise_step = np.maximum(KNOT_TIME, np.minimum(cruise_step, np.divide(
+            KNOT_ANGLE, turn, out=np.full(len(p), np.inf), where=turn > 0)))
         cruise = np.where(t_flat > 0, np.ceil(t_flat / cruise_step - 1e-9), 0).astype(np.int64)
         ramp = np.maximum(ramp, np.where(cruise > 0, 0, 1))  # at least one step per move
         steps = 2 * ramp + cruise
@@ -269,6 +273,12 @@ time. 8 mm is what :data:`KNOT_TIME` gives at the controller's default movel spe
 (0.25 m/s); a slow process move (a 0.1 m/s toolpath) is solved every 80 ms."""
 
 
+KNOT_ANGLE = 0.032
+"""Longest tool rotation (rad) between knots while a move cruises: what :data:`KNOT_TIME`
+gives at a movel's default rotational speed (1 rad/s); it matters for moves that mostly
+turn the tool, whose path length says little about how far the joints go."""
+
+
 def _joint_velocities(planner, paths, which, q_start, moved, fraction_rate) -> np.ndarray:
     """Joint speeds (M, 6) rad/s at solved samples of straight TCP paths: the twist of the
     path (linear ``(p1 − p0)·ḟ``, angular ``R0·w·ḟ`` with ``w = log(R0ᵀR1)``) through the
@@ -357,6 +367,7 @@ class _Paths:
         self.r0 = starts[:, :3, :3]
         self.w = matrix_to_rotvec(np.swapaxes(self.r0, 1, 2) @ ends[:, :3, :3])
         self.angular = (self.r0 @ self.w[:, :, None])[:, :, 0]  # rotation step in Base
+        self.turn = np.linalg.norm(self.w, axis=1)  # rotation angle of each move, rad
         self.arc = np.array([s.kind == "movec" and s.via is not None for s in segments])
         self.tcp_group, self.tcps = tcp_groups(segments)
 
