@@ -289,3 +289,61 @@ def test_a_move_that_mostly_translates_keeps_the_time_of_its_path():
         """)
     # 0.3 m at 0.25 m/s with 1.2 m/s²: 0.3/0.25 + 0.25/1.2; 0.2 rad takes far less
     assert report.moves[1].duration == pytest.approx(0.3 / 0.25 + 0.25 / 1.2, rel=1e-6)
+
+
+def test_a_bug_in_a_loop_is_reported_once_with_how_often_and_when_first():
+    report = check(f"""
+        {READY}
+        i = 0
+        while i < 12:
+          movej([0, -1.9, 1.9, -1.57, -1.57, 0])
+          movej([0, -1.9, 1.9, -1.57, -1.57, 3.0], a=40, v=6.0)
+          i = i + 1
+        end
+        """)
+    (finding,) = only(report, "URS304")
+    assert finding.span.line == 5 and finding.count == 12
+    assert "wrist 3" in finding.message
+    assert finding.message.endswith(f"(12 times, first at t={finding.time:.3f} s)")
+    first_pass = [m for m in report.moves if m.span.line == 5][0]
+    assert first_pass.start <= finding.time <= first_pass.start + first_pass.duration
+    assert report.to_dict()["findings"][0]["count"] == 12
+
+
+def test_a_controller_warning_in_a_loop_is_reported_once():
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        i = 0
+        while i < 3:
+          movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]), r=0.05)
+          movel(pose_add(home, p[0.1, 0.06, 0, 0, 0, 0]), r=0.05)
+          movel(home)
+          i = i + 1
+        end
+        """)
+    (finding,) = only(report, "URS309")
+    assert finding.count == 3 and "(3 times, first at t=" in finding.message
+
+
+def test_findings_differing_only_in_numbers_merge_but_not_across_joints_or_lines():
+    from urdsl.script.nodes import Source, Span
+    from urdsl.verify.findings import Finding
+    from urdsl.verify.report import Report
+
+    source = Source("a = 1\nb = 2\n", "t.script")
+    here, there = Span(source, 0, 5), Span(source, 6, 11)
+    report = Report("t.script", "ur5e", findings=[
+        Finding("URS205", "warning", "socket read 12 timed out after 0.5 s", here, 2.0),
+        Finding("URS205", "warning", "socket read 7 timed out after 0.25 s", here, 1.0),
+        Finding.of("URS304", "wrist 1 joint turns at 4.00 rad/s", here, 1.5),
+        Finding.of("URS304", "wrist 2 joint turns at 4.00 rad/s", here, 1.6),
+        Finding("URS205", "warning", "socket read 3 timed out after 0.5 s", there, 0.1),
+    ])
+    report.sort()
+    messages = [f.message for f in report.findings]
+    assert messages == ["socket read 7 timed out after 0.25 s (2 times, first at t=1.000 s)",
+                        "wrist 1 joint turns at 4.00 rad/s", "wrist 2 joint turns at 4.00 rad/s",
+                        "socket read 3 timed out after 0.5 s"]
+    report.sort()  # sorting again changes nothing
+    assert [f.message for f in report.findings] == messages
