@@ -347,3 +347,46 @@ def test_findings_differing_only_in_numbers_merge_but_not_across_joints_or_lines
                         "socket read 3 timed out after 0.5 s"]
     report.sort()  # sorting again changes nothing
     assert [f.message for f in report.findings] == messages
+
+
+def _line_past_the_base(x: float) -> str:
+    """A movel, tool down, along y at ``x`` (m) in front of the base: the wrist centre passes
+    the base axis at about |x|, and the shoulder singularity lies on the cylinder of radius
+    d4 (0.1333 m on a UR5e) around it, the workspace's inner boundary."""
+    return f"""
+        {READY}
+        start = get_actual_tcp_pose()
+        movej(p[{x}, -0.35, 0.25, start[3], start[4], start[5]])
+        movel(p[{x}, 0.35, 0.25, start[3], start[4], start[5]], a=0.5, v=0.1)
+        """
+
+
+@pytest.mark.parametrize("x", [0.16, 0.145])
+def test_a_movel_near_the_shoulder_singularity_follows_one_solution(x):
+    # the base turns by about 130° while the tool passes the base: the IK solution closest
+    # to the straight joint-space line between the ends is another branch mid-way, which
+    # gave a jump and joint speeds of 20-100 rad/s; the arm follows its branch smoothly
+    report = check(_line_past_the_base(x))
+    assert not {"URS302", "URS304"} & set(report.codes()), report.render_text()
+    base_speed = abs(report.trace.qd[:, 0]).max()
+    assert base_speed < 3.0
+    # the move ends where its branch leads, turning the base the long way round
+    line = report.trace.segment == 2
+    turned = report.trace.q[line, 0].max() - report.trace.q[line, 0].min()
+    assert turned > math.radians(100)
+
+
+def test_a_movel_through_the_shoulder_singularity_is_still_reported():
+    report = check(_line_past_the_base(0.13))
+    (finding,) = only(report, "URS302")
+    assert finding.span.line == 4 and "workspace" in finding.message
+
+
+def test_the_course_movel_from_a_singular_pose_is_still_found():
+    from pathlib import Path
+
+    mistakes = Path(__file__).parent.parent / "programs" / "mistakes"
+    path = mistakes / "course_movel_from_singular.script"
+    report = check(path.read_text(encoding="utf-8"))
+    assert {"URS302", "URS304"} <= set(report.codes())
+    assert {f.span.line for f in report.findings if f.severity == "error"} == {20}

@@ -41,7 +41,7 @@ from ..script.nodes import Span
 from .profiles import Trapezoid
 
 __all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel", "JOINT_SPACE",
-           "UnreachableTarget", "line_profile", "ROTATION_PER_METRE"]
+           "UnreachableTarget", "line_profile", "ROTATION_PER_METRE", "continue_branch"]
 
 BLENDABLE_INTO = frozenset({"movej", "movel", "movep", "movec"})
 """Moves the previous move may blend into (servoj and speedj start from rest)."""
@@ -210,21 +210,21 @@ class MotionPlanner:
 
     def resolve(self) -> None:
         """Solve the joints of the straight-line moves planned since the last call: all their
-        targets in one batched call for every analytic solution, then, move by move, the
-        controller's choice — the solution closest to the joints the move starts from.
+        targets in one batched call for every analytic solution, then, move by move, where
+        the controller ends up: the continuation of the joints the move starts from along the
+        straight line, i.e. the target's solution on the same IK branch
+        (:func:`continue_branch`).
 
         Raises :class:`UnreachableTarget` for the first target out of reach; that move and
         everything planned after it are dropped, as the robot stops there.
         """
         if not self._unresolved:
             return
-        from ..kinematics.ik import choose_sequence
-
         pending, self._unresolved = self._unresolved, []
         model = self.kinematics
         targets = np.array([segment.pose_end for segment in pending])
         solutions, miss = model.ik_all_many(targets, tcp=pending[0].tcp)
-        chosen, found = choose_sequence(solutions, self._q_end, model.q_min, model.q_max)
+        chosen, found = continue_branch(model, solutions, self._q_end, pending[0].tcp)
         previous = self._q_end.copy()
         for index, segment in enumerate(pending):
             if not found[index]:
@@ -485,6 +485,77 @@ class MotionPlanner:
         self._pending = None
         self._free_at = end
         return end
+
+
+def continue_branch(model, solutions: np.ndarray, q_first: np.ndarray, tcp=None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """The joints (N, 6) at the end of a chain of straight-line moves to targets with the
+    analytic solutions ``solutions`` (N, 8, 6), starting from ``q_first`` (rad), and which
+    were found (N,).
+
+    On a straight TCP line the controller follows one IK solution continuously, so a move
+    ends on the IK branch (shoulder, elbow, wrist: :mod:`urdsl.kinematics.ik`) it started on
+    unless the path passes a singularity — where the trace shows the jump (URS302). Each
+    target therefore takes the solution of the branch the chain is on, each joint turned by
+    the multiple of 2π nearest the previous joints. Where that branch does not exist or
+    leaves the joint limits (and at a singular start, where the branch is ambiguous) the
+    target takes the solution closest to the previous joints, and the chain goes on from
+    its branch. The closest solution and the continuation differ only for moves that pass
+    near a singularity: a line passing the base at a small distance turns the base by
+    far more than the closest solution would.
+    """
+    from ..kinematics.ik import choose_nearest, choose_sequence
+
+    count = solutions.shape[0]
+    chosen = np.full((count, 6), np.nan)
+    found = np.zeros(count, dtype=bool)
+    previous = np.asarray(q_first, dtype=float)
+    row = 0
+    branch = _branch_of(model, previous, tcp)
+    while row < count:
+        if branch is None:  # no branch to continue: the controller's nearest choice
+            rest, ok = choose_sequence(solutions[row:], previous, model.q_min, model.q_max)
+            chosen[row:], found[row:] = rest, ok
+            return chosen, found
+        rest, ok = choose_sequence(solutions[row:, branch:branch + 1], previous,
+                                   model.q_min, model.q_max)
+        missing = np.flatnonzero(~ok)
+        stop = len(ok) if len(missing) == 0 else int(missing[0])
+        chosen[row:row + stop], found[row:row + stop] = rest[:stop], True
+        if stop:
+            previous = rest[stop - 1]
+        row += stop
+        if row == count:
+            break
+        q, ok = choose_nearest(solutions[row:row + 1], previous[None], model.q_min,
+                               model.q_max)
+        if not ok[0]:
+            return chosen, found  # out of reach: this target and the rest stay unfound
+        chosen[row], found[row] = q[0], True
+        previous = q[0]
+        branch = _matching_branch(solutions[row], previous)
+        row += 1
+    return chosen, found
+
+
+def _branch_of(model, q: np.ndarray, tcp) -> int | None:
+    """The IK branch (0…7) the joints ``q`` are on, or None at a singular pose (where
+    branches meet) or for a model without analytic solutions."""
+    every, _ = model.ik_all_many(model.fk(q, tcp=tcp)[None], tcp=tcp)
+    return _matching_branch(every[0], q)
+
+
+def _matching_branch(solutions: np.ndarray, q: np.ndarray, tolerance: float = 1e-6
+                     ) -> int | None:
+    """Index of the solution (8, 6) equal to ``q`` up to whole turns of each joint, if just
+    one is (two equal ones: a singular pose)."""
+    difference = solutions - q
+    difference -= 2.0 * np.pi * np.rint(difference / (2.0 * np.pi))
+    cost = np.einsum("kj,kj->k", difference, difference)
+    matches = np.flatnonzero(cost < tolerance)  # NaN (missing branches) never matches
+    if len(matches) != 1:
+        return None
+    return int(matches[0])
 
 
 ROTATION_PER_METRE = 4.0

@@ -388,10 +388,9 @@ def tcp_groups(segments) -> tuple[np.ndarray, list]:
 
 
 def _cartesian(planner, paths, which, fraction, q_start, linear):
-    """Joint displacements of samples on TCP paths: poses along each path, then batched IK
-    (one call per TCP); each sample takes the solution closest to the joint-space
-    interpolation of its move's ends (``linear``), which keeps the arm on the branch of its
-    end points."""
+    """Joint displacements of samples on TCP paths (rows sorted by move, then along the
+    path): poses along each path, then inverse kinematics that follows one solution
+    continuously along each move (:func:`_track`), one batch per TCP."""
     from ..kinematics.pose import rotvec_to_matrix
 
     poses = np.repeat(np.eye(4)[None], len(which), axis=0)
@@ -409,9 +408,72 @@ def _cartesian(planner, paths, which, fraction, q_start, linear):
     groups = paths.tcp_group[which]
     for group in np.unique(groups):
         rows = np.flatnonzero(groups == group)
-        solutions[rows] = planner.kinematics.ik_many(poses[rows], near[rows],
-                                                     tcp=paths.tcps[group])
+        solutions[rows] = _track(planner.kinematics, poses[rows], near[rows],
+                                 q_start[which[rows]], which[rows], paths.tcps[group])
     return solutions - q_start[which]
+
+
+def _track(model, poses: np.ndarray, near: np.ndarray, first: np.ndarray,
+           owner: np.ndarray, tcp) -> np.ndarray:
+    """Joints (N, 6) for ``poses`` (N, 4, 4) along TCP paths, following one IK solution
+    continuously, as the controller does on a straight line: each sample takes the solution
+    closest to the sample before it on the same move (``owner``: the move of each row; rows
+    of a move in path order), the first sample of a move the one closest to where the move
+    starts (``first``, rad). A branch change then shows only where no continuous solution
+    exists — at a singularity or where the path leaves the workspace (URS302) — and not
+    near a singularity, where the solution closest to the straight joint-space line between
+    the move's ends (``near``, the first guess) may be another branch.
+
+    The sequential rule is solved in rounds over all rows at once: each round chooses every
+    row from the previous round's choice of the row before it; a row is final once the row
+    before it is, so only rows after a change are chosen again (toolpaths settle in one or
+    two rounds). A row without a solution (NaN) hands ``near`` on to the next.
+    """
+    count = len(poses)
+    if count == 0:
+        return np.empty((0, 6))
+    from ..kinematics.ik import choose_nearest
+
+    starts = np.ones(count, dtype=bool)
+    starts[1:] = owner[1:] != owner[:-1]
+    analytic = hasattr(model, "ik_all_many") and not getattr(model, "calibrated", False)
+    if analytic:
+        every, _ = model.ik_all_many(poses, tcp=tcp)
+
+        def choose(rows: np.ndarray, toward: np.ndarray) -> np.ndarray:
+            return choose_nearest(every[rows], toward, model.q_min, model.q_max)[0]
+    else:
+        def choose(rows: np.ndarray, toward: np.ndarray) -> np.ndarray:
+            return model.ik_many(poses[rows], toward, tcp=tcp)
+
+    current = choose(np.arange(count), near)
+    if analytic:
+        active = np.arange(count)
+    else:  # each solve is costly: choose again only rows that step away from the one before
+        before = np.where(starts[:, None], first, np.roll(current, 1, axis=0))
+        step = np.abs(current - before).max(axis=1)
+        active = np.flatnonzero(~(step <= TRACK_STEP))  # NaN: choose again
+    for _ in range(count):
+        if len(active) == 0:
+            break
+        previous = np.where(starts[active, None], first[active], current[active - 1])
+        lost = np.isnan(previous).any(axis=1)
+        previous[lost] = near[active[lost]]
+        chosen = choose(active, previous)
+        old = current[active]
+        same = ((chosen == old) | (np.isnan(chosen) & np.isnan(old))).all(axis=1)
+        current[active] = chosen
+        after = active[~same] + 1
+        after = after[after < count]
+        active = np.unique(after[~starts[after]])
+    return current
+
+
+TRACK_STEP = 0.05
+"""Largest joint step (rad) between consecutive path samples below which a model without
+analytic solutions (a calibrated arm) keeps the solution closest to the joint-space line
+(:func:`_track`): far smaller than the distance between two IK branches away from a
+singularity."""
 
 
 def _fill_gaps(values: np.ndarray, owner: np.ndarray) -> np.ndarray:
