@@ -582,10 +582,8 @@ def line_profile(pose_from: np.ndarray, pose_to: np.ndarray, v: float, a: float,
     a move that only turns the tool has its angle in rad as distance. A 1 cm move that turns
     the tool by 120° at the defaults takes about 2.3 s, not the 0.18 s of its 1 cm.
     """
-    from .geometry import rotation_angle
-
     length = _distance(pose_to, pose_from)
-    angle = rotation_angle(pose_from[:3, :3], pose_to[:3, :3])
+    angle = _turn(pose_from, pose_to)
     rotation = Trapezoid.plan(angle, v_rot, a_rot) if angle > 1e-9 else None
     if length < 1e-9:  # the tool only turns: time it on the angle
         return rotation.stretched(t) if rotation is not None and t > 0 else (
@@ -596,6 +594,21 @@ def line_profile(pose_from: np.ndarray, pose_to: np.ndarray, v: float, a: float,
         profile = Trapezoid(length, rotation.accel * scale, rotation.peak * scale,
                             rotation.t_acc, rotation.t_flat)
     return profile.stretched(t) if t > 0 else profile
+
+
+def _turn(pose: np.ndarray, other: np.ndarray) -> float:
+    """Angle (rad, in [0, π]) of the rotation between the orientations of two 4x4 poses:
+    ``atan2(sin θ, cos θ)`` from the trace and the skew part of ``R = R0ᵀ·R1`` (accurate
+    at 0 and π), in scalar maths (the planner's hot path)."""
+    a, b = pose[:3, :3].tolist(), other[:3, :3].tolist()
+
+    def entry(i: int, j: int) -> float:  # (R0ᵀ·R1)[i][j]
+        return a[0][i] * b[0][j] + a[1][i] * b[1][j] + a[2][i] * b[2][j]
+
+    cosine = (entry(0, 0) + entry(1, 1) + entry(2, 2) - 1.0) / 2.0
+    sine = math.hypot(entry(2, 1) - entry(1, 2), entry(0, 2) - entry(2, 0),
+                      entry(1, 0) - entry(0, 1)) / 2.0
+    return math.atan2(sine, cosine)
 
 
 def _distance(pose: np.ndarray, other: np.ndarray) -> float:

@@ -424,10 +424,11 @@ def _track(model, poses: np.ndarray, near: np.ndarray, first: np.ndarray,
     near a singularity, where the solution closest to the straight joint-space line between
     the move's ends (``near``, the first guess) may be another branch.
 
-    The sequential rule is solved in rounds over all rows at once: each round chooses every
-    row from the previous round's choice of the row before it; a row is final once the row
-    before it is, so only rows after a change are chosen again (toolpaths settle in one or
-    two rounds). A row without a solution (NaN) hands ``near`` on to the next.
+    The sequential rule is solved in rounds over all rows at once. The first guess is kept
+    where it steps less than :data:`TRACK_STEP` from the row before; the other rows are
+    chosen from the row before them, and each further round chooses again the rows after a
+    row that changed (a toolpath needs no round at all). A row without a solution (NaN)
+    hands ``near`` on to the next.
     """
     count = len(poses)
     if count == 0:
@@ -447,12 +448,10 @@ def _track(model, poses: np.ndarray, near: np.ndarray, first: np.ndarray,
             return model.ik_many(poses[rows], toward, tcp=tcp)
 
     current = choose(np.arange(count), near)
-    if analytic:
-        active = np.arange(count)
-    else:  # each solve is costly: choose again only rows that step away from the one before
-        before = np.where(starts[:, None], first, np.roll(current, 1, axis=0))
-        step = np.abs(current - before).max(axis=1)
-        active = np.flatnonzero(~(step <= TRACK_STEP))  # NaN: choose again
+    # rows that stay within TRACK_STEP of the row before are its continuation already
+    before = np.where(starts[:, None], first, np.roll(current, 1, axis=0))
+    step = np.abs(current - before).max(axis=1)
+    active = np.flatnonzero(~(step <= TRACK_STEP))  # NaN too: choose again
     for _ in range(count):
         if len(active) == 0:
             break
@@ -469,11 +468,12 @@ def _track(model, poses: np.ndarray, near: np.ndarray, first: np.ndarray,
     return current
 
 
-TRACK_STEP = 0.05
-"""Largest joint step (rad) between consecutive path samples below which a model without
-analytic solutions (a calibrated arm) keeps the solution closest to the joint-space line
-(:func:`_track`): far smaller than the distance between two IK branches away from a
-singularity."""
+TRACK_STEP = 0.25
+"""Largest joint step (rad) between consecutive path samples (knots, at most 32 ms apart)
+below which :func:`_track` keeps the first guess, the solution closest to the joint-space
+line: a joint moves at most 0.1 rad between knots at the fastest joint speed of a UR, and a
+change of branch moves one by about π (as :data:`urdsl.verify.checks.JUMP_MIN`). Rows
+stepping further are chosen again from the row before them, and so on along the move."""
 
 
 def _fill_gaps(values: np.ndarray, owner: np.ndarray) -> np.ndarray:
