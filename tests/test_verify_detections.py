@@ -390,3 +390,94 @@ def test_the_course_movel_from_a_singular_pose_is_still_found():
     report = check(path.read_text(encoding="utf-8"))
     assert {"URS302", "URS304"} <= set(report.codes())
     assert {f.span.line for f in report.findings if f.severity == "error"} == {20}
+
+
+# PolyScope's Direction node "until tool contact", as the e-Series writes it (shortened): a
+# thread moves toward a point 1000 m away; the main loop kills it and stops the arm when the
+# condition fires
+DIRECTION = f"""
+    def calculate_point_to_move_towards(feature, direction, position_distance):
+      local posDir=[direction[0], direction[1], direction[2]]
+      local unit=normalize(posDir)
+      local d=position_distance
+      local displacement=p[unit[0] * d, unit[1] * d, unit[2] * d, 0, 0, 0]
+      local wanted=pose_sub(pose_trans(feature, displacement), feature)
+      return pose_add(get_target_tcp_pose(), wanted)
+    end
+    {READY}
+    global move_thread_flag_3=0
+    thread move_thread_3():
+      enter_critical
+      move_thread_flag_3 = 1
+      local towardsPos=calculate_point_to_move_towards(p[0,0,0,0,0,0], [0.0,0.0,-1.0], 1000.0)
+      movel(towardsPos, a=1.2, v=0.1)
+      move_thread_flag_3 = 2
+      exit_critical
+    end
+    move_thread_han_3 = run move_thread_3()
+    while (True):
+      local stepsToRetract=tool_contact(direction=get_target_tcp_speed())
+      if (stepsToRetract > 0):
+        kill move_thread_han_3
+        stopl(3.0)
+        break
+      end
+      if (move_thread_flag_3 > 1):
+        break
+      end
+      sync()
+    end
+    """
+
+
+def test_a_direction_move_until_contact_is_not_a_move_to_its_far_target():
+    report = check(DIRECTION)
+    assert not {"URS301", "URS302"} & set(report.codes()), report.render_text()
+    (move,) = [m for m in report.moves if m.kind == "movel"]
+    assert move.span.line == 15
+    # checked down to where the arm could still follow the line: about a metre at 0.1 m/s
+    assert 5.0 < move.duration < 20.0
+    assert not report.trace.unreachable.any()
+
+
+def test_a_direction_move_is_still_checked_up_to_where_it_could_stop(tmp_path):
+    cell = tmp_path / "cell.toml"
+    cell.write_text("[floor]\nheight = 0.0\n")
+    report = check(DIRECTION, cell=str(cell))
+    (finding,) = only(report, "URS308")  # the floor is on its way down
+    assert finding.span.line == 15 and "URS301" not in report.codes()
+
+
+def test_the_same_far_target_without_a_condition_is_unreachable():
+    report = check(f"""
+        {READY}
+        movel(pose_add(get_target_tcp_pose(), p[0, 0, -1000.0, 0, 0, 0]), a=1.2, v=0.1)
+        """)
+    (finding,) = only(report, "URS301")
+    assert finding.span.line == 2
+
+
+def test_stoppable_moves_are_those_in_a_thread_killed_under_a_condition():
+    from urdsl.motion.direction import stoppable_moves
+    from urdsl.script.parser import parse
+
+    module = parse(textwrap.dedent("""
+        thread until():
+          movel(p[0, 0, -1000, 0, 0, 0])
+        end
+        thread plain():
+          movel(p[0, 0, -1000, 0, 0, 0])
+        end
+        handle = run until()
+        other = run plain()
+        movel(p[0, 0, -1000, 0, 0, 0])
+        while True:
+          if get_digital_in(0):
+            kill handle
+            stopl(2)
+          end
+          sync()
+        end
+        join other
+        """).lstrip("\n"), filename="t.script")
+    assert sorted(span.line for span in stoppable_moves(module)) == [2]

@@ -174,6 +174,9 @@ class MotionPlanner:
         self.warnings: list[MotionWarning] = []
         self.skipped: list[Segment] = []
         self.failure: UnreachableTarget | None = None
+        # spans of the movel/movep calls that a condition may stop before their target
+        # (PolyScope's Direction node: :func:`urdsl.motion.direction.stoppable_moves`)
+        self.stoppable: frozenset = frozenset()
         self._tcp: np.ndarray | None = None
         self._pending: Segment | None = None  # the last move, if it may still blend
         self._q_end = self.q_start.copy()  # joints at the end of the last resolved move
@@ -323,13 +326,69 @@ class MotionPlanner:
         :data:`ROTATION_PER_METRE` times ``v`` and ``a``); the move takes the longer of the
         two profiles (see :func:`line_profile`)."""
         pose_from = self._end_matrix()
+        params = {"a": a, "v": v, "t": t}
+        if span in self.stoppable:
+            pose, stopped = self._until_out_of_reach(pose_from, pose)
+            if stopped:
+                params["until"] = True  # checked up to where it could stop
         if v_rot is None:
             v_rot = ROTATION_PER_METRE * v
         if a_rot is None:
             a_rot = ROTATION_PER_METRE * a
         profile = line_profile(pose_from, pose, v, a, t, v_rot, a_rot)
-        return self._add_cartesian(kind, profile, pose_from, pose, r, span,
-                                   {"a": a, "v": v, "t": t}, now)
+        return self._add_cartesian(kind, profile, pose_from, pose, r, span, params, now)
+
+    def _until_out_of_reach(self, pose_from: np.ndarray, pose: np.ndarray
+                            ) -> tuple[np.ndarray, bool]:
+        """A straight line that a condition stops (a Direction node's move toward a point
+        far away) goes at most as far as the arm can follow it: the pose (4x4) where the line
+        leaves the workspace or its IK solution can no longer continue, less
+        :data:`STOP_MARGIN`; and whether the line was cut there. A line the arm can follow
+        to its end is kept."""
+        from .geometry import slerp_rotations
+        from .trace import _track
+
+        length = _distance(pose, pose_from)
+        if length < 1e-9:
+            return pose, False
+        q_from = self._q
+        model, tcp = self.kinematics, self.tcp
+
+        def continuous(fractions: np.ndarray, q_first: np.ndarray, jump: float
+                       ) -> tuple[int, np.ndarray]:
+            """How many of ``fractions`` (rising) the arm reaches continuously from
+            ``q_first``, and the joints (N, 6) there."""
+            poses = np.repeat(np.eye(4)[None], len(fractions), axis=0)
+            poses[:, :3, :3] = slerp_rotations(pose_from[:3, :3], pose[:3, :3], fractions)
+            poses[:, :3, 3] = pose_from[:3, 3] + fractions[:, None] * (pose[:3, 3]
+                                                                         - pose_from[:3, 3])
+            q = _track(model, poses, np.repeat(q_first[None], len(fractions), axis=0),
+                       np.repeat(q_first[None], len(fractions), axis=0),
+                       np.zeros(len(fractions), dtype=np.int64), tcp)
+            steps = np.abs(np.diff(np.vstack([q_first, q]), axis=0)).max(axis=1)
+            bad = np.flatnonzero(~(steps <= jump))  # NaN: out of reach
+            return (len(fractions) if len(bad) == 0 else int(bad[0])), q
+
+        high = min(1.0, STOP_SEARCH / length)
+        coarse = np.linspace(0.0, high, 257)[1:]
+        good, q_coarse = continuous(coarse, q_from, 2.0 * STOP_JUMP)
+        if good == len(coarse) and high == 1.0:
+            return pose, False
+        if good == len(coarse):
+            reached = high
+        else:
+            low = coarse[good - 1] if good > 0 else 0.0
+            q_low = q_coarse[good - 1] if good > 0 else q_from
+            fine = np.linspace(low, coarse[good], 66)[1:-1]
+            reached = low
+            count, _ = continuous(fine, q_low, STOP_JUMP)
+            if count > 0:
+                reached = float(fine[count - 1])
+        reached = max(0.0, reached - STOP_MARGIN / length)
+        cut = pose_from.copy()
+        cut[:3, :3] = slerp_rotations(pose_from[:3, :3], pose[:3, :3], np.array([reached]))[0]
+        cut[:3, 3] = pose_from[:3, 3] + reached * (pose[:3, 3] - pose_from[:3, 3])
+        return cut, True
 
     def _add_cartesian(self, kind: str, profile: Trapezoid, pose_from: np.ndarray,
                        pose: np.ndarray, r: float, span: Span, params: dict, now: float,
@@ -556,6 +615,21 @@ def _matching_branch(solutions: np.ndarray, q: np.ndarray, tolerance: float = 1e
     if len(matches) != 1:
         return None
     return int(matches[0])
+
+
+STOP_SEARCH = 4.0
+"""How far (m) along a line that a condition stops the planner looks for where the arm can
+no longer follow it: twice the reach of the largest UR (UR20: 1.75 m), plus room."""
+
+STOP_JUMP = 0.25
+"""Joint step (rad) between neighbouring points of such a line that counts as the end of a
+continuous solution (as :data:`urdsl.verify.checks.JUMP_MIN`)."""
+
+STOP_MARGIN = 0.05
+"""How far (m) before the edge of the workspace a line that a condition stops is checked
+to: the arm reaches the edge only if the condition never fires, and the checks'
+singularity margins (2 to 5 cm, URS307) would otherwise warn about a stretched arm that the
+program does not ask for."""
 
 
 ROTATION_PER_METRE = 4.0
