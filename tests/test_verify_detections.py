@@ -481,3 +481,33 @@ def test_stoppable_moves_are_those_in_a_thread_killed_under_a_condition():
         join other
         """).lstrip("\n"), filename="t.script")
     assert sorted(span.line for span in stoppable_moves(module)) == [2]
+
+
+def test_a_waypoint_out_of_reach_is_reported_even_when_a_condition_may_stop_the_move():
+    # "Until" on a waypoint (an expression ends the move early): its target is a real
+    # destination, 20 cm beyond the reach of a UR5e
+    report = check("""
+        global move_thread_flag_7=0
+        thread move_thread_7():
+          enter_critical
+          move_thread_flag_7 = 1
+          movel(p[0.95, 0.2, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)
+          move_thread_flag_7 = 2
+          exit_critical
+        end
+        move_thread_han_7 = run move_thread_7()
+        while (True):
+          if (get_digital_in(0)):
+            kill move_thread_han_7
+            stopl(1.2)
+            break
+          end
+          if (move_thread_flag_7 > 1):
+            join move_thread_han_7
+            break
+          end
+          sync()
+        end
+        """)
+    (finding,) = only(report, "URS301")
+    assert finding.span.line == 5

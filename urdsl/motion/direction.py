@@ -31,14 +31,15 @@ where the condition fires, and at the latest where the straight line leaves the 
 
 :func:`stoppable_moves` finds such moves by their structure, whatever the target expression:
 a ``movel``/``movep`` inside a thread that the program kills inside an ``if`` (the Until
-test; PolyScope follows the kill with ``stopl``). The planner then checks such a move only
-up to where it could stop (:meth:`urdsl.motion.planner.MotionPlanner.movel`): an unreachable
-far target is not reported as URS301/URS302, while everything on the path up to the
-workspace's edge is still checked. "Until distance" moves stop at a real, reachable
-destination and keep being checked to it. [U] The exact scripts of other PolyScope versions
-may differ; any thread killed under a condition counts. A move stopped by a ``stopl`` from a
-watcher thread, with no kill, is not recognised (whether such a ``stopl`` stops another
-thread's move is not documented).
+test; PolyScope follows the kill with ``stopl``). When such a move aims far beyond the arm's
+reach (1.5 times it, :data:`urdsl.motion.planner.FAR_TARGET`) the planner checks it only up
+to where it could stop (:meth:`urdsl.motion.planner.MotionPlanner.movel`): the far target is
+not reported as URS301/URS302, while everything on the path up to the workspace's edge is
+still checked; a stoppable move to a waypoint just out of reach is still an error. "Until
+distance" moves stop at a real, reachable destination and keep being checked to it. [U] The
+exact scripts of other PolyScope versions may differ; any thread killed under a condition
+counts. A move stopped by a ``stopl`` from a watcher thread, with no kill, is not recognised
+(whether such a ``stopl`` stops another thread's move is not documented).
 """
 
 from __future__ import annotations

@@ -327,7 +327,7 @@ class MotionPlanner:
         two profiles (see :func:`line_profile`)."""
         pose_from = self._end_matrix()
         params = {"a": a, "v": v, "t": t}
-        if span in self.stoppable:
+        if span in self.stoppable and self._far(pose):
             pose, stopped = self._until_out_of_reach(pose_from, pose)
             if stopped:
                 params["until"] = True  # checked up to where it could stop
@@ -337,6 +337,15 @@ class MotionPlanner:
             a_rot = ROTATION_PER_METRE * a
         profile = line_profile(pose_from, pose, v, a, t, v_rot, a_rot)
         return self._add_cartesian(kind, profile, pose_from, pose, r, span, params, now)
+
+    def _far(self, pose: np.ndarray) -> bool:
+        """Whether a target (4x4) lies further from the base than :data:`FAR_TARGET` times
+        the model's reach: no taught waypoint does, while a Direction node aims 1000 m
+        away. A move that a condition stops but whose target is merely out of reach (an
+        "Until" on a waypoint moved by hand) is still reported as unreachable."""
+        spec = getattr(self.kinematics, "spec", None)
+        reach = getattr(spec, "reach", None) or STOP_SEARCH / (2.0 * FAR_TARGET)
+        return float(np.linalg.norm(pose[:3, 3])) > FAR_TARGET * reach
 
     def _until_out_of_reach(self, pose_from: np.ndarray, pose: np.ndarray
                             ) -> tuple[np.ndarray, bool]:
@@ -620,6 +629,10 @@ def _matching_branch(solutions: np.ndarray, q: np.ndarray, tolerance: float = 1e
 STOP_SEARCH = 4.0
 """How far (m) along a line that a condition stops the planner looks for where the arm can
 no longer follow it: twice the reach of the largest UR (UR20: 1.75 m), plus room."""
+
+FAR_TARGET = 1.5
+"""A target further from the base than this many times the arm's reach is a direction to
+move in, not a destination (see :meth:`MotionPlanner._far`)."""
 
 STOP_JUMP = 0.25
 """Joint step (rad) between neighbouring points of such a line that counts as the end of a
