@@ -54,24 +54,25 @@ STOPPABLE_KINDS = frozenset({"movel", "movep"})
 
 def stoppable_moves(module: n.Node) -> frozenset:
     """Spans of the ``movel``/``movep`` calls in ``module`` that a condition may stop: those
-    in a thread that the program kills inside an ``if`` (see the module docstring)."""
+    in a thread that the program kills inside an ``if`` (see the module docstring).
+
+    Only statements are visited (kills, thread definitions and ``run`` assignments are
+    statements), so that a long toolpath costs one pass over its lines."""
     threads: dict[str, n.ThreadDef] = {}
     handles: dict[str, set[str]] = {}  # handle variable -> threads run into it
     killed: set[str] = set()  # handle variables killed under a condition
-    for node in n.walk(module):
-        if isinstance(node, n.ThreadDef):
-            threads[node.name] = node
-        elif isinstance(node, (n.Assign, n.Declare)):
-            value = node.value
-            target = node.target if isinstance(node, n.Assign) else n.Name(node.name)
-            if isinstance(value, n.Run) and isinstance(target, n.Name):
-                handles.setdefault(target.id, set()).add(value.thread)
-        elif isinstance(node, (n.If, n.Elif)):
-            for inner in _blocks(node):
-                for item in inner:
-                    for below in n.walk(item):
-                        if isinstance(below, n.Kill) and isinstance(below.thread, n.Name):
-                            killed.add(below.thread.id)
+    for statement, conditional in _statements(module.body, False):
+        if isinstance(statement, n.ThreadDef):
+            threads[statement.name] = statement
+        elif isinstance(statement, n.Assign):
+            if isinstance(statement.value, n.Run) and isinstance(statement.target, n.Name):
+                handles.setdefault(statement.target.id, set()).add(statement.value.thread)
+        elif isinstance(statement, n.Declare):
+            if isinstance(statement.value, n.Run):
+                handles.setdefault(statement.name, set()).add(statement.value.thread)
+        elif (isinstance(statement, n.Kill) and conditional
+              and isinstance(statement.thread, n.Name)):
+            killed.add(statement.thread.id)
     stopped = {thread for handle in killed for thread in handles.get(handle, ())}
     spans = set()
     for name in stopped:
@@ -85,10 +86,16 @@ def stoppable_moves(module: n.Node) -> frozenset:
     return frozenset(spans)
 
 
-def _blocks(node: n.If | n.Elif):
-    """The statement blocks an ``if`` (or ``elif``) runs when its test holds."""
-    yield node.body
-    if isinstance(node, n.If):
-        yield from (elif_.body for elif_ in node.elifs)
-        if node.orelse is not None:
-            yield node.orelse
+def _statements(block, conditional: bool):
+    """Every statement in ``block`` and the blocks inside it, depth first, each with whether
+    it runs only when an ``if`` (or ``elif``/``else``) test holds."""
+    for item in block:
+        yield item, conditional
+        if isinstance(item, n.If):
+            yield from _statements(item.body, True)
+            for elif_ in item.elifs:
+                yield from _statements(elif_.body, True)
+            if item.orelse is not None:
+                yield from _statements(item.orelse, True)
+        elif isinstance(item, (n.While, n.FunctionDef, n.ThreadDef, n.SecDef)):
+            yield from _statements(item.body, conditional)

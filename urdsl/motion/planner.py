@@ -669,8 +669,10 @@ def line_profile(pose_from: np.ndarray, pose_to: np.ndarray, v: float, a: float,
     a move that only turns the tool has its angle in rad as distance. A 1 cm move that turns
     the tool by 120° at the defaults takes about 2.3 s, not the 0.18 s of its 1 cm.
     """
-    length = _distance(pose_to, pose_from)
-    angle = _turn(pose_from, pose_to)
+    start, end = pose_from.tolist(), pose_to.tolist()  # scalar maths: the planner's hot path
+    length = math.dist((start[0][3], start[1][3], start[2][3]),
+                       (end[0][3], end[1][3], end[2][3]))
+    angle = _turn(start, end)
     rotation = Trapezoid.plan(angle, v_rot, a_rot) if angle > 1e-9 else None
     if length < 1e-9:  # the tool only turns: time it on the angle
         return rotation.stretched(t) if rotation is not None and t > 0 else (
@@ -683,11 +685,13 @@ def line_profile(pose_from: np.ndarray, pose_to: np.ndarray, v: float, a: float,
     return profile.stretched(t) if t > 0 else profile
 
 
-def _turn(pose: np.ndarray, other: np.ndarray) -> float:
-    """Angle (rad, in [0, π]) of the rotation between the orientations of two 4x4 poses:
-    ``atan2(sin θ, cos θ)`` from the trace and the skew part of ``R = R0ᵀ·R1`` (accurate
-    at 0 and π), in scalar maths (the planner's hot path)."""
-    a, b = pose[:3, :3].tolist(), other[:3, :3].tolist()
+def _turn(start: list, end: list) -> float:
+    """Angle (rad, in [0, π]) of the rotation between the orientations of two poses given as
+    nested lists (4x4): ``atan2(sin θ, cos θ)`` from the trace and the skew part of
+    ``R = R0ᵀ·R1`` (accurate at 0 and π)."""
+    a, b = start, end
+    if a[0][:3] == b[0][:3] and a[1][:3] == b[1][:3] and a[2][:3] == b[2][:3]:
+        return 0.0  # the same orientation (most toolpath moves)
 
     def entry(i: int, j: int) -> float:  # (R0ᵀ·R1)[i][j]
         return a[0][i] * b[0][j] + a[1][i] * b[1][j] + a[2][i] * b[2][j]
