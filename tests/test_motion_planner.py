@@ -213,3 +213,24 @@ def test_a_line_takes_the_longer_of_its_path_and_rotation_profiles(length, angle
     if length > 1e-9:  # the path's distance, whatever profile leads
         assert profile.distance == pytest.approx(length)
         assert float(profile.position(profile.duration)) == pytest.approx(length)
+
+
+@pytest.mark.parametrize("direction", [(1, 0, 0), (0, -1, 0), (0.6, 0.8, 0)])
+def test_a_move_that_a_condition_stops_goes_as_far_as_the_arm_can_follow_it(direction):
+    arm = planner()
+    arm.stoppable = frozenset({NO_SPAN})  # this move is in a thread killed under a condition
+    target = pose(*(100.0 * np.array(direction)))
+    end = arm.movel(target, 1.2, 0.25, 0, 0, NO_SPAN, 0.0)
+    arm.finish(end)
+    (move,) = arm.segments
+    reached = move.pose_end[:3, 3]
+    # the gantry's box ends at |x|, |y| = 1 m; the move stops 5 cm of path before its edge
+    edge = 1.0 / max(abs(c) for c in direction)
+    assert np.linalg.norm(reached) == pytest.approx(edge - 0.05, abs=0.002)
+    assert move.params["until"] and arm.failure is None
+
+
+def test_a_move_without_a_condition_to_the_same_target_is_not_cut():
+    arm = planner()
+    with pytest.raises(OutOfReach):
+        arm.movel(pose(100.0, 0, 0), 1.2, 0.25, 0, 0, NO_SPAN, 0.0)
