@@ -195,3 +195,42 @@ def test_samples_out_of_reach_are_marked_and_the_trace_stays_finite():
     crossing = np.abs(trace.q[inside[0] - 1, 0])
     assert crossing == pytest.approx(np.sqrt(0.1 ** 2 - x ** 2), abs=0.01)
     assert np.allclose(trace.q[-1, :3], (0.5, 0.02, 0))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(0.0, 0.5), st.floats(0.0, 3.0), st.floats(0.05, 1.0), st.floats(0.2, 3.0))
+def test_a_line_takes_the_longer_of_its_path_and_rotation_profiles(length, angle, v, a):
+    from urdsl.motion.planner import ROTATION_PER_METRE, line_profile
+
+    start, end = pose(0, 0, 0), pose(length, 0, 0)
+    end[:3, :3] = rotvec_to_matrix(np.array([0.0, 0.0, angle]))
+    profile = line_profile(start, end, v, a, 0.0, ROTATION_PER_METRE * v,
+                           ROTATION_PER_METRE * a)
+    expected = max(closed_form(length, v, a) if length > 1e-9 else 0.0,
+                   closed_form(angle, ROTATION_PER_METRE * v, ROTATION_PER_METRE * a)
+                   if angle > 1e-9 else 0.0)
+    assert profile.duration == pytest.approx(expected, rel=1e-9, abs=1e-12)
+    if length > 1e-9:  # the path's distance, whatever profile leads
+        assert profile.distance == pytest.approx(length)
+        assert float(profile.position(profile.duration)) == pytest.approx(length)
+
+
+@pytest.mark.parametrize("direction", [(1, 0, 0), (0, -1, 0), (0.6, 0.8, 0)])
+def test_a_move_that_a_condition_stops_goes_as_far_as_the_arm_can_follow_it(direction):
+    arm = planner()
+    arm.stoppable = frozenset({NO_SPAN})  # this move is in a thread killed under a condition
+    target = pose(*(100.0 * np.array(direction)))
+    end = arm.movel(target, 1.2, 0.25, 0, 0, NO_SPAN, 0.0)
+    arm.finish(end)
+    (move,) = arm.segments
+    reached = move.pose_end[:3, 3]
+    # the gantry's box ends at |x|, |y| = 1 m; the move stops 5 cm of path before its edge
+    edge = 1.0 / max(abs(c) for c in direction)
+    assert np.linalg.norm(reached) == pytest.approx(edge - 0.05, abs=0.002)
+    assert move.params["until"] and arm.failure is None
+
+
+def test_a_move_without_a_condition_to_the_same_target_is_not_cut():
+    arm = planner()
+    with pytest.raises(OutOfReach):
+        arm.movel(pose(100.0, 0, 0), 1.2, 0.25, 0, 0, NO_SPAN, 0.0)

@@ -263,3 +263,251 @@ def test_a_jump_is_found_wherever_it_lies_in_a_long_trace(at):
     (finding,) = found.findings
     assert f"t={at * dt:.3f} s" in finding.message and "wrist 1" in finding.message
     assert found.samples[at] and not found.samples[at + 3 if at + 3 < count else at - 3]
+
+
+# ---- issue 12, item 5: motion semantics found wrong on real programs -------------------------
+
+
+def test_a_short_movel_that_mostly_turns_the_tool_is_timed_on_its_rotation():
+    # 1 cm along the tool's x and 120° about its z: at the defaults (v = 0.25 m/s,
+    # a = 1.2 m/s²) the path alone would take 0.18 s and spin wrist 3 at over 20 rad/s
+    report = check(f"""
+        {READY}
+        movel(pose_trans(get_target_tcp_pose(), p[0.01, 0, 0, 0, 0, {math.radians(120)}]))
+        """)
+    assert "URS304" not in report.codes(), report.render_text()
+    assert not report.has_errors
+    turn = report.moves[1]
+    # rotation trapezoid: 2.094 rad at 1 rad/s with 4.8 rad/s²: 2.094 + 1/4.8 s
+    assert turn.duration == pytest.approx(math.radians(120) / 1.0 + 1.0 / 4.8, rel=1e-6)
+
+
+def test_a_move_that_mostly_translates_keeps_the_time_of_its_path():
+    report = check(f"""
+        {READY}
+        movel(pose_trans(get_target_tcp_pose(), p[0.3, 0, 0, 0, 0, 0.2]), a=1.2, v=0.25)
+        """)
+    # 0.3 m at 0.25 m/s with 1.2 m/s²: 0.3/0.25 + 0.25/1.2; 0.2 rad takes far less
+    assert report.moves[1].duration == pytest.approx(0.3 / 0.25 + 0.25 / 1.2, rel=1e-6)
+
+
+def test_a_bug_in_a_loop_is_reported_once_with_how_often_and_when_first():
+    report = check(f"""
+        {READY}
+        i = 0
+        while i < 12:
+          movej([0, -1.9, 1.9, -1.57, -1.57, 0])
+          movej([0, -1.9, 1.9, -1.57, -1.57, 3.0], a=40, v=6.0)
+          i = i + 1
+        end
+        """)
+    (finding,) = only(report, "URS304")
+    assert finding.span.line == 5 and finding.count == 12
+    assert "wrist 3" in finding.message
+    assert finding.message.endswith(f"(12 times, first at t={finding.time:.3f} s)")
+    first_pass = [m for m in report.moves if m.span.line == 5][0]
+    assert first_pass.start <= finding.time <= first_pass.start + first_pass.duration
+    assert report.to_dict()["findings"][0]["count"] == 12
+
+
+def test_a_controller_warning_in_a_loop_is_reported_once():
+    report = check(f"""
+        {READY}
+        home = get_actual_tcp_pose()
+        i = 0
+        while i < 3:
+          movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]), r=0.05)
+          movel(pose_add(home, p[0.1, 0.06, 0, 0, 0, 0]), r=0.05)
+          movel(home)
+          i = i + 1
+        end
+        """)
+    (finding,) = only(report, "URS309")
+    assert finding.count == 3 and "(3 times, first at t=" in finding.message
+
+
+def test_findings_differing_only_in_numbers_merge_but_not_across_joints_or_lines():
+    from urdsl.script.nodes import Source, Span
+    from urdsl.verify.findings import Finding
+    from urdsl.verify.report import Report
+
+    source = Source("a = 1\nb = 2\n", "t.script")
+    here, there = Span(source, 0, 5), Span(source, 6, 11)
+    report = Report("t.script", "ur5e", findings=[
+        Finding("URS205", "warning", "socket read 12 timed out after 0.5 s", here, 2.0),
+        Finding("URS205", "warning", "socket read 7 timed out after 0.25 s", here, 1.0),
+        Finding.of("URS304", "wrist 1 joint turns at 4.00 rad/s", here, 1.5),
+        Finding.of("URS304", "wrist 2 joint turns at 4.00 rad/s", here, 1.6),
+        Finding("URS205", "warning", "socket read 3 timed out after 0.5 s", there, 0.1),
+    ])
+    report.sort()
+    messages = [f.message for f in report.findings]
+    assert messages == ["socket read 7 timed out after 0.25 s (2 times, first at t=1.000 s)",
+                        "wrist 1 joint turns at 4.00 rad/s", "wrist 2 joint turns at 4.00 rad/s",
+                        "socket read 3 timed out after 0.5 s"]
+    report.sort()  # sorting again changes nothing
+    assert [f.message for f in report.findings] == messages
+
+
+def _line_past_the_base(x: float) -> str:
+    """A movel, tool down, along y at ``x`` (m) in front of the base: the wrist centre passes
+    the base axis at about |x|, and the shoulder singularity lies on the cylinder of radius
+    d4 (0.1333 m on a UR5e) around it, the workspace's inner boundary."""
+    return f"""
+        {READY}
+        start = get_actual_tcp_pose()
+        movej(p[{x}, -0.35, 0.25, start[3], start[4], start[5]])
+        movel(p[{x}, 0.35, 0.25, start[3], start[4], start[5]], a=0.5, v=0.1)
+        """
+
+
+@pytest.mark.parametrize("x", [0.16, 0.145])
+def test_a_movel_near_the_shoulder_singularity_follows_one_solution(x):
+    # the base turns by about 130° while the tool passes the base: the IK solution closest
+    # to the straight joint-space line between the ends is another branch mid-way, which
+    # gave a jump and joint speeds of 20-100 rad/s; the arm follows its branch smoothly
+    report = check(_line_past_the_base(x))
+    assert not {"URS302", "URS304"} & set(report.codes()), report.render_text()
+    base_speed = abs(report.trace.qd[:, 0]).max()
+    assert base_speed < 3.0
+    # the move ends where its branch leads, turning the base the long way round
+    line = report.trace.segment == 2
+    turned = report.trace.q[line, 0].max() - report.trace.q[line, 0].min()
+    assert turned > math.radians(100)
+
+
+def test_a_movel_through_the_shoulder_singularity_is_still_reported():
+    report = check(_line_past_the_base(0.13))
+    (finding,) = only(report, "URS302")
+    assert finding.span.line == 4 and "workspace" in finding.message
+
+
+def test_the_course_movel_from_a_singular_pose_is_still_found():
+    from pathlib import Path
+
+    mistakes = Path(__file__).parent.parent / "programs" / "mistakes"
+    path = mistakes / "course_movel_from_singular.script"
+    report = check(path.read_text(encoding="utf-8"))
+    assert {"URS302", "URS304"} <= set(report.codes())
+    assert {f.span.line for f in report.findings if f.severity == "error"} == {20}
+
+
+# PolyScope's Direction node "until tool contact", as the e-Series writes it (shortened): a
+# thread moves toward a point 1000 m away; the main loop kills it and stops the arm when the
+# condition fires
+DIRECTION = f"""
+    def calculate_point_to_move_towards(feature, direction, position_distance):
+      local posDir=[direction[0], direction[1], direction[2]]
+      local unit=normalize(posDir)
+      local d=position_distance
+      local displacement=p[unit[0] * d, unit[1] * d, unit[2] * d, 0, 0, 0]
+      local wanted=pose_sub(pose_trans(feature, displacement), feature)
+      return pose_add(get_target_tcp_pose(), wanted)
+    end
+    {READY}
+    global move_thread_flag_3=0
+    thread move_thread_3():
+      enter_critical
+      move_thread_flag_3 = 1
+      local towardsPos=calculate_point_to_move_towards(p[0,0,0,0,0,0], [0.0,0.0,-1.0], 1000.0)
+      movel(towardsPos, a=1.2, v=0.1)
+      move_thread_flag_3 = 2
+      exit_critical
+    end
+    move_thread_han_3 = run move_thread_3()
+    while (True):
+      local stepsToRetract=tool_contact(direction=get_target_tcp_speed())
+      if (stepsToRetract > 0):
+        kill move_thread_han_3
+        stopl(3.0)
+        break
+      end
+      if (move_thread_flag_3 > 1):
+        break
+      end
+      sync()
+    end
+    """
+
+
+def test_a_direction_move_until_contact_is_not_a_move_to_its_far_target():
+    report = check(DIRECTION)
+    assert not {"URS301", "URS302"} & set(report.codes()), report.render_text()
+    (move,) = [m for m in report.moves if m.kind == "movel"]
+    assert move.span.line == 15
+    # checked down to where the arm could still follow the line: about a metre at 0.1 m/s
+    assert 5.0 < move.duration < 20.0
+    assert not report.trace.unreachable.any()
+
+
+def test_a_direction_move_is_still_checked_up_to_where_it_could_stop(tmp_path):
+    cell = tmp_path / "cell.toml"
+    cell.write_text("[floor]\nheight = 0.0\n")
+    report = check(DIRECTION, cell=str(cell))
+    (finding,) = only(report, "URS308")  # the floor is on its way down
+    assert finding.span.line == 15 and "URS301" not in report.codes()
+
+
+def test_the_same_far_target_without_a_condition_is_unreachable():
+    report = check(f"""
+        {READY}
+        movel(pose_add(get_target_tcp_pose(), p[0, 0, -1000.0, 0, 0, 0]), a=1.2, v=0.1)
+        """)
+    (finding,) = only(report, "URS301")
+    assert finding.span.line == 2
+
+
+def test_stoppable_moves_are_those_in_a_thread_killed_under_a_condition():
+    from urdsl.motion.direction import stoppable_moves
+    from urdsl.script.parser import parse
+
+    module = parse(textwrap.dedent("""
+        thread until():
+          movel(p[0, 0, -1000, 0, 0, 0])
+        end
+        thread plain():
+          movel(p[0, 0, -1000, 0, 0, 0])
+        end
+        handle = run until()
+        other = run plain()
+        movel(p[0, 0, -1000, 0, 0, 0])
+        while True:
+          if get_digital_in(0):
+            kill handle
+            stopl(2)
+          end
+          sync()
+        end
+        join other
+        """).lstrip("\n"), filename="t.script")
+    assert sorted(span.line for span in stoppable_moves(module)) == [2]
+
+
+def test_a_waypoint_out_of_reach_is_reported_even_when_a_condition_may_stop_the_move():
+    # "Until" on a waypoint (an expression ends the move early): its target is a real
+    # destination, 20 cm beyond the reach of a UR5e
+    report = check("""
+        global move_thread_flag_7=0
+        thread move_thread_7():
+          enter_critical
+          move_thread_flag_7 = 1
+          movel(p[0.95, 0.2, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)
+          move_thread_flag_7 = 2
+          exit_critical
+        end
+        move_thread_han_7 = run move_thread_7()
+        while (True):
+          if (get_digital_in(0)):
+            kill move_thread_han_7
+            stopl(1.2)
+            break
+          end
+          if (move_thread_flag_7 > 1):
+            join move_thread_han_7
+            break
+          end
+          sync()
+        end
+        """)
+    (finding,) = only(report, "URS301")
+    assert finding.span.line == 5

@@ -5,8 +5,9 @@ Timing model
 ------------
 * ``movej``: joint-space line, trapezoid of the *leading axis* (the joint with the longest
   time at ``a``/``v``); all joints start and stop together. ``t`` > 0 overrides ``a``/``v``.
-* ``movel``: straight TCP line (orientation slerped), trapezoid on the path length (m); a
-  rotation-only move is timed on the rotation angle with the same ``a``/``v`` in rad.
+* ``movel``: straight TCP line (orientation slerped), trapezoid on the path length (m) and
+  one on the rotation angle (rad, with ``4·v`` and ``4·a`` [U]); the longer one sets the
+  time (:func:`line_profile`).
 * ``movep``: like ``movel`` (constant tool speed comes from blending consecutive moves).
 * ``movec``: circular arc through the via point's position, trapezoid on the arc length.
 
@@ -40,7 +41,7 @@ from ..script.nodes import Span
 from .profiles import Trapezoid
 
 __all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel", "JOINT_SPACE",
-           "UnreachableTarget"]
+           "UnreachableTarget", "line_profile", "ROTATION_PER_METRE", "continue_branch"]
 
 BLENDABLE_INTO = frozenset({"movej", "movel", "movep", "movec"})
 """Moves the previous move may blend into (servoj and speedj start from rest)."""
@@ -173,6 +174,9 @@ class MotionPlanner:
         self.warnings: list[MotionWarning] = []
         self.skipped: list[Segment] = []
         self.failure: UnreachableTarget | None = None
+        # spans of the movel/movep calls that a condition may stop before their target
+        # (PolyScope's Direction node: :func:`urdsl.motion.direction.stoppable_moves`)
+        self.stoppable: frozenset = frozenset()
         self._tcp: np.ndarray | None = None
         self._pending: Segment | None = None  # the last move, if it may still blend
         self._q_end = self.q_start.copy()  # joints at the end of the last resolved move
@@ -209,21 +213,21 @@ class MotionPlanner:
 
     def resolve(self) -> None:
         """Solve the joints of the straight-line moves planned since the last call: all their
-        targets in one batched call for every analytic solution, then, move by move, the
-        controller's choice — the solution closest to the joints the move starts from.
+        targets in one batched call for every analytic solution, then, move by move, where
+        the controller ends up: the continuation of the joints the move starts from along the
+        straight line, i.e. the target's solution on the same IK branch
+        (:func:`continue_branch`).
 
         Raises :class:`UnreachableTarget` for the first target out of reach; that move and
         everything planned after it are dropped, as the robot stops there.
         """
         if not self._unresolved:
             return
-        from ..kinematics.ik import choose_sequence
-
         pending, self._unresolved = self._unresolved, []
         model = self.kinematics
         targets = np.array([segment.pose_end for segment in pending])
         solutions, miss = model.ik_all_many(targets, tcp=pending[0].tcp)
-        chosen, found = choose_sequence(solutions, self._q_end, model.q_min, model.q_max)
+        chosen, found = continue_branch(model, solutions, self._q_end, pending[0].tcp)
         previous = self._q_end.copy()
         for index, segment in enumerate(pending):
             if not found[index]:
@@ -314,17 +318,86 @@ class MotionPlanner:
                                        {"a": a, "v": v, "t": t, "lead": lead}), now)
 
     def movel(self, pose: np.ndarray, a: float, v: float, t: float, r: float, span: Span,
-              now: float, kind: str = "movel") -> float:
-        """Straight TCP line to ``pose`` (4x4): ``a`` m/s², ``v`` m/s, ``t`` s, ``r`` m."""
-        from .geometry import rotation_angle
+              now: float, kind: str = "movel", a_rot: float | None = None,
+              v_rot: float | None = None) -> float:
+        """Straight TCP line to ``pose`` (4x4): ``a`` m/s², ``v`` m/s, ``t`` s, ``r`` m.
 
+        The orientation has its own limits, ``v_rot`` rad/s and ``a_rot`` rad/s² (default
+        :data:`ROTATION_PER_METRE` times ``v`` and ``a``); the move takes the longer of the
+        two profiles (see :func:`line_profile`)."""
         pose_from = self._end_matrix()
+        params = {"a": a, "v": v, "t": t}
+        if span in self.stoppable and self._far(pose):
+            pose, stopped = self._until_out_of_reach(pose_from, pose)
+            if stopped:
+                params["until"] = True  # checked up to where it could stop
+        if v_rot is None:
+            v_rot = ROTATION_PER_METRE * v
+        if a_rot is None:
+            a_rot = ROTATION_PER_METRE * a
+        profile = line_profile(pose_from, pose, v, a, t, v_rot, a_rot)
+        return self._add_cartesian(kind, profile, pose_from, pose, r, span, params, now)
+
+    def _far(self, pose: np.ndarray) -> bool:
+        """Whether a target (4x4) lies further from the base than :data:`FAR_TARGET` times
+        the model's reach: no taught waypoint does, while a Direction node aims 1000 m
+        away. A move that a condition stops but whose target is merely out of reach (an
+        "Until" on a waypoint moved by hand) is still reported as unreachable."""
+        spec = getattr(self.kinematics, "spec", None)
+        reach = getattr(spec, "reach", None) or STOP_SEARCH / (2.0 * FAR_TARGET)
+        return float(np.linalg.norm(pose[:3, 3])) > FAR_TARGET * reach
+
+    def _until_out_of_reach(self, pose_from: np.ndarray, pose: np.ndarray
+                            ) -> tuple[np.ndarray, bool]:
+        """A straight line that a condition stops (a Direction node's move toward a point
+        far away) goes at most as far as the arm can follow it: the pose (4x4) where the line
+        leaves the workspace or its IK solution can no longer continue, less
+        :data:`STOP_MARGIN`; and whether the line was cut there. A line the arm can follow
+        to its end is kept."""
+        from .geometry import slerp_rotations
+        from .trace import _track
+
         length = _distance(pose, pose_from)
-        if length < 1e-9:  # rotation only: time it on the angle
-            length = rotation_angle(pose_from[:3, :3], pose[:3, :3])
-        profile = Trapezoid.plan(length, v, a, t)
-        return self._add_cartesian(kind, profile, pose_from, pose, r, span,
-                                   {"a": a, "v": v, "t": t}, now)
+        if length < 1e-9:
+            return pose, False
+        q_from = self._q
+        model, tcp = self.kinematics, self.tcp
+
+        def continuous(fractions: np.ndarray, q_first: np.ndarray, jump: float
+                       ) -> tuple[int, np.ndarray]:
+            """How many of ``fractions`` (rising) the arm reaches continuously from
+            ``q_first``, and the joints (N, 6) there."""
+            poses = np.repeat(np.eye(4)[None], len(fractions), axis=0)
+            poses[:, :3, :3] = slerp_rotations(pose_from[:3, :3], pose[:3, :3], fractions)
+            poses[:, :3, 3] = pose_from[:3, 3] + fractions[:, None] * (pose[:3, 3]
+                                                                         - pose_from[:3, 3])
+            q = _track(model, poses, np.repeat(q_first[None], len(fractions), axis=0),
+                       np.repeat(q_first[None], len(fractions), axis=0),
+                       np.zeros(len(fractions), dtype=np.int64), tcp)
+            steps = np.abs(np.diff(np.vstack([q_first, q]), axis=0)).max(axis=1)
+            bad = np.flatnonzero(~(steps <= jump))  # NaN: out of reach
+            return (len(fractions) if len(bad) == 0 else int(bad[0])), q
+
+        high = min(1.0, STOP_SEARCH / length)
+        coarse = np.linspace(0.0, high, 257)[1:]
+        good, q_coarse = continuous(coarse, q_from, 2.0 * STOP_JUMP)
+        if good == len(coarse) and high == 1.0:
+            return pose, False
+        if good == len(coarse):
+            reached = high
+        else:
+            low = coarse[good - 1] if good > 0 else 0.0
+            q_low = q_coarse[good - 1] if good > 0 else q_from
+            fine = np.linspace(low, coarse[good], 66)[1:-1]
+            reached = low
+            count, _ = continuous(fine, q_low, STOP_JUMP)
+            if count > 0:
+                reached = float(fine[count - 1])
+        reached = max(0.0, reached - STOP_MARGIN / length)
+        cut = pose_from.copy()
+        cut[:3, :3] = slerp_rotations(pose_from[:3, :3], pose[:3, :3], np.array([reached]))[0]
+        cut[:3, 3] = pose_from[:3, 3] + reached * (pose[:3, 3] - pose_from[:3, 3])
+        return cut, True
 
     def _add_cartesian(self, kind: str, profile: Trapezoid, pose_from: np.ndarray,
                        pose: np.ndarray, r: float, span: Span, params: dict, now: float,
@@ -392,7 +465,9 @@ class MotionPlanner:
         pose = pose_from.copy()
         pose[:3, 3] += xd[:3] * t
         pose[:3, :3] = rotvec_to_matrix(xd[3:] * t) @ pose_from[:3, :3]
-        end = self.movel(pose, a, speed, 0.0, 0.0, span, now, kind="speedl")
+        # speedl's rotational part is in rad/s and rad/s² as given (aRot defaults to a)
+        end = self.movel(pose, a, max(linear, 1e-12), 0.0, 0.0, span, now, kind="speedl",
+                         a_rot=a, v_rot=max(angular, 1e-12))
         return end - min(speed / a, end - now)
 
     def stop(self, now: float) -> float:
@@ -478,6 +553,153 @@ class MotionPlanner:
         self._pending = None
         self._free_at = end
         return end
+
+
+def continue_branch(model, solutions: np.ndarray, q_first: np.ndarray, tcp=None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """The joints (N, 6) at the end of a chain of straight-line moves to targets with the
+    analytic solutions ``solutions`` (N, 8, 6), starting from ``q_first`` (rad), and which
+    were found (N,).
+
+    On a straight TCP line the controller follows one IK solution continuously, so a move
+    ends on the IK branch (shoulder, elbow, wrist: :mod:`urdsl.kinematics.ik`) it started on
+    unless the path passes a singularity — where the trace shows the jump (URS302). Each
+    target therefore takes the solution of the branch the chain is on, each joint turned by
+    the multiple of 2π nearest the previous joints. Where that branch does not exist or
+    leaves the joint limits (and at a singular start, where the branch is ambiguous) the
+    target takes the solution closest to the previous joints, and the chain goes on from
+    its branch. The closest solution and the continuation differ only for moves that pass
+    near a singularity: a line passing the base at a small distance turns the base by
+    far more than the closest solution would.
+    """
+    from ..kinematics.ik import choose_nearest, choose_sequence
+
+    count = solutions.shape[0]
+    chosen = np.full((count, 6), np.nan)
+    found = np.zeros(count, dtype=bool)
+    previous = np.asarray(q_first, dtype=float)
+    row = 0
+    branch = _branch_of(model, previous, tcp)
+    while row < count:
+        if branch is None:  # no branch to continue: the controller's nearest choice
+            rest, ok = choose_sequence(solutions[row:], previous, model.q_min, model.q_max)
+            chosen[row:], found[row:] = rest, ok
+            return chosen, found
+        rest, ok = choose_sequence(solutions[row:, branch:branch + 1], previous,
+                                   model.q_min, model.q_max)
+        missing = np.flatnonzero(~ok)
+        stop = len(ok) if len(missing) == 0 else int(missing[0])
+        chosen[row:row + stop], found[row:row + stop] = rest[:stop], True
+        if stop:
+            previous = rest[stop - 1]
+        row += stop
+        if row == count:
+            break
+        q, ok = choose_nearest(solutions[row:row + 1], previous[None], model.q_min,
+                               model.q_max)
+        if not ok[0]:
+            return chosen, found  # out of reach: this target and the rest stay unfound
+        chosen[row], found[row] = q[0], True
+        previous = q[0]
+        branch = _matching_branch(solutions[row], previous)
+        row += 1
+    return chosen, found
+
+
+def _branch_of(model, q: np.ndarray, tcp) -> int | None:
+    """The IK branch (0…7) the joints ``q`` are on, or None at a singular pose (where
+    branches meet) or for a model without analytic solutions."""
+    every, _ = model.ik_all_many(model.fk(q, tcp=tcp)[None], tcp=tcp)
+    return _matching_branch(every[0], q)
+
+
+def _matching_branch(solutions: np.ndarray, q: np.ndarray, tolerance: float = 1e-6
+                     ) -> int | None:
+    """Index of the solution (8, 6) equal to ``q`` up to whole turns of each joint, if just
+    one is (two equal ones: a singular pose)."""
+    difference = solutions - q
+    difference -= 2.0 * np.pi * np.rint(difference / (2.0 * np.pi))
+    cost = np.einsum("kj,kj->k", difference, difference)
+    matches = np.flatnonzero(cost < tolerance)  # NaN (missing branches) never matches
+    if len(matches) != 1:
+        return None
+    return int(matches[0])
+
+
+STOP_SEARCH = 4.0
+"""How far (m) along a line that a condition stops the planner looks for where the arm can
+no longer follow it: twice the reach of the largest UR (UR20: 1.75 m), plus room."""
+
+FAR_TARGET = 1.5
+"""A target further from the base than this many times the arm's reach is a direction to
+move in, not a destination (see :meth:`MotionPlanner._far`)."""
+
+STOP_JUMP = 0.25
+"""Joint step (rad) between neighbouring points of such a line that counts as the end of a
+continuous solution (as :data:`urdsl.verify.checks.JUMP_MIN`)."""
+
+STOP_MARGIN = 0.05
+"""How far (m) before the edge of the workspace a line that a condition stops is checked
+to: the arm reaches the edge only if the condition never fires, and the checks'
+singularity margins (2 to 5 cm, URS307) would otherwise warn about a stretched arm that the
+program does not ask for."""
+
+
+ROTATION_PER_METRE = 4.0
+"""Rotational speed and acceleration limits of a ``movel``/``movep`` per unit of its tool
+speed and acceleration: ``v_rot = 4·v`` rad/s and ``a_rot = 4·a`` rad/s² (1 rad/s and
+4.8 rad/s² at the defaults v = 0.25 m/s, a = 1.2 m/s²). [U] The script manual documents only
+the m/s and m/s² of the position; this rule is a user's measurement reported on the UR
+forum ("MoveL: Tool Angular Speed", forum.universal-robots.com/t/movel-tool-angular-speed/
+15912): position and orientation each get a trapezoid, the longer one sets the move's time
+and the other is slowed down to it."""
+
+
+def line_profile(pose_from: np.ndarray, pose_to: np.ndarray, v: float, a: float, t: float,
+                 v_rot: float, a_rot: float) -> Trapezoid:
+    """The speed profile of a straight TCP line from ``pose_from`` to ``pose_to`` (4x4, m).
+
+    The controller plans two trapezoids, one for the path length ``L`` (m) with ``v`` m/s and
+    ``a`` m/s², one for the rotation angle ``θ`` (rad) with ``v_rot`` rad/s and ``a_rot``
+    rad/s², and moves on the longer one; position and orientation progress by the same path
+    fraction, so the shorter one is slowed down to it [U: see :data:`ROTATION_PER_METRE`].
+    A time ``t`` > 0 stretches the result as for any move.
+
+    The profile's distance stays the path length in m (what blends and the TCP speed use);
+    a move that only turns the tool has its angle in rad as distance. A 1 cm move that turns
+    the tool by 120° at the defaults takes about 2.3 s, not the 0.18 s of its 1 cm.
+    """
+    start, end = pose_from.tolist(), pose_to.tolist()  # scalar maths: the planner's hot path
+    length = math.dist((start[0][3], start[1][3], start[2][3]),
+                       (end[0][3], end[1][3], end[2][3]))
+    angle = _turn(start, end)
+    rotation = Trapezoid.plan(angle, v_rot, a_rot) if angle > 1e-9 else None
+    if length < 1e-9:  # the tool only turns: time it on the angle
+        return rotation.stretched(t) if rotation is not None and t > 0 else (
+            rotation if rotation is not None else Trapezoid.plan(0.0, v, a, t))
+    profile = Trapezoid.plan(length, v, a)
+    if rotation is not None and rotation.duration > profile.duration:
+        scale = length / angle  # the rotation's timing, with the path's distance
+        profile = Trapezoid(length, rotation.accel * scale, rotation.peak * scale,
+                            rotation.t_acc, rotation.t_flat)
+    return profile.stretched(t) if t > 0 else profile
+
+
+def _turn(start: list, end: list) -> float:
+    """Angle (rad, in [0, π]) of the rotation between the orientations of two poses given as
+    nested lists (4x4): ``atan2(sin θ, cos θ)`` from the trace and the skew part of
+    ``R = R0ᵀ·R1`` (accurate at 0 and π)."""
+    a, b = start, end
+    if a[0][:3] == b[0][:3] and a[1][:3] == b[1][:3] and a[2][:3] == b[2][:3]:
+        return 0.0  # the same orientation (most toolpath moves)
+
+    def entry(i: int, j: int) -> float:  # (R0ᵀ·R1)[i][j]
+        return a[0][i] * b[0][j] + a[1][i] * b[1][j] + a[2][i] * b[2][j]
+
+    cosine = (entry(0, 0) + entry(1, 1) + entry(2, 2) - 1.0) / 2.0
+    sine = math.hypot(entry(2, 1) - entry(1, 2), entry(0, 2) - entry(2, 0),
+                      entry(1, 0) - entry(0, 1)) / 2.0
+    return math.atan2(sine, cosine)
 
 
 def _distance(pose: np.ndarray, other: np.ndarray) -> float:

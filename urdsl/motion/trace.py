@@ -144,9 +144,13 @@ class _Moves:
         p = self.profile[moves]
         t_acc, t_flat = p[:, 3], p[:, 4]
         ramp = np.where(t_acc > 0, np.ceil(t_acc / KNOT_TIME - 1e-9), 0).astype(np.int64)
-        cruise_step = np.maximum(KNOT_TIME, np.divide(KNOT_PATH, p[:, 2],
-                                                      out=np.full(len(p), np.inf),
-                                                      where=p[:, 2] > 0))
+        cruise_step = np.divide(KNOT_PATH, p[:, 2], out=np.full(len(p), np.inf),
+                                where=p[:, 2] > 0)
+        # a move that turns the tool far along a short path: KNOT_ANGLE of rotation at most
+        turn = self.paths.turn[moves] * np.divide(p[:, 2], p[:, 0], out=np.zeros(len(p)),
+                                                  where=p[:, 0] > 0)
+        cruise_step = np.maximum(KNOT_TIME, np.minimum(cruise_step, np.divide(
+            KNOT_ANGLE, turn, out=np.full(len(p), np.inf), where=turn > 0)))
         cruise = np.where(t_flat > 0, np.ceil(t_flat / cruise_step - 1e-9), 0).astype(np.int64)
         ramp = np.maximum(ramp, np.where(cruise > 0, 0, 1))  # at least one step per move
         steps = 2 * ramp + cruise
@@ -269,6 +273,12 @@ time. 8 mm is what :data:`KNOT_TIME` gives at the controller's default movel spe
 (0.25 m/s); a slow process move (a 0.1 m/s toolpath) is solved every 80 ms."""
 
 
+KNOT_ANGLE = 0.032
+"""Longest tool rotation (rad) between knots while a move cruises: what :data:`KNOT_TIME`
+gives at a movel's default rotational speed (1 rad/s); it matters for moves that mostly
+turn the tool, whose path length says little about how far the joints go."""
+
+
 def _joint_velocities(planner, paths, which, q_start, moved, fraction_rate) -> np.ndarray:
     """Joint speeds (M, 6) rad/s at solved samples of straight TCP paths: the twist of the
     path (linear ``(p1 − p0)·ḟ``, angular ``R0·w·ḟ`` with ``w = log(R0ᵀR1)``) through the
@@ -357,6 +367,7 @@ class _Paths:
         self.r0 = starts[:, :3, :3]
         self.w = matrix_to_rotvec(np.swapaxes(self.r0, 1, 2) @ ends[:, :3, :3])
         self.angular = (self.r0 @ self.w[:, :, None])[:, :, 0]  # rotation step in Base
+        self.turn = np.linalg.norm(self.w, axis=1)  # rotation angle of each move, rad
         self.arc = np.array([s.kind == "movec" and s.via is not None for s in segments])
         self.tcp_group, self.tcps = tcp_groups(segments)
 
@@ -377,10 +388,9 @@ def tcp_groups(segments) -> tuple[np.ndarray, list]:
 
 
 def _cartesian(planner, paths, which, fraction, q_start, linear):
-    """Joint displacements of samples on TCP paths: poses along each path, then batched IK
-    (one call per TCP); each sample takes the solution closest to the joint-space
-    interpolation of its move's ends (``linear``), which keeps the arm on the branch of its
-    end points."""
+    """Joint displacements of samples on TCP paths (rows sorted by move, then along the
+    path): poses along each path, then inverse kinematics that follows one solution
+    continuously along each move (:func:`_track`), one batch per TCP."""
     from ..kinematics.pose import rotvec_to_matrix
 
     poses = np.repeat(np.eye(4)[None], len(which), axis=0)
@@ -398,9 +408,72 @@ def _cartesian(planner, paths, which, fraction, q_start, linear):
     groups = paths.tcp_group[which]
     for group in np.unique(groups):
         rows = np.flatnonzero(groups == group)
-        solutions[rows] = planner.kinematics.ik_many(poses[rows], near[rows],
-                                                     tcp=paths.tcps[group])
+        solutions[rows] = _track(planner.kinematics, poses[rows], near[rows],
+                                 q_start[which[rows]], which[rows], paths.tcps[group])
     return solutions - q_start[which]
+
+
+def _track(model, poses: np.ndarray, near: np.ndarray, first: np.ndarray,
+           owner: np.ndarray, tcp) -> np.ndarray:
+    """Joints (N, 6) for ``poses`` (N, 4, 4) along TCP paths, following one IK solution
+    continuously, as the controller does on a straight line: each sample takes the solution
+    closest to the sample before it on the same move (``owner``: the move of each row; rows
+    of a move in path order), the first sample of a move the one closest to where the move
+    starts (``first``, rad). A branch change then shows only where no continuous solution
+    exists — at a singularity or where the path leaves the workspace (URS302) — and not
+    near a singularity, where the solution closest to the straight joint-space line between
+    the move's ends (``near``, the first guess) may be another branch.
+
+    The sequential rule is solved in rounds over all rows at once. The first guess is kept
+    where it steps less than :data:`TRACK_STEP` from the row before; the other rows are
+    chosen from the row before them, and each further round chooses again the rows after a
+    row that changed (a toolpath needs no round at all). A row without a solution (NaN)
+    hands ``near`` on to the next.
+    """
+    count = len(poses)
+    if count == 0:
+        return np.empty((0, 6))
+    from ..kinematics.ik import choose_nearest
+
+    starts = np.ones(count, dtype=bool)
+    starts[1:] = owner[1:] != owner[:-1]
+    analytic = hasattr(model, "ik_all_many") and not getattr(model, "calibrated", False)
+    if analytic:
+        every, _ = model.ik_all_many(poses, tcp=tcp)
+
+        def choose(rows: np.ndarray, toward: np.ndarray) -> np.ndarray:
+            return choose_nearest(every[rows], toward, model.q_min, model.q_max)[0]
+    else:
+        def choose(rows: np.ndarray, toward: np.ndarray) -> np.ndarray:
+            return model.ik_many(poses[rows], toward, tcp=tcp)
+
+    current = choose(np.arange(count), near)
+    # rows that stay within TRACK_STEP of the row before are its continuation already
+    before = np.where(starts[:, None], first, np.roll(current, 1, axis=0))
+    step = np.abs(current - before).max(axis=1)
+    active = np.flatnonzero(~(step <= TRACK_STEP))  # NaN too: choose again
+    for _ in range(count):
+        if len(active) == 0:
+            break
+        previous = np.where(starts[active, None], first[active], current[active - 1])
+        lost = np.isnan(previous).any(axis=1)
+        previous[lost] = near[active[lost]]
+        chosen = choose(active, previous)
+        old = current[active]
+        same = ((chosen == old) | (np.isnan(chosen) & np.isnan(old))).all(axis=1)
+        current[active] = chosen
+        after = active[~same] + 1
+        after = after[after < count]
+        active = np.unique(after[~starts[after]])
+    return current
+
+
+TRACK_STEP = 0.25
+"""Largest joint step (rad) between consecutive path samples (knots, at most 32 ms apart)
+below which :func:`_track` keeps the first guess, the solution closest to the joint-space
+line: a joint moves at most 0.1 rad between knots at the fastest joint speed of a UR, and a
+change of branch moves one by about π (as :data:`urdsl.verify.checks.JUMP_MIN`). Rows
+stepping further are chosen again from the row before them, and so on along the move."""
 
 
 def _fill_gaps(values: np.ndarray, owner: np.ndarray) -> np.ndarray:

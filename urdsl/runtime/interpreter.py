@@ -30,7 +30,13 @@ from ..script import nodes as n
 from ..script.binder import Binding, Signature
 from ..script.nodes import NO_SPAN, Span
 from .errors import ScriptRuntimeError
-from .unknown import UNKNOWN_LOOP_PASSES, ends_program, first_unknown, unknown_call
+from .unknown import (
+    UNKNOWN_LOOP_PASSES,
+    ends_program,
+    first_unknown,
+    stops_motion,
+    unknown_call,
+)
 from .values import (
     ListValue,
     PoseValue,
@@ -716,22 +722,31 @@ class _Compiler:
     def s_If(self, node: n.If):
         rt = self.rt
         branches = [(self.expr(node.test), self.block(node.body), node.test,
-                     ends_program(node.body))]
-        branches += [(self.expr(b.test), self.block(b.body), b.test, ends_program(b.body))
-                     for b in node.elifs]
+                     ends_program(node.body), stops_motion(node.body))]
+        branches += [(self.expr(b.test), self.block(b.body), b.test, ends_program(b.body),
+                      stops_motion(b.body)) for b in node.elifs]
         orelse = self.block(node.orelse) if node.orelse is not None else None
+        first_seen: dict[int, float] = {}  # branch -> robot time of its first unknown test
 
         def run(frame):
-            for test, body, test_node, ending in branches:
+            for index, (test, body, test_node, ending, stopping) in enumerate(branches):
                 value = test(frame)
                 if type(value) is Unknown:
                     # follow a working device: not into an error branch (it ends the
                     # program), not against the reply the program expects, else in
                     take = not ending and value.lean is not False
+                    if take and stopping:
+                        # a sensor that stops a move (PolyScope's Until: tool contact, an
+                        # input) fires once the move has come as far as it can go
+                        seen = first_seen.setdefault(index, rt.time)
+                        free_at = getattr(rt.robot, "free_at", rt.time)
+                        take = rt.time > seen and free_at <= rt.time + 1e-9
                     rt.warn_once(
                         f"this condition depends on {value.source}, which is unknown "
                         "offline; the check follows a working device: "
                         + ("it skips this branch, which ends the program" if ending
+                           else "it takes this branch once the move it stops has come as "
+                           "far as it can" if stopping and value.lean is not False
                            else "it takes this branch" if take
                            else "it skips this branch (the reply is as expected)"),
                         test_node)

@@ -43,7 +43,8 @@ from .values import ListValue, StructValue, Unknown, has_unknown
 
 __all__ = [
     "DEVICE_REPLY_TIME", "OPERATOR_REPLY_TIME", "UNCHECKED_MOVE_TIME", "UNKNOWN_LOOP_PASSES",
-    "DEVICE_READS", "OPERATOR_PROMPTS", "ends_program", "unknown_from", "describe",
+    "DEVICE_READS", "OPERATOR_PROMPTS", "ends_program", "stops_motion", "unknown_from",
+    "describe",
 ]
 
 DEVICE_REPLY_TIME = 0.1
@@ -103,20 +104,32 @@ def unknown_from(name: str, node: Any) -> Unknown:
     return value
 
 
+def stops_motion(body: Any) -> bool:
+    """Whether a block stops the arm's motion: it kills a thread or calls ``stopl``/``stopj``
+    (outside nested definitions), as PolyScope's Until conditions of a Direction node do."""
+    return _holds(body, (n.Kill,), frozenset(("stopl", "stopj")))
+
+
 def ends_program(body: Any) -> bool:
     """Whether a block ends or stops the program in a way a failing device causes: it holds
     (outside nested definitions) a ``halt``, a ``popup`` or a protective stop."""
+    return _holds(body, (n.Halt,), _ENDING_CALLS)
+
+
+def _holds(body: Any, statements: tuple[type, ...], calls: frozenset[str]) -> bool:
+    """Whether a block holds (in its branches and loops, not in nested definitions) one of
+    ``statements`` or a call statement of one of ``calls``."""
     stack = list(body or ())
     while stack:
         item = stack.pop()
-        if isinstance(item, n.Halt):
+        if isinstance(item, statements):
             return True
         if isinstance(item, (n.FunctionDef, n.ThreadDef, n.SecDef)):
             continue
         if isinstance(item, n.ExprStmt):
             call = item.expr
             if (isinstance(call, n.Call) and isinstance(call.func, n.Name)
-                    and call.func.id in _ENDING_CALLS):
+                    and call.func.id in calls):
                 return True
         elif isinstance(item, n.If):
             stack.extend(item.body)

@@ -1,6 +1,8 @@
 """Checks over a sampled trace, one function per rule. Each takes the trace (and what it
 needs of the robot model or the cell) and returns findings, at most one per move and rule,
-placed at the statement that commanded the move."""
+placed at the statement that commanded the move, with its cause (the joint, the
+singularity, the colliding pair): the report keeps one finding per statement, rule and
+cause, however often a loop runs the statement (:meth:`urdsl.verify.report.Report.sort`)."""
 
 from __future__ import annotations
 
@@ -59,7 +61,8 @@ def joint_limits(trace: Trace, lower: np.ndarray, upper: np.ndarray) -> list[Fin
             f"{JOINTS[joint]} joint reaches {np.degrees(value):.1f}° "
             f"(limit {np.degrees(bound):.1f}°) at t={trace.times[sample]:.3f} s",
             _span(trace, segment), float(trace.times[sample]),
-            "choose a target closer to the current joints, or another IK solution"))
+            "choose a target closer to the current joints, or another IK solution",
+            cause=f"{JOINTS[joint]} {'upper' if value > upper[joint] else 'lower'}"))
     return findings
 
 
@@ -83,7 +86,8 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
             "URS304",
             f"{JOINTS[joint]} joint turns at {peak:.2f} rad/s, over its limit of "
             f"{limits[joint]:.2f} rad/s",
-            _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment)))
+            _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
+            cause=JOINTS[joint]))
     return findings
 
 
@@ -107,7 +111,7 @@ def joint_accelerations(trace: Trace, limits: np.ndarray, exclude: np.ndarray | 
             "URS305",
             f"{JOINTS[joint]} joint accelerates at {abs(trace.qdd[sample, joint]):.1f} "
             f"rad/s², over {limits[joint]:.1f} rad/s²",
-            _span(trace, segment), float(trace.times[sample]), "lower a"))
+            _span(trace, segment), float(trace.times[sample]), "lower a", cause=JOINTS[joint]))
     return findings
 
 
@@ -175,7 +179,7 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
             f"{100 * fraction.min():.0f}% and {100 * fraction.max():.0f}% of the way "
             f"(t={trace.times[sample]:.3f} s), although both ends are reachable",
             _span(trace, segment), float(trace.times[sample]),
-            "go round the unreachable region with a waypoint, or use movej"))
+            "go round the unreachable region with a waypoint, or use movej", cause="reach"))
     for segment, sample in _per_segment(trace, jumps):
         if segment in reported or segment < 0:
             continue
@@ -188,7 +192,7 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
             f"jumps by {np.degrees(step[joint]):.0f}° at "
             f"t={trace.times[sample]:.3f} s, which the robot cannot do on a straight line",
             _span(trace, segment), float(trace.times[sample]),
-            "split the move, or reach the end with movej"))
+            "split the move, or reach the end with movej", cause=f"jump {JOINTS[joint]}"))
     bad = jumps | trace.unreachable
     for shift in (-2, -1, 1, 2):  # central differences spread a jump to the neighbours
         flagged |= np.roll(bad, shift)
@@ -223,7 +227,8 @@ def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
         peak = float(np.max(speed[trace.segment == segment]))
         findings.append(Finding.of(
             "URS306", f"the TCP moves at {peak:.3f} m/s, over the cell's limit of {limit:g} m/s",
-            _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment)))
+            _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
+            cause="tcp"))
     return findings
 
 
@@ -269,7 +274,7 @@ def singularities(trace: Trace, robot, scale: float | None = None,
                 f"{distance:.3g} {_UNITS[kind]} of it at "
                 f"t={trace.times[sample]:.3f} s (joint speeds grow without bound there)",
                 _span(trace, segment), float(trace.times[sample]),
-                _SINGULARITY_HINTS[kind]))
+                _SINGULARITY_HINTS[kind], cause=kind))
     return findings
 
 
@@ -317,5 +322,5 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
             "URS308", f"collision: {what} (overlap {depth * 1000:.0f} mm) at "
             f"t={trace.times[sample]:.3f} s",
             _span(trace, segment), float(trace.times[sample]),
-            "move around the obstacle with an extra waypoint"))
+            "move around the obstacle with an extra waypoint", cause=what))
     return findings

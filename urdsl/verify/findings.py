@@ -28,12 +28,18 @@ URS210   warning   what follows depends on a value from outside (a device's repl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import re
+from dataclasses import dataclass, field, replace
 
 from ..script.diagnostics import Diagnostic
 from ..script.nodes import NO_SPAN, Span
 
 __all__ = ["Finding", "RULES"]
+
+_NUMBER = re.compile(r"(?<![\w.])(?<!wrist )[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
+"""Numbers in a message (not inside names such as ``Waypoint_1``, nor a wrist's number)."""
+
+_REPEATED = re.compile(r" \(\d+ times(?:, first at t=[-\d.]+ s)?\)$")
 
 RULES: dict[str, tuple[str, str]] = {
     "URS301": ("error", "unreachable pose"),
@@ -55,7 +61,13 @@ RULES: dict[str, tuple[str, str]] = {
 
 @dataclass(frozen=True)
 class Finding:
-    """One problem, at the statement that caused it. ``time`` is robot time in s."""
+    """One problem, at the statement that caused it. ``time`` is robot time in s.
+
+    ``cause`` tells findings of one rule at one statement apart (the joint, the singularity,
+    the colliding pair); None: the message without its numbers does (:meth:`identity`).
+    ``count`` is how many times the program ran into it (a statement in a loop); the
+    finding is the first of them.
+    """
 
     code: str
     severity: str
@@ -63,11 +75,31 @@ class Finding:
     span: Span = NO_SPAN
     time: float | None = None
     hint: str | None = None
+    cause: str | None = field(default=None, compare=False)
+    count: int = field(default=1, compare=False)
 
     @classmethod
     def of(cls, code: str, message: str, span: Span = NO_SPAN, time: float | None = None,
-           hint: str | None = None) -> Finding:
-        return cls(code, RULES[code][0], message, span, time, hint)
+           hint: str | None = None, cause: str | None = None) -> Finding:
+        return cls(code, RULES[code][0], message, span, time, hint, cause)
+
+    def identity(self) -> tuple:
+        """What makes two findings the same problem: rule, statement and cause — not the
+        times, speeds or poses of one loop pass (numbers in the message are ignored when no
+        ``cause`` is given; joint names such as "wrist 2" are kept)."""
+        cause = (self.cause if self.cause is not None
+                 else _NUMBER.sub("#", _REPEATED.sub("", self.message)))
+        return (self.code, self.span, cause)
+
+    def repeated(self, count: int) -> Finding:
+        """This finding as the first of ``count`` occurrences, saying so in its message."""
+        if count == self.count:
+            return self
+        message = _REPEATED.sub("", self.message)
+        if count > 1:
+            when = f", first at t={self.time:.3f} s" if self.time is not None else ""
+            message = f"{message} ({count} times{when})"
+        return replace(self, message=message, count=count)
 
     def diagnostic(self) -> Diagnostic:
         return Diagnostic.at(self.span, self.message, code=self.code, severity=self.severity,
@@ -76,4 +108,5 @@ class Finding:
     def to_dict(self) -> dict:
         result = self.diagnostic().to_dict()
         result["time"] = None if self.time is None else round(self.time, 6)
+        result["count"] = self.count
         return result

@@ -6,7 +6,7 @@ JSON shape (``urdsl check --json``), one document::
      "summary": {"error": 1, "warning": 0, "info": 0},
      "findings": [{"code": "URS303", "severity": "error", "message": "...",
                    "file": "pick.script", "line": 7, "column": 1, "hint": "...",
-                   "time": 2.31}],
+                   "time": 2.31, "count": 1}],
      "moves": [{"kind": "movej", "line": 3, "column": 1, "start": 0.0,
                 "duration": 2.094}],
      "events": [{"time": 0.0, "kind": "textmsg", "message": "hello", "line": 2}],
@@ -59,17 +59,25 @@ class Report:
     context: str | None = None  # the project context the program ran in, if any
 
     def sort(self) -> None:
-        """Order findings by position in the file, then by time; a finding repeated word for
-        word at the same statement (a function called in a loop) is kept once."""
+        """Order findings by position in the file, then by time, with one finding per
+        statement, rule and cause (:meth:`Finding.identity`): a problem met on every pass of
+        a loop is reported once, the first time, saying how often it happened
+        ("... (12 times, first at t=3.210 s)")."""
         self.findings.sort(key=lambda f: (f.span.line, f.span.column, f.time or 0.0, f.code))
-        seen: set = set()
-        unique = []
+        first: dict[tuple, int] = {}
+        counts: list[int] = []
+        unique: list[Finding] = []
         for finding in self.findings:
-            key = (finding.code, finding.span, finding.message)
-            if key not in seen:
-                seen.add(key)
+            identity = finding.identity()
+            index = first.get(identity)
+            if index is None:
+                first[identity] = len(unique)
                 unique.append(finding)
-        self.findings = unique
+                counts.append(finding.count)
+            else:
+                counts[index] += finding.count
+        self.findings = [finding.repeated(count) for finding, count in zip(unique, counts,
+                                                                           strict=True)]
 
     def count(self, severity: str) -> int:
         return sum(1 for f in self.findings if f.severity == severity)

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from .._gc import gc_paused
+from ..motion.direction import stoppable_moves
 from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
 from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
@@ -132,6 +133,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     cb3 = getattr(robot.spec, "generation", "") == "cb3"
     step = 0.008 if cb3 else 0.002
     planner = MotionPlanner(robot, options.start_joints, step_time=step, lazy_ik=True)
+    planner.stoppable = stoppable_moves(module)  # Direction nodes: moves until a condition
     if options.tcp is not None:
         planner.tcp = np.asarray(options.tcp, dtype=float)
     deadline = None if options.timeout is None else started + RUN_SHARE * options.timeout
