@@ -414,25 +414,42 @@ class VirtualController:
         path relative to the folder. Raises FileNotFoundError or SimError (not URScript)."""
         from ..script.parser import parse
 
-        if self.programs_dir is None:
-            raise FileNotFoundError(name)
-        root = self.programs_dir.resolve()
-        path = (root / name.strip()).resolve()
-        if root not in path.parents or not path.is_file():  # no escaping the folder
+        path = self.program_path(name)
+        if path is None:
             raise FileNotFoundError(name)
         try:
-            text = path.read_text(encoding="utf-8")
-        except UnicodeDecodeError:
-            text = path.read_text(encoding="latin-1")
+            raw = path.read_bytes()
         except OSError as error:
             raise FileNotFoundError(name) from error
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            text = raw.decode("latin-1")
         try:
             parse(text, filename=name)
         except ScriptError as error:
             raise SimError(error.diagnostic.render()) from None
+        except RecursionError:
+            raise SimError(f"{name}: the program nests too deeply") from None
         with self._lock:
             self._loaded = (name.strip(), text)
         return name.strip()
+
+    def program_path(self, name: str) -> Path | None:
+        """The file ``name`` names inside ``programs_dir``, or None when there is no such
+        file there. Never raises: a name too long for the file system, with a NUL byte or
+        one that leads out of the folder (``..``, an absolute path, a link) is just not
+        there, so the answer tells nothing about files outside the folder."""
+        if self.programs_dir is None:
+            return None
+        try:
+            root = self.programs_dir.resolve()
+            path = (root / name.strip()).resolve()
+            if root not in path.parents or not path.is_file():  # no escaping the folder
+                return None
+        except (OSError, ValueError, RuntimeError):  # ENAMETOOLONG, NUL byte, link loop
+            return None
+        return path
 
     def play(self) -> bool:
         """Start the loaded program, or resume a paused one (dashboard ``play``)."""
