@@ -23,6 +23,7 @@ A client that breaks a protocol's framing is dropped too; its neighbours do not 
 from __future__ import annotations
 
 import errno
+import logging
 import selectors
 import socket
 import threading
@@ -37,6 +38,8 @@ from .rtde import InputOwners, RtdeProtocolError, RtdeSession
 from .state import Snapshot
 
 __all__ = ["SimServers", "STANDARD_PORTS"]
+
+_log = logging.getLogger("urdsl.sim")
 
 STANDARD_PORTS = {
     "dashboard": 29999, "primary": 30001, "secondary": 30002, "realtime": 30003,
@@ -260,8 +263,16 @@ class SimServers:
                 client.send(realtime)
             elif kind == "rtde":
                 session: RtdeSession = client.session
-                with client.session_lock:
-                    data = session.encode(snap) if session.output_due() else None
+                try:
+                    with client.session_lock:
+                        data = session.encode(snap) if session.output_due() else None
+                except Exception as error:  # noqa: BLE001 - this client's recipe: drop it
+                    _log.error("virtual controller: RTDE client dropped: %s: %s",
+                               type(error).__name__, error, exc_info=error)
+                    client.dropped_for = f"internal error: {type(error).__name__}: {error}"
+                    client.closed = True
+                    self._poke(client)
+                    continue
                 if data is not None:
                     client.send(data)
             elif kind != "dashboard" and state_due:
@@ -287,25 +298,46 @@ class SimServers:
                 break
             for key, mask in events:
                 data = key.data
-                if data is None:
-                    self._drain_wake()
-                elif isinstance(data, _Listener):
-                    self._accept(data)
-                else:
-                    if mask & selectors.EVENT_READ:
-                        self._read(data)
-                    if mask & selectors.EVENT_WRITE and not data.closed:
-                        self._flush(data)
+                try:
+                    if data is None:
+                        self._drain_wake()
+                    elif isinstance(data, _Listener):
+                        self._accept(data)
+                    else:
+                        if mask & selectors.EVENT_READ:
+                            self._read(data)
+                        if mask & selectors.EVENT_WRITE and not data.closed:
+                            self._flush(data)
+                except Exception as error:  # noqa: BLE001 - see _failed
+                    self._failed(data, error)
             with self._pending_lock:
                 pending = list(self._pending)
                 self._pending.clear()
                 self._woken = False
             for client in pending:
-                if client in self._clients:
-                    if client.closed:
-                        self._drop(client, client.dropped_for)
-                    else:
-                        self._flush(client)
+                try:
+                    if client in self._clients:
+                        if client.closed:
+                            self._drop(client, client.dropped_for)
+                        else:
+                            self._flush(client)
+                except Exception as error:  # noqa: BLE001 - see _failed
+                    self._failed(client, error)
+
+    def _failed(self, data: Any, error: Exception) -> None:
+        """An exception escaped a handler: a bug of urdsl that a client's input exposed.
+        Log it with its traceback, drop that client (its session may be half updated) and
+        keep serving everybody else. Never raises."""
+        where = data.kind if isinstance(data, (_Client, _Listener)) else "wake-up"
+        try:
+            _log.error("virtual controller: %s client dropped after an internal error: "
+                       "%s: %s", where, type(error).__name__, error, exc_info=error)
+            if isinstance(data, _Client):
+                self._drop(data, f"internal error: {type(error).__name__}: {error}")
+            else:
+                self.dropped.append((where, f"internal error: {type(error).__name__}"))
+        except Exception:  # noqa: BLE001 - the loop must go on whatever happens
+            pass
 
     def _drain_wake(self) -> None:
         try:
@@ -329,7 +361,11 @@ class SimServers:
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             client = _Client(self, sock, listener.kind)
-            self._open(client)
+            try:
+                self._open(client)
+            except Exception as error:  # noqa: BLE001 - see _failed
+                self._failed(client, error)
+                sock.close()
 
     def _open(self, client: _Client) -> None:
         kind = client.kind
@@ -428,7 +464,10 @@ class SimServers:
         if reason:
             self.dropped.append((client.kind, reason))
         if client.kind == "rtde" and client.session is not None:
-            client.session.close()
+            try:
+                client.session.close()
+            except Exception as error:  # noqa: BLE001 - the socket must still be closed
+                _log.error("virtual controller: closing an RTDE session failed: %s", error)
         try:
             self._selector.unregister(client.sock)
         except (KeyError, ValueError, OSError):

@@ -1,0 +1,203 @@
+"""Hostile clients against the virtual controller's servers (issue 14): no input a client
+sends may silence the network thread, and the dashboard is no oracle for files outside its
+programs folder. Every socket has a timeout, so no test can hang."""
+
+from __future__ import annotations
+
+import socket
+import struct
+import time
+
+import pytest
+
+from urdsl.sim import dashboard as sim_dashboard
+from urdsl.sim import rtde as sim_rtde
+from urdsl.sim.controller import VirtualController
+from urdsl.sim.servers import STANDARD_PORTS
+
+TIMEOUT = 5.0
+
+
+@pytest.fixture
+def sim(tmp_path):
+    programs = tmp_path / "programs"
+    programs.mkdir()
+    (programs / "wave.script").write_text("def wave():\n  textmsg(\"hi\")\nend\n")
+    (programs / "inside.urp").write_bytes(b"\x1f\x8b not URScript")
+    (tmp_path / "secret.urp").write_bytes(b"\x1f\x8b secret")
+    with VirtualController(programs_dir=programs) as controller:
+        with controller.serve(ports={k: 0 for k in STANDARD_PORTS}) as servers:
+            controller.servers = servers
+            controller.tmp = tmp_path
+            yield controller
+
+
+def connect(sim, interface: str) -> socket.socket:
+    sock = socket.create_connection(("127.0.0.1", sim.servers.ports[interface]), TIMEOUT)
+    sock.settimeout(TIMEOUT)
+    return sock
+
+
+class Dashboard:
+    def __init__(self, sim):
+        self.sock = connect(sim, "dashboard")
+        self.file = self.sock.makefile("rb")
+        self.welcome = self.line()
+
+    def line(self) -> str:
+        return self.file.readline().decode("utf-8", "replace").rstrip("\n")
+
+    def ask(self, command: str) -> str:
+        self.sock.sendall(command.encode() + b"\n")
+        return self.line()
+
+    def close(self) -> None:
+        self.file.close()
+        self.sock.close()
+
+
+def read_exactly(sock: socket.socket, count: int) -> bytes:
+    data = b""
+    while len(data) < count:
+        chunk = sock.recv(count - len(data))
+        if not chunk:
+            raise ConnectionError("closed")
+        data += chunk
+    return data
+
+
+def rtde_ask(sock: socket.socket, kind: str, payload: bytes = b"") -> bytes:
+    sock.sendall(struct.pack(">HB", len(payload) + 3, ord(kind)) + payload)
+    while True:
+        size, got = struct.unpack(">HB", read_exactly(sock, 3))
+        data = read_exactly(sock, size - 3)
+        if chr(got) == kind:
+            return data
+
+
+def still_served(sim) -> None:
+    """A new dashboard client gets its welcome and an answer."""
+    dash = Dashboard(sim)
+    try:
+        assert dash.welcome.startswith("Connected: Universal Robots Dashboard Server")
+        assert dash.ask("robotmode") == "Robotmode: RUNNING"
+    finally:
+        dash.close()
+
+
+# ---- the two remote kills ---------------------------------------------------------------------
+
+
+def test_loading_a_300_character_file_name_answers_file_not_found(sim):
+    dash = Dashboard(sim)
+    name = "a" * 300 + ".script"
+    assert dash.ask(f"load {name}") == f"File not found: {name}"
+    assert dash.ask("load " + "d/" * 3000 + "x.script").startswith("File not found: ")
+    assert dash.ask("load bad\x00name.script") == "File not found: bad\x00name.script"
+    assert dash.ask("load wave.script") == "Loading program: wave.script"  # same client
+    dash.close()
+    still_served(sim)
+    assert sim.servers.dropped == []
+
+
+def test_256_input_recipes_on_one_connection_refuse_the_256th_and_serve_on(sim):
+    sock = connect(sim, "rtde")
+    assert rtde_ask(sock, "V", struct.pack(">H", 2)) == b"\x01"
+    ids = []
+    for _ in range(256):
+        reply = rtde_ask(sock, "I", b"input_int_register_0")
+        ids.append(reply[0])
+        assert reply[1:] == b"INT32"
+    assert ids[:255] == list(range(1, 256))
+    assert ids[255] == 0  # no id left: refused, like a recipe with an unknown field
+    # the connection lives on, its recipes still work
+    assert len(rtde_ask(sock, "v")) == 16
+    sock.sendall(struct.pack(">HBBi", 8, ord("U"), 255, 1234))
+    assert rtde_ask(sock, "S") == b"\x01"
+    deadline = time.monotonic() + TIMEOUT
+    while sim.env.input_int_registers[0] != 1234 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert sim.env.input_int_registers[0] == 1234
+    sock.close()
+    still_served(sim)
+
+
+def test_a_client_whose_input_makes_a_handler_raise_is_dropped_and_others_are_served(
+        sim, monkeypatch, caplog):
+    original = sim_dashboard.DashboardSession.command
+
+    def command(self, line):
+        if line == "boom":
+            raise RuntimeError("a bug a client found")
+        return original(self, line)
+
+    monkeypatch.setattr(sim_dashboard.DashboardSession, "command", command)
+    bystander = Dashboard(sim)
+    victim = Dashboard(sim)
+    victim.sock.sendall(b"boom\n")
+    assert victim.file.read() == b""  # dropped: the server closed the connection
+    victim.close()
+    assert bystander.ask("robotmode") == "Robotmode: RUNNING"
+    bystander.close()
+    still_served(sim)
+    assert ("dashboard", "internal error: RuntimeError: a bug a client found") \
+        in sim.servers.dropped
+    assert "a bug a client found" in caplog.text  # logged, with its traceback
+
+
+@pytest.mark.parametrize("error", [struct.error("bad"), KeyError("x"), OverflowError("big"),
+                                   MemoryError(), RecursionError("deep")])
+def test_any_exception_in_the_rtde_handler_drops_only_that_client(sim, monkeypatch, error):
+    def receive(self, data):
+        raise error
+
+    keeper = connect(sim, "rtde")
+    assert rtde_ask(keeper, "V", struct.pack(">H", 2)) == b"\x01"
+    monkeypatch.setattr(sim_rtde.RtdeSession, "receive", receive)
+    victim = connect(sim, "rtde")
+    victim.sendall(b"\x00\x03V")
+    assert victim.recv(100) == b""
+    victim.close()
+    monkeypatch.undo()
+    assert len(rtde_ask(keeper, "v")) == 16
+    keeper.close()
+    still_served(sim)
+
+
+def test_an_exception_while_encoding_a_clients_stream_drops_only_that_client(sim,
+                                                                             monkeypatch):
+    def encode(self, snap):
+        raise ZeroDivisionError("encoder bug")
+
+    keeper = Dashboard(sim)
+    sock = connect(sim, "rtde")
+    assert rtde_ask(sock, "V", struct.pack(">H", 2)) == b"\x01"
+    assert rtde_ask(sock, "O", struct.pack(">d", 125.0) + b"timestamp")[0] == 1
+    monkeypatch.setattr(sim_rtde.RtdeSession, "encode", encode)
+    sock.sendall(struct.pack(">HB", 3, ord("S")))
+    while sock.recv(65536):  # a timeout here fails the test: the client must be dropped
+        pass
+    sock.close()
+    assert any(reason == "internal error: ZeroDivisionError: encoder bug"
+               for _kind, reason in sim.servers.dropped)
+    assert keeper.ask("robotmode") == "Robotmode: RUNNING"
+    keeper.close()
+
+
+# ---- no file-existence oracle -----------------------------------------------------------------
+
+
+def test_load_of_a_urp_outside_the_programs_folder_answers_alike_whether_it_exists(sim):
+    dash = Dashboard(sim)
+    outside = sim.tmp
+    for existing, missing in [("../secret.urp", "../nothing.urp"),
+                              (str(outside / "secret.urp"), str(outside / "nothing.urp"))]:
+        assert (outside / existing.rsplit("/", 1)[-1]).exists()
+        got_existing = dash.ask(f"load {existing}")
+        got_missing = dash.ask(f"load {missing}")
+        assert got_existing == f"File not found: {existing}"
+        assert got_missing == f"File not found: {missing}"
+    # inside the folder the controller says what it found
+    assert dash.ask("load inside.urp") == "Error while loading program: inside.urp"
+    assert dash.ask("load absent.urp") == "File not found: absent.urp"
+    dash.close()
