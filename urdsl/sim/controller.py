@@ -204,7 +204,6 @@ class VirtualController:
         self._subscribers: list[Callable[[Snapshot], None]] = []
         self._message_subscribers: list[Callable[[ControllerMessage], None]] = []
         self._message_log: list[ControllerMessage] = []
-        self._env_cursor = 0
         self._closing = threading.Event()
         self._threads: list[threading.Thread] = []
         self._wall0 = time.perf_counter()
@@ -558,11 +557,10 @@ class VirtualController:
                                           name="urdsl-sim-sec", daemon=True)
                 thread.start()
                 continue
-            collecting = gc.isenabled()
-            gc.disable()  # as in _compile: no collection scans the new tree
             try:
-                job.module = parse(job.text, filename=job.name or job.origin)
-                gc.freeze()
+                with _GC_PAUSE:  # as in _compile: no collection scans the new tree
+                    job.module = parse(job.text, filename=job.name or job.origin)
+                    gc.freeze()
             except ScriptSyntaxError as error:
                 self._report_error(error)
                 continue
@@ -570,9 +568,6 @@ class VirtualController:
                 self._publish(ControllerMessage(self.now(), "runtime_exception",
                                                 f"{job.origin}: the program nests too deeply"))
                 continue
-            finally:
-                if collecting:
-                    gc.enable()
             with self._lock:
                 if self._program is not None:
                     self._halt_program(self._program)
@@ -592,6 +587,19 @@ class VirtualController:
                 with self._lock:
                     self._program = None
                     self._program_state = ProgramState.STOPPED
+            job.module = None
+            del job
+            self._collect()
+
+    def _collect(self) -> None:
+        """Free the finished program. Its tree and the interpreter's closures hold reference
+        cycles, and while it ran they sat in the collector's permanent generation (see
+        :func:`_compile`); thawed, they land in the oldest generation, which Python's
+        automatic collections almost never scan: without a full collection here every
+        program stayed in memory (+17,000 objects per 200 lines). The collection walks the
+        live objects plus the garbage, about as long as freeing the program costs anyway
+        (~50 ms per 1,000 lines on one core), once per program and never while one runs."""
+        gc.collect()
 
     def _run_job(self, job: _Job) -> None:
         from ..runtime import Interpreter, RuntimeConfig
@@ -700,9 +708,12 @@ class VirtualController:
 
     def _publish_env_messages(self) -> None:
         with self._lock:
+            # taken out of the list, so that it does not grow for as long as the controller
+            # runs (programs append at the end from their own threads meanwhile)
             messages = self.env.messages
-            new = messages[self._env_cursor:]
-            self._env_cursor = len(messages)
+            count = len(messages)
+            new = messages[:count]
+            del messages[:count]
         for _time, kind, text in new:
             self._publish(ControllerMessage(self.now(), "popup" if kind == "popup" else "text",
                                             text))
@@ -885,14 +896,40 @@ def _compile(interpreter, module, planner, environment, config):
     paused, then freeze what exists so that no collection scans the program while it runs.
     A 100,000-line program compiles in 0.9 s this way instead of 8 s, and the collector no
     longer holds Python's lock for a second in the middle of the clock's 2 ms steps."""
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
-        return interpreter(module, robot=planner, environment=environment, config=config)
-    finally:
-        gc.freeze()
-        if collecting:
-            gc.enable()
+    with _GC_PAUSE:
+        try:
+            return interpreter(module, robot=planner, environment=environment, config=config)
+        finally:
+            gc.freeze()
+
+
+class _GcPause:
+    """The cyclic collector paused while any thread is inside (nestable, thread-safe).
+
+    The collector's switch is global: with a plain ``gc.disable()``/``gc.enable()`` pair in
+    the compiler and the runner thread, one thread could read "disabled" while the other had
+    paused it, and leave the collector off for good."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.depth = 0
+        self._was_enabled = True
+
+    def __enter__(self) -> None:
+        with self.lock:
+            if self.depth == 0:
+                self._was_enabled = gc.isenabled()
+                gc.disable()
+            self.depth += 1
+
+    def __exit__(self, *exc: object) -> None:
+        with self.lock:
+            self.depth -= 1
+            if self.depth == 0 and self._was_enabled:
+                gc.enable()
+
+
+_GC_PAUSE = _GcPause()
 
 
 def _frozen(values) -> np.ndarray:

@@ -28,6 +28,7 @@ import selectors
 import socket
 import threading
 import time
+from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
@@ -52,6 +53,9 @@ realtime packets at 500 Hz, or 10 s of RTDE with a 100-field recipe."""
 
 MAX_CLIENTS = 64
 """Connections per port; more are refused (closed at once)."""
+
+DROPS_KEPT = 1000
+"""Reasons of the latest dropped connections kept in :attr:`SimServers.dropped`."""
 
 STATE_PERIOD = 0.1
 """Primary/secondary robot state period (s of wall time): 10 Hz on CB3 and e-Series."""
@@ -135,7 +139,9 @@ class SimServers:
             self.requested[name] = port
         self.ports: dict[str, int] = {}
         self.owners = InputOwners()
-        self.dropped: list[tuple[str, str]] = []  # (interface, reason), for tests and logs
+        # (interface, reason) of the latest drops, for tests and logs; bounded, as a
+        # controller runs for months and hostile clients may be dropped by the million
+        self.dropped: deque[tuple[str, str]] = deque(maxlen=DROPS_KEPT)
         self._selector = selectors.DefaultSelector()
         self._listeners: list[_Listener] = []
         self._clients: set[_Client] = set()
