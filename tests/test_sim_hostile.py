@@ -253,3 +253,35 @@ def test_sixty_programs_in_a_row_leave_memory_flat():
         assert sim.stats.programs == 60 and sim.stats.errors == 0
     assert grown_objects < 100_000, grown_objects  # was ~850,000
     assert grown_rss < 30.0, grown_rss  # MiB; was ~75
+
+
+# ---- a program cut off by its connection ------------------------------------------------------
+
+
+@pytest.mark.parametrize("reset", [False, True])
+def test_a_program_cut_off_by_its_connection_is_reported_not_silently_lost(sim, reset):
+    primary = connect(sim, "primary")
+    seen = len(sim.messages)
+    sender = connect(sim, "secondary")
+    sender.sendall(b"def cut():\n  textmsg(\"never\")\n")
+    deadline = time.monotonic() + TIMEOUT
+    while not sim.servers._clients or not any(  # the sim has read the partial program
+            c.framer is not None and c.framer.pending for c in list(sim.servers._clients)):
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    if reset:  # close with SO_LINGER 0: the kernel sends a reset
+        sender.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+    else:  # an orderly end: half-close, read until the sim closes too
+        sender.shutdown(socket.SHUT_WR)
+        while sender.recv(65536):
+            pass
+    sender.close()
+    how = "was reset" if reset else "ended"
+    while not any(how in m.text for m in sim.messages[seen:]):
+        assert time.monotonic() < deadline, sim.messages[seen:]
+        time.sleep(0.01)
+    message = next(m for m in sim.messages[seen:] if how in m.text)
+    assert message.kind == "runtime_exception"
+    assert message.text.startswith(f"<secondary {sim.servers.ports['secondary']}>: the "
+                                   f"connection {how} before the program's 'end' line")
+    primary.close()

@@ -364,11 +364,15 @@ class VirtualController:
         framer = ScriptFramer()
         chunks = framer.feed(text.encode("utf-8") + (b"" if text.endswith("\n") else b"\n"))
         if framer.pending:
-            self._publish(ControllerMessage(self.now(), "runtime_exception",
-                                            f"{origin}: the program has no 'end' line in "
-                                            "column 0; it was not run"))
+            self.refuse(origin, "the program has no 'end' line in column 0; it was not run")
         for chunk in chunks:
             self.submit_chunk(chunk.kind, chunk.text, origin)
+
+    def refuse(self, origin: str, why: str) -> None:
+        """Tell the primary clients that script text from ``origin`` was not run, and
+        ``why`` (as a runtime exception without a line, as :meth:`submit` does for a
+        program without ``end``)."""
+        self._publish(ControllerMessage(self.now(), "runtime_exception", f"{origin}: {why}"))
 
     def submit_chunk(self, kind: str, text: str, origin: str) -> None:
         """One framed program (``kind`` ``"def"``, ``"sec"`` or ``"bare"``). It is parsed

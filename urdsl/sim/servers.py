@@ -469,6 +469,14 @@ class SimServers:
         self._clients.discard(client)
         if reason:
             self.dropped.append((client.kind, reason))
+        if client.framer is not None and client.framer.pending and \
+                not self._closing.is_set():
+            # a program cut off (the client closed or reset the connection before its
+            # 'end' line, or was dropped): say so, rather than nothing ever happening
+            how = "was reset" if reason == "connection error" else "ended"
+            self.sim.refuse(f"<{client.kind} {self.ports.get(client.kind, 0)}>",
+                            f"the connection {how} before the program's 'end' line "
+                            "arrived; it was not run")
         if client.kind == "rtde" and client.session is not None:
             try:
                 client.session.close()
