@@ -32,7 +32,7 @@ test: $(TSTAMP)
 FUZZ_SECONDS ?= 60
 FUZZ_SEED ?= 14
 fuzz: $(TSTAMP)
-	URDSL_FUZZ_SECONDS=$(FUZZ_SECONDS) URDSL_FUZZ_SEED=$(FUZZ_SEED) $(PY) -m pytest -q tests/test_fuzz_*.py
+	URDSL_FUZZ_SECONDS=$(FUZZ_SECONDS) URDSL_FUZZ_SEED=$(FUZZ_SEED) $(PY) -m pytest -q -s tests/test_fuzz_*.py
 
 bench: $(TSTAMP)
 	$(PY) bench/parse_bench.py

@@ -593,7 +593,8 @@ class VirtualController:
                     self._program_state = ProgramState.STOPPED
             job.module = None
             del job
-            self._collect()
+            if not self._closing.is_set():  # closing: leave it to the process's collector
+                self._collect()
 
     def _collect(self) -> None:
         """Free the finished program. Its tree and the interpreter's closures hold reference
@@ -602,7 +603,15 @@ class VirtualController:
         automatic collections almost never scan: without a full collection here every
         program stayed in memory (+17,000 objects per 200 lines). The collection walks the
         live objects plus the garbage, about as long as freeing the program costs anyway
-        (~50 ms per 1,000 lines on one core), once per program and never while one runs."""
+        (~50 ms per 1,000 lines on one core), once per program and never while one runs;
+        the clock waits meanwhile (Python's collector holds the interpreter lock), so a client
+        may see late packets right after a long program ends. It starts once a controller
+        step has published the program's end, so that clients see the stop on time."""
+        ended = self.now()
+        try:
+            self.wait_snapshot(lambda snap: snap.time >= ended, timeout=0.2)
+        except TimeoutError:
+            pass
         gc.collect()
 
     def _run_job(self, job: _Job) -> None:

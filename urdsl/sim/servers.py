@@ -28,7 +28,6 @@ import selectors
 import socket
 import threading
 import time
-from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
@@ -141,7 +140,8 @@ class SimServers:
         self.owners = InputOwners()
         # (interface, reason) of the latest drops, for tests and logs; bounded, as a
         # controller runs for months and hostile clients may be dropped by the million
-        self.dropped: deque[tuple[str, str]] = deque(maxlen=DROPS_KEPT)
+        # (a list, not a deque: readers in other threads may iterate while it grows)
+        self.dropped: list[tuple[str, str]] = []
         self._selector = selectors.DefaultSelector()
         self._listeners: list[_Listener] = []
         self._clients: set[_Client] = set()
@@ -341,7 +341,7 @@ class SimServers:
             if isinstance(data, _Client):
                 self._drop(data, f"internal error: {type(error).__name__}: {error}")
             else:
-                self.dropped.append((where, f"internal error: {type(error).__name__}"))
+                self._dropped((where, f"internal error: {type(error).__name__}"))
         except Exception:  # noqa: BLE001 - the loop must go on whatever happens
             pass
 
@@ -362,7 +362,7 @@ class SimServers:
                 return
             if sum(1 for c in self._clients if c.kind == listener.kind) >= MAX_CLIENTS:
                 sock.close()
-                self.dropped.append((listener.kind, "too many clients"))
+                self._dropped((listener.kind, "too many clients"))
                 continue
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -462,13 +462,18 @@ class SimServers:
             except (KeyError, ValueError, OSError):
                 pass
 
+    def _dropped(self, entry: tuple[str, str]) -> None:
+        self.dropped.append(entry)
+        if len(self.dropped) > DROPS_KEPT:
+            del self.dropped[:len(self.dropped) - DROPS_KEPT // 2]
+
     def _drop(self, client: _Client, reason: str) -> None:
         client.closed = True
         if client not in self._clients:
             return
         self._clients.discard(client)
         if reason:
-            self.dropped.append((client.kind, reason))
+            self._dropped((client.kind, reason))
         if client.framer is not None and client.framer.pending and \
                 not self._closing.is_set():
             # a program cut off (the client closed or reset the connection before its
