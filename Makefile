@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.urdsl-installed
 TSTAMP := $(VENV)/.urdsl-test-installed
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench fuzz clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -27,6 +27,12 @@ demo: $(STAMP)
 test: $(TSTAMP)
 	$(PY) -m ruff check urdsl tests bench programs grammar
 	$(PY) -m pytest -q
+
+# longer fuzzing: FUZZ_SECONDS per target (default 60), FUZZ_SEED to vary the inputs
+FUZZ_SECONDS ?= 60
+FUZZ_SEED ?= 14
+fuzz: $(TSTAMP)
+	URDSL_FUZZ_SECONDS=$(FUZZ_SECONDS) URDSL_FUZZ_SEED=$(FUZZ_SEED) $(PY) -m pytest -q -s tests/test_fuzz_*.py
 
 bench: $(TSTAMP)
 	$(PY) bench/parse_bench.py

@@ -283,3 +283,23 @@ def test_cli_syntax_error_is_shown_with_the_line(tmp_path, capsys):
     assert main(["send", str(path), "--host", LOOPBACK, "--no-check"]) == 1
     err = capsys.readouterr().err
     assert f"{path}:1:" in err and "^" in err
+
+
+def test_a_100000_line_program_sent_to_the_sim_runs():
+    """The sending connection used to close with the controller's states unread: the kernel
+    reset it, threw away what was still queued, and the sim never saw the program's end
+    ("no start was seen"; 20,000 and 50,000 lines happened to fit the socket buffers)."""
+    from urdsl.sim.controller import VirtualController
+    from urdsl.sim.servers import STANDARD_PORTS
+
+    lines = ["def big():", "  x = 0"] + ["  x = x + 1"] * 99_996 + \
+        ['  textmsg("big done ", x)', "end"]
+    text = "\n".join(lines) + "\n"
+    assert text.count("\n") == 100_000
+    with VirtualController(speed=10) as sim, \
+            sim.serve(ports={k: 0 for k in STANDARD_PORTS}) as servers:
+        result = send(text, LOOPBACK, servers.ports["secondary"], check=False, timeout=300,
+                      monitor_port=servers.ports["primary"])
+        assert result.status == "finished", result.summary()
+        assert "big done 99996" in result.messages
+        assert list(servers.dropped) == []

@@ -75,8 +75,9 @@ class PreparedProgram:
     @property
     def name(self) -> str:
         """Name of the program's ``def`` (``sec``), as the controller reports it."""
-        sent = parse(self.text, SENT_NAME)
-        for item in sent.body:
+        if self.wrapped:
+            return WRAPPER_NAME
+        for item in self.tree.body:  # printed as they are: no need to parse the text again
             if isinstance(item, (n.FunctionDef, n.SecDef)):
                 return item.name
         return WRAPPER_NAME

@@ -25,6 +25,8 @@ request) and :func:`run_program` (send and follow).
 from __future__ import annotations
 
 import re
+import socket
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -57,6 +59,21 @@ SCRIPT_PORTS = (30001, 30002, 30003)
 READ_BEFORE_CLOSE = 79
 """Bytes to read on a separate sending connection before closing it: UR's manual says a
 script sent on a socket closed at once may be discarded, and to read at least 79 bytes."""
+
+START_RATE = 50_000
+"""Bytes of program per second a controller is assumed to take in and compile at least:
+the wait for a sign of the start (:data:`START_WINDOW`) grows by one second per this many
+bytes (``urdsl sim`` takes 1.5 s for a 100,000-line program of 1.2 MB on an idle core, 6 s
+on a loaded one; a real controller is not faster). The wait ends at once when the start
+shows, and never outlasts the send's ``timeout``."""
+
+SEND_RATE = 1_000_000
+"""Bytes per second a link to the controller is assumed to carry at least: the bound on the
+wait for the controller to take a whole program before the sending connection closes."""
+
+ACK_GRACE = 0.5
+"""Seconds to keep a sending connection open after the controller acknowledged every byte
+(where the system tells, Linux), for it to read them and close first."""
 
 Checker = Callable[[n.Module, str, str], Any]
 """``checker(tree, filename, robot) -> report`` with ``report.has_errors`` and
@@ -324,12 +341,12 @@ def send_prepared(prepared: PreparedProgram, host: str, port: int = 30002, *,
             report("sent", f"sent {result.program!r} ({prepared.text.count(chr(10))} lines, "
                    f"{len(data)} bytes) to {sender.where}")
         if sender is not monitor:
-            _read_a_little(sender, min(connect_timeout, 1.0))
+            _finish_sending(sender, len(data), connect_timeout)
             sender.close()
         if follow:
             try:
-                follower.follow(timeout, START_WINDOW if start_timeout is None
-                                else start_timeout)
+                follower.follow(timeout, START_WINDOW + len(data) / START_RATE
+                                if start_timeout is None else start_timeout)
             except ConnectionLost as error:
                 raise ConnectionLost(f"the program was sent, but {error.message} while urdsl "
                                      "followed it", host=error.host, port=error.port,
@@ -342,18 +359,52 @@ def send_prepared(prepared: PreparedProgram, host: str, port: int = 30002, *,
     return result
 
 
-def _read_a_little(connection: Connection, timeout: float) -> None:
-    """Read at least :data:`READ_BEFORE_CLOSE` bytes or for ``timeout`` s, whichever first."""
-    deadline = time.monotonic() + timeout
+def _finish_sending(connection: Connection, size: int, timeout: float) -> None:
+    """End a connection that only sent a program (``size`` bytes) without losing any of it.
+
+    Closing a socket while bytes it received are unread makes the kernel reset the
+    connection: what is still queued for sending is thrown away, and the controller sees
+    a reset instead of the program's end (a 100,000-line program then never ran). So: mark
+    the end of the stream (half-close: the controller reads every byte, then the end), keep
+    reading and discarding what the controller sends (its version message and states, at
+    least :data:`READ_BEFORE_CLOSE` bytes as UR asks), and close only once the controller
+    closed its side, or every byte was acknowledged :data:`ACK_GRACE` s ago, or after
+    ``timeout`` s plus the time :data:`SEND_RATE` allows for ``size`` bytes."""
+    sock = connection.sock
+    try:
+        sock.shutdown(socket.SHUT_WR)
+    except OSError:
+        return  # the connection is gone already
+    deadline = time.monotonic() + timeout + size / SEND_RATE
     got = 0
-    while got < READ_BEFORE_CLOSE:
-        left = deadline - time.monotonic()
-        if left <= 0:
+    acknowledged_at: float | None = None
+    while True:
+        now = time.monotonic()
+        if now >= deadline:
             return
+        if got >= READ_BEFORE_CLOSE and _unacknowledged(sock) == 0:
+            acknowledged_at = acknowledged_at or now
+            if now - acknowledged_at >= ACK_GRACE:
+                return
         try:
-            got += len(connection.recv(left))
-        except (RobotTimeout, ConnectionLost):
-            return
+            got += len(connection.recv(min(deadline - now, 0.05)))
+        except RobotTimeout:
+            continue
+        except ConnectionLost:
+            return  # the controller closed its side: it has read everything
+
+
+def _unacknowledged(sock: socket.socket) -> int | None:
+    """Bytes sent on ``sock`` that the peer has not acknowledged yet (Linux: TIOCOUTQ), or
+    None where the system does not tell."""
+    try:
+        import fcntl
+        import termios
+
+        buffer = fcntl.ioctl(sock.fileno(), termios.TIOCOUTQ, b"\0\0\0\0")
+    except (ImportError, AttributeError, OSError):
+        return None
+    return int.from_bytes(buffer, sys.byteorder, signed=True)
 
 
 def _checked(tree: n.Module, filename: str, check: bool, robot: str,

@@ -65,11 +65,7 @@ class DashboardSession:
     # ---- commands --------------------------------------------------------------------------
 
     def _load(self, name: str) -> str:
-        if name.lower().endswith(".urp"):
-            try:
-                self.sim.load_program(name)
-            except (FileNotFoundError, SimError):
-                pass
+        if name.lower().endswith(".urp"):  # PolyScope programs: urdsl cannot run them
             return (f"File not found: {name}" if not self._exists(name)
                     else f"Error while loading program: {name}")
         try:
@@ -81,8 +77,9 @@ class DashboardSession:
         return f"Loading program: {loaded}"
 
     def _exists(self, name: str) -> bool:
-        folder = self.sim.programs_dir
-        return folder is not None and (folder / name).is_file()
+        # only files inside the programs folder count: a file elsewhere answers as a
+        # missing one, so the dashboard is no oracle for the controller's file system
+        return self.sim.program_path(name) is not None
 
     def _play(self) -> str:
         return "Starting program" if self.sim.play() else "Failed to execute: play"

@@ -34,6 +34,11 @@ PAUSE = 80                     # 'P'
 
 MAX_NAMES = 2048
 
+MAX_INPUT_RECIPES = 255
+"""Input recipes one connection may set up: the recipe id is one byte and 0 means refused.
+Further SETUP_INPUTS requests are answered with id 0 (refused), and the connection lives on.
+"""
+
 _CODES = {"BOOL": "?", "UINT8": "B", "UINT32": "I", "UINT64": "Q", "INT32": "i",
           "DOUBLE": "d", "VECTOR3D": "3d", "VECTOR6D": "6d", "VECTOR6INT32": "6i",
           "VECTOR6UINT32": "6I"}
@@ -321,6 +326,10 @@ class RtdeSession:
         names = self._names(payload)
         types = [INPUTS.get(n, "NOT_FOUND") for n in names]
         known = [n for n, t in zip(names, types, strict=True) if t != "NOT_FOUND"]
+        if self._next_id > MAX_INPUT_RECIPES:
+            # no id left: refused (id 0), as a recipe with an unknown field is; the
+            # connection and its earlier recipes live on
+            return package(SETUP_INPUTS, b"\x00" + ",".join(types).encode("ascii"))
         if known and len(known) == len(names):
             free = self.owners.claim(names, self)
             types = [t if ok else "IN_USE" for t, ok in zip(types, free, strict=True)]

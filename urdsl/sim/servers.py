@@ -23,6 +23,7 @@ A client that breaks a protocol's framing is dropped too; its neighbours do not 
 from __future__ import annotations
 
 import errno
+import logging
 import selectors
 import socket
 import threading
@@ -38,6 +39,8 @@ from .state import Snapshot
 
 __all__ = ["SimServers", "STANDARD_PORTS"]
 
+_log = logging.getLogger("urdsl.sim")
+
 STANDARD_PORTS = {
     "dashboard": 29999, "primary": 30001, "secondary": 30002, "realtime": 30003,
     "rtde": 30004, "primary_ro": 30011, "secondary_ro": 30012, "realtime_ro": 30013,
@@ -49,6 +52,9 @@ realtime packets at 500 Hz, or 10 s of RTDE with a 100-field recipe."""
 
 MAX_CLIENTS = 64
 """Connections per port; more are refused (closed at once)."""
+
+DROPS_KEPT = 1000
+"""Reasons of the latest dropped connections kept in :attr:`SimServers.dropped`."""
 
 STATE_PERIOD = 0.1
 """Primary/secondary robot state period (s of wall time): 10 Hz on CB3 and e-Series."""
@@ -132,7 +138,10 @@ class SimServers:
             self.requested[name] = port
         self.ports: dict[str, int] = {}
         self.owners = InputOwners()
-        self.dropped: list[tuple[str, str]] = []  # (interface, reason), for tests and logs
+        # (interface, reason) of the latest drops, for tests and logs; bounded, as a
+        # controller runs for months and hostile clients may be dropped by the million
+        # (a list, not a deque: readers in other threads may iterate while it grows)
+        self.dropped: list[tuple[str, str]] = []
         self._selector = selectors.DefaultSelector()
         self._listeners: list[_Listener] = []
         self._clients: set[_Client] = set()
@@ -260,8 +269,16 @@ class SimServers:
                 client.send(realtime)
             elif kind == "rtde":
                 session: RtdeSession = client.session
-                with client.session_lock:
-                    data = session.encode(snap) if session.output_due() else None
+                try:
+                    with client.session_lock:
+                        data = session.encode(snap) if session.output_due() else None
+                except Exception as error:  # noqa: BLE001 - this client's recipe: drop it
+                    _log.error("virtual controller: RTDE client dropped: %s: %s",
+                               type(error).__name__, error, exc_info=error)
+                    client.dropped_for = f"internal error: {type(error).__name__}: {error}"
+                    client.closed = True
+                    self._poke(client)
+                    continue
                 if data is not None:
                     client.send(data)
             elif kind != "dashboard" and state_due:
@@ -287,25 +304,46 @@ class SimServers:
                 break
             for key, mask in events:
                 data = key.data
-                if data is None:
-                    self._drain_wake()
-                elif isinstance(data, _Listener):
-                    self._accept(data)
-                else:
-                    if mask & selectors.EVENT_READ:
-                        self._read(data)
-                    if mask & selectors.EVENT_WRITE and not data.closed:
-                        self._flush(data)
+                try:
+                    if data is None:
+                        self._drain_wake()
+                    elif isinstance(data, _Listener):
+                        self._accept(data)
+                    else:
+                        if mask & selectors.EVENT_READ:
+                            self._read(data)
+                        if mask & selectors.EVENT_WRITE and not data.closed:
+                            self._flush(data)
+                except Exception as error:  # noqa: BLE001 - see _failed
+                    self._failed(data, error)
             with self._pending_lock:
                 pending = list(self._pending)
                 self._pending.clear()
                 self._woken = False
             for client in pending:
-                if client in self._clients:
-                    if client.closed:
-                        self._drop(client, client.dropped_for)
-                    else:
-                        self._flush(client)
+                try:
+                    if client in self._clients:
+                        if client.closed:
+                            self._drop(client, client.dropped_for)
+                        else:
+                            self._flush(client)
+                except Exception as error:  # noqa: BLE001 - see _failed
+                    self._failed(client, error)
+
+    def _failed(self, data: Any, error: Exception) -> None:
+        """An exception escaped a handler: a bug of urdsl that a client's input exposed.
+        Log it with its traceback, drop that client (its session may be half updated) and
+        keep serving everybody else. Never raises."""
+        where = data.kind if isinstance(data, (_Client, _Listener)) else "wake-up"
+        try:
+            _log.error("virtual controller: %s client dropped after an internal error: "
+                       "%s: %s", where, type(error).__name__, error, exc_info=error)
+            if isinstance(data, _Client):
+                self._drop(data, f"internal error: {type(error).__name__}: {error}")
+            else:
+                self._dropped((where, f"internal error: {type(error).__name__}"))
+        except Exception:  # noqa: BLE001 - the loop must go on whatever happens
+            pass
 
     def _drain_wake(self) -> None:
         try:
@@ -324,12 +362,16 @@ class SimServers:
                 return
             if sum(1 for c in self._clients if c.kind == listener.kind) >= MAX_CLIENTS:
                 sock.close()
-                self.dropped.append((listener.kind, "too many clients"))
+                self._dropped((listener.kind, "too many clients"))
                 continue
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             client = _Client(self, sock, listener.kind)
-            self._open(client)
+            try:
+                self._open(client)
+            except Exception as error:  # noqa: BLE001 - see _failed
+                self._failed(client, error)
+                sock.close()
 
     def _open(self, client: _Client) -> None:
         kind = client.kind
@@ -420,15 +462,31 @@ class SimServers:
             except (KeyError, ValueError, OSError):
                 pass
 
+    def _dropped(self, entry: tuple[str, str]) -> None:
+        self.dropped.append(entry)
+        if len(self.dropped) > DROPS_KEPT:
+            del self.dropped[:len(self.dropped) - DROPS_KEPT // 2]
+
     def _drop(self, client: _Client, reason: str) -> None:
         client.closed = True
         if client not in self._clients:
             return
         self._clients.discard(client)
         if reason:
-            self.dropped.append((client.kind, reason))
+            self._dropped((client.kind, reason))
+        if client.framer is not None and client.framer.pending and \
+                not self._closing.is_set():
+            # a program cut off (the client closed or reset the connection before its
+            # 'end' line, or was dropped): say so, rather than nothing ever happening
+            how = "was reset" if reason == "connection error" else "ended"
+            self.sim.refuse(f"<{client.kind} {self.ports.get(client.kind, 0)}>",
+                            f"the connection {how} before the program's 'end' line "
+                            "arrived; it was not run")
         if client.kind == "rtde" and client.session is not None:
-            client.session.close()
+            try:
+                client.session.close()
+            except Exception as error:  # noqa: BLE001 - the socket must still be closed
+                _log.error("virtual controller: closing an RTDE session failed: %s", error)
         try:
             self._selector.unregister(client.sock)
         except (KeyError, ValueError, OSError):
