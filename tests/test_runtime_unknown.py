@@ -241,3 +241,20 @@ def test_boolean_registers_go_up_to_127():
                  "b = read_input_boolean_register(127)\n")
     assert result.error is None and result.globals["a"] is True
     assert type(result.globals["b"]) is Unknown
+
+
+def test_a_force_sensor_loop_ends_where_contact_would_end_it():
+    # press down until the force sensor reads 50 N: offline nothing touches the part, so a
+    # modelled force of 0 N would drive the arm through the table and out of reach
+    from urdsl.verify.run import check_text
+
+    report = check_text(
+        "movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])\n"
+        "while force() < 50:\n"
+        "  movel(pose_add(get_actual_tcp_pose(), p[0, 0, -0.0005, 0, 0, 0]))\n"
+        "end\n"
+        "done = 1\n", "press.script")
+    assert not report.has_errors, report.render_text()
+    assert [f.span.line for f in report.findings if f.code == "URS210"] == [2]
+    assert "force() at line 2" in report.findings[0].message
+    assert len([m for m in report.moves if m.kind == "movel"]) == UNKNOWN_LOOP_PASSES

@@ -8,6 +8,8 @@ reads from outside the controller is an :class:`~urdsl.runtime.values.Unknown`:
   conveyor ticks;
 * digital and analog inputs (standard, configurable, tool) and the RTDE input registers
   (``read_input_*_register``);
+* what the arm's sensors measure of the world: forces (``force``, ``get_tcp_force``), joint
+  torques, tool current, temperatures;
 * the operator's answers (``request_*_from_primary_client``).
 
 What stays known: the program's own variables, outputs and output registers it wrote itself,
@@ -69,6 +71,9 @@ DEVICE_READS = frozenset({
     "modbus_get_signal_status", "modbus_get_error", "modbus_get_time_since_signal_invalid",
     "read_port_bit", "read_port_register", "get_euromap_input",
     "get_conveyor_tick_count", "tool_contact",
+    # what the arm's sensors measure of the world: contact forces and what follows from them
+    "force", "get_tcp_force", "get_joint_torques", "get_tool_current",
+    "get_controller_temp", "get_joint_temp", "get_tool_temp",
 })
 """Builtins whose result comes from outside the controller (unknown offline)."""
 
