@@ -84,6 +84,9 @@ class Installation:
     active_payload: str | None = None
     mounting: tuple[float, float] | None = None
     version: str | None = None
+    io_names: tuple[tuple[str, str], ...] = ()
+    """The I/O names the user gave: (name, pin) pairs, pin as PolyScope refers to it
+    (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``)."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -195,7 +198,32 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
     if element is not None and element.get("major") is not None:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
-                        mounting, version)
+                        mounting, version, _io_names(root))
+
+
+_IO_BANKS = {
+    "DigitalInputNames": "digital_in", "DigitalOutputNames": "digital_out",
+    "ConfigurableInputNames": "configurable_in", "ConfigurableOutputNames": "configurable_out",
+    "ToolDigitalInputNames": "tool_in", "ToolDigitalOutputNames": "tool_out",
+    "AnalogInputNames": "analog_in", "AnalogOutputNames": "analog_out",
+    "ToolAnalogInputNames": "tool_analog_in",
+}
+"""``<IOs>`` name lists (comma-separated, empty for an unnamed pin) and the pins they name."""
+
+
+def _io_names(root: ElementTree.Element) -> tuple[tuple[str, str], ...]:
+    names: list[tuple[str, str]] = []
+    ios = root.find("IOs")
+    if ios is None:
+        return ()
+    for tag, bank in _IO_BANKS.items():
+        element = ios.find(tag)
+        if element is None:
+            continue
+        for index, name in enumerate((element.get("value") or "").split(",")):
+            if name.strip():
+                names.append((name.strip(), f"{bank}[{index}]"))
+    return tuple(names)
 
 
 def _legacy(root: ElementTree.Element, path: str) -> Installation:

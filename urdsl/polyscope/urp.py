@@ -161,6 +161,8 @@ class Program:
     threads: list[Node] = field(default_factory=list)
     subprograms: list[Node] = field(default_factory=list)
     others: list[Node] = field(default_factory=list)
+    top: list[Node] = field(default_factory=list)
+    """Every top-level node in the order the file lists them (PolyScope numbers them so)."""
 
     @property
     def major_version(self) -> int | None:
@@ -268,6 +270,7 @@ class _Reader:
         threads: list[Node] = []
         subs: list[Node] = []
         others: list[Node] = []
+        top: list[Node] = []
         for element in children:
             target = self.resolve(element)
             node = self.node(target, None)
@@ -285,13 +288,14 @@ class _Reader:
                 subs.append(node)
             else:
                 others.append(node)
+            top.append(node)
         if main is None:
             raise UrpError(f"{self.path}: error: the program has no <MainProgram> (Robot "
                            "Program) node")
         return Program(self.path, root.get("name", Path(self.path).stem),
                        root.get("installation"), root.get("createdIn"),
                        root.get("lastSavedIn"), kinematics, main, before, init, threads, subs,
-                       others)
+                       others, top)
 
     def node(self, element: ElementTree.Element, parent: Node | None) -> Node:
         element = self.resolve(element)

@@ -1,0 +1,239 @@
+"""Benchmark: compile real PolyScope programs (.urp) and compare with the .script PolyScope
+wrote beside them.
+
+Pairs are listed in ``bench/polyscope/pairs.tsv`` (repository, commit, .urp path, .script path,
+licence, split). Files are read from local git directories (``--repos DIR`` holding
+``owner+name`` git dirs, as ``fetch`` leaves them: ``DIR/owner+name/repo`` or a bare git dir
+``DIR/owner+name``); nothing is downloaded. The installation the program names is read from
+the same folder when it is there.
+
+Both scripts are parsed and printed canonically, statement by statement: comments and URCap
+blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare to
+1e-9, PolyScope's generated ids (``_3f89b84f_1daa_...``) are masked, and ``$`` markers
+compare by number and flag (their label text is in the language PolyScope ran in, which the
+.urp does not record). Two views: the whole program, and the program part (the top-level
+statements from the first waypoint global, definition or marker on: what the program tree,
+not the installation, generates).
+
+Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back),
+the share of programs exact, the mean share of matching lines and the node types whose lines
+differ most. ``--show N`` prints the first differing lines of N programs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import difflib
+import re
+import subprocess
+import sys
+from pathlib import Path, PurePosixPath
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from urdsl.polyscope.compile import CompileError, compile_program  # noqa: E402
+from urdsl.polyscope.installation import InstallationError, parse_installation  # noqa: E402
+from urdsl.polyscope.urp import UrpError, parse_urp  # noqa: E402
+from urdsl.script import parse  # noqa: E402
+from urdsl.script.diagnostics import ScriptError  # noqa: E402
+from urdsl.script.nodes import (  # noqa: E402
+    Comment,
+    Declare,
+    FunctionDef,
+    Marker,
+    Module,
+    ThreadDef,
+)
+from urdsl.script.printer import format as print_tree  # noqa: E402
+
+_ID = re.compile(r"_[0-9a-f]{8}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{12}")
+_NUMBER = re.compile(r"(?<![\w.])(\d+\.\d*|\.\d+|\d+)(e-?\d+)?(?![\w.])", re.IGNORECASE)
+_MARKER = re.compile(r'^(\s*)\$ (\d+) "(?:[^"]*)"(.*)$')
+
+
+def git_dir(repos: Path, repo: str) -> Path:
+    base = repos / repo.replace("/", "+")
+    return base / "repo" if (base / "repo").exists() else base
+
+
+def git_show(gitdir: Path, commit: str, path: str) -> bytes | None:
+    result = subprocess.run(["git", f"--git-dir={gitdir}", "show", f"{commit}:{path}"],
+                            capture_output=True)
+    return result.stdout if result.returncode == 0 else None
+
+
+def _strip_urcap(items: tuple) -> list:
+    out, depth = [], 0
+    for item in items:
+        if isinstance(item, Comment):
+            text = item.text.lstrip("#").strip()
+            if text.startswith("begin: URCap"):
+                depth += 1
+            elif text.startswith("end: URCap"):
+                depth = max(0, depth - 1)
+            continue
+        if depth == 0:
+            out.append(item)
+    return out
+
+
+def _clean(module: Module) -> Module:
+    """The module with comments and URCap blocks left out, at every level."""
+    def block(items):
+        kept = []
+        for item in _strip_urcap(items):
+            kept.append(_clean_node(item))
+        return tuple(kept)
+
+    def _clean_node(node):
+        from dataclasses import fields, replace
+        changes = {}
+        for f in fields(node):
+            value = getattr(node, f.name)
+            if f.name in ("body", "orelse") and isinstance(value, tuple):
+                changes[f.name] = block(value)
+            elif f.name == "elifs":
+                changes[f.name] = tuple(replace(e, body=block(e.body)) for e in value)
+        return replace(node, **changes) if changes else node
+
+    return Module(block(module.body))
+
+
+def _number(match: re.Match) -> str:
+    value = float(match.group(0))
+    return f"{round(value, 9):.9f}".rstrip("0").rstrip(".") or "0"
+
+
+def canonical_lines(module: Module) -> list[str]:
+    """Canonical lines of a cleaned module: printed, ids masked, numbers rounded to 1e-9,
+    marker labels masked."""
+    text = print_tree(module)
+    lines = []
+    for line in text.splitlines():
+        if not line.strip():
+            continue
+        line = _ID.sub("_ID", line)
+        marker = _MARKER.match(line)
+        if marker:
+            line = f"{marker.group(1)}$ {marker.group(2)}{marker.group(3)}"
+        else:
+            line = _NUMBER.sub(_number, line)
+        lines.append(line)
+    return lines
+
+
+def program_part(module: Module) -> Module:
+    """The top-level statements of the program's def from the first waypoint global,
+    definition or marker on."""
+    body = module.body
+    if len(body) == 1 and isinstance(body[0], FunctionDef):
+        items = body[0].body
+        for index, item in enumerate(items):
+            if isinstance(item, Marker) or (
+                    isinstance(item, (FunctionDef, ThreadDef)) and not _ID.search(item.name)) \
+                    or (isinstance(item, Declare) and re.search(r"_[pq]$", item.name)):
+                return Module(items[index:])
+        return Module(())
+    return module
+
+
+def compare(ours: list[str], theirs: list[str]) -> float:
+    if not ours and not theirs:
+        return 1.0
+    matcher = difflib.SequenceMatcher(a=theirs, b=ours, autojunk=False)
+    same = sum(block.size for block in matcher.get_matching_blocks())
+    return same / max(len(theirs), len(ours))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--repos", type=Path, default=Path("/work/.mirror"),
+                        help="folder of owner+name git dirs")
+    parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
+    parser.add_argument("--split", choices=("tune", "held", "all"), default="all")
+    parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
+    parser.add_argument("--only", default="", help="only pairs whose .urp path contains this")
+    args = parser.parse_args(argv)
+
+    rows = [line.rstrip("\n").split("\t") for line in args.pairs.read_text().splitlines()
+            if line and not line.startswith("#")]
+    stats: dict[str, dict] = {}
+    shown = 0
+    for repo, commit, urp_path, script_path, _licence, split in rows:
+        if args.split != "all" and split != args.split:
+            continue
+        if args.only and args.only not in urp_path:
+            continue
+        st = stats.setdefault(split, {"n": 0, "exact": 0, "exact_prog": 0, "share": 0.0,
+                                      "share_prog": 0.0, "errors": collections.Counter(),
+                                      "kinds": collections.Counter(), "missing": 0})
+        gitdir = git_dir(args.repos, repo)
+        urp = git_show(gitdir, commit, urp_path)
+        script = git_show(gitdir, commit, script_path)
+        if urp is None or script is None:
+            st["missing"] += 1
+            continue
+        st["n"] += 1
+        try:
+            theirs_tree = _clean(parse(script.decode("utf-8", "replace"), script_path))
+        except ScriptError:
+            st["errors"]["reference does not parse"] += 1
+            continue
+        try:
+            program = parse_urp(urp, urp_path)
+            installation = None
+            if program.installation:
+                folder = PurePosixPath(urp_path).parent
+                data = git_show(gitdir, commit, str(folder / f"{program.installation}"
+                                                             ".installation"))
+                if data is not None:
+                    try:
+                        installation = parse_installation(data, program.installation)
+                    except InstallationError:
+                        installation = None
+            compiled = compile_program(program, installation)
+            ours_tree = _clean(compiled.module)
+        except (UrpError, CompileError) as error:
+            st["errors"][str(error).split("error: ", 1)[-1][:60]] += 1
+            continue
+        theirs = canonical_lines(theirs_tree)
+        ours = canonical_lines(ours_tree)
+        theirs_prog = canonical_lines(program_part(theirs_tree))
+        ours_prog = canonical_lines(program_part(ours_tree))
+        share = compare(ours, theirs)
+        share_prog = compare(ours_prog, theirs_prog)
+        st["share"] += share
+        st["share_prog"] += share_prog
+        st["exact"] += ours == theirs
+        st["exact_prog"] += ours_prog == theirs_prog
+        if ours_prog != theirs_prog:
+            for kind in compiled.kinds_in_diff(ours_prog, theirs_prog):
+                st["kinds"][kind] += 1
+            if shown < args.show:
+                shown += 1
+                print(f"==== {repo} {urp_path} ({share_prog:.0%})")
+                diff = difflib.unified_diff(theirs_prog, ours_prog, "polyscope", "urdsl",
+                                            n=1, lineterm="")
+                for number, line in enumerate(diff):
+                    if number > 40:
+                        break
+                    print(line[:160])
+    for split, st in sorted(stats.items(), reverse=True):
+        n = max(st["n"], 1)
+        print(f"[{split}] {st['n']} programs ({st['missing']} missing): "
+              f"exact {st['exact'] / n:.1%} whole, {st['exact_prog'] / n:.1%} program part; "
+              f"mean matching lines {st['share'] / n:.1%} whole, "
+              f"{st['share_prog'] / n:.1%} program part")
+        if st["errors"]:
+            print("  not compiled: " + "; ".join(f"{k} ({v})" for k, v in
+                                                 st["errors"].most_common(5)))
+        print("  node types in differing lines: " + ", ".join(
+            f"{k} {v}" for k, v in st["kinds"].most_common(8)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,592 @@
+"""Compiling a PolyScope program tree to URScript as PolyScope does.
+
+:func:`compile_program` turns a :class:`~urdsl.polyscope.urp.Program` (and, when known, its
+:class:`~urdsl.polyscope.installation.Installation`) into a URScript syntax tree; the one
+printer (:mod:`urdsl.script.printer`) writes the text. Nothing here writes URScript text:
+statements PolyScope generates are built as tree nodes, and the code users typed into the
+program (expressions, script lines, script files) is parsed into tree nodes.
+
+What PolyScope generates, learned from programs saved by PolyScope 3.x and 5.x beside their
+``.script``:
+
+* ``def NAME():`` where NAME is the program name with every character that is not a letter,
+  digit or ``_`` removed; the installation's preamble; one ``global W_p=p[...]`` (the
+  waypoint's pose: forward kinematics of its joint angles with the arm's calibration and the
+  waypoint's TCP) and ``global W_q=[...]`` per fixed waypoint; subprogram ``def``s; the
+  BeforeStart sequence; threads; then the Robot Program, inside ``while (True):`` unless it
+  runs only once.
+* Every program node gets a ``$ N "label"`` marker. N counts the nodes in program order:
+  BeforeStart, the Robot Program, then threads and subprograms in the order the file lists
+  them; a subprogram's nodes are counted with the subprogram, not at its calls.
+* URCap nodes become a block ``# begin: URCap Program Node`` / ``# end: URCap Program Node``
+  with ``#   Source: ...`` and ``#   Type: ...`` comments: their code only the URCap can
+  generate, so the block holds no statements.
+
+Marker labels are the English ones; PolyScope writes them in the language it runs in.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..script import parse
+from ..script.build import literal
+from ..script.diagnostics import ScriptError
+from ..script.nodes import (
+    Assign,
+    BinOp,
+    Bool,
+    Call,
+    Comment,
+    Declare,
+    Expr,
+    ExprStmt,
+    FunctionDef,
+    Halt,
+    If,
+    Item,
+    Keyword,
+    List,
+    Marker,
+    Module,
+    Name,
+    Number,
+    Paren,
+    Pose,
+    Run,
+    String,
+    ThreadDef,
+    While,
+)
+from ..script.printer import format as print_tree
+from .installation import Installation
+from .urp import Kinematics, Node, Program
+
+__all__ = ["CompileError", "Compiled", "compile_program", "waypoint_pose"]
+
+
+class CompileError(Exception):
+    """A program node that cannot be compiled; the message names the file and node path."""
+
+
+@dataclass
+class Compiled:
+    """The result: ``module`` (the URScript tree) and ``numbers`` (marker number → node)."""
+
+    module: Module
+    numbers: dict[int, Node] = field(default_factory=dict)
+
+    @property
+    def text(self) -> str:
+        """The URScript text, printed by the one printer."""
+        return print_tree(self.module)
+
+    def kinds_in_diff(self, ours: list[str], theirs: list[str]) -> list[str]:
+        """Node kinds owning the lines of ``ours`` that differ from ``theirs`` (both lists of
+        printed lines; a line belongs to the nearest marker above it)."""
+        import difflib
+
+        owner: list[str] = []
+        current = "preamble"
+        for line in ours:
+            match = re.match(r"\s*\$ (\d+)", line)
+            if match:
+                node = self.numbers.get(int(match.group(1)))
+                current = node.kind if node is not None else "?"
+            owner.append(current)
+        kinds = set()
+        matcher = difflib.SequenceMatcher(a=theirs, b=ours, autojunk=False)
+        for tag, _i1, _i2, j1, j2 in matcher.get_opcodes():
+            if tag == "equal":
+                continue
+            for index in range(max(0, j1 - (j1 == j2)), max(j2, j1 + 1)):
+                if index < len(owner):
+                    kinds.add(owner[index])
+        return sorted(kinds)
+
+
+# ---- waypoint poses ------------------------------------------------------------------------
+
+
+def _dh(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
+    ct, st, ca, sa = math.cos(theta), math.sin(theta), math.cos(alpha), math.sin(alpha)
+    return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
+                     [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]])
+
+
+def _rotvec_to_matrix(rv) -> np.ndarray:
+    rv = np.asarray(rv, dtype=float)
+    angle = float(np.linalg.norm(rv))
+    if angle < 1e-300:
+        return np.eye(3)
+    k = rv / angle
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
+
+
+def _matrix_to_rotvec(m: np.ndarray) -> np.ndarray:
+    """Rotation vector of a rotation matrix, angle in [0, π] (as the controller's
+    ``rotmat2rotvec``)."""
+    cos = max(-1.0, min(1.0, (np.trace(m) - 1.0) / 2.0))
+    angle = math.acos(cos)
+    axis = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+    sin2 = np.linalg.norm(axis)
+    if angle < 1e-12:
+        return np.zeros(3)
+    if math.pi - angle < 1e-6:
+        # near π the antisymmetric part vanishes: take the axis from the symmetric part
+        b = (m + np.eye(3)) / 2.0
+        column = int(np.argmax(np.diag(b)))
+        axis = b[:, column] / math.sqrt(b[column, column])
+        if sin2 > 1e-300:  # keep the sign the antisymmetric part still shows
+            anti = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+            if float(anti @ axis) < 0:
+                axis = -axis
+        return axis * angle
+    return axis / sin2 * angle
+
+
+def waypoint_pose(q, tcp, kinematics: Kinematics) -> tuple[float, ...]:
+    """The TCP pose (x, y, z in m, rotation vector in rad, in the base frame) of joint angles
+    ``q`` (rad) with TCP offset ``tcp`` on the arm described by ``kinematics`` (standard DH;
+    ``delta_theta`` added to each joint angle)."""
+    transform = np.eye(4)
+    for i in range(6):
+        transform = transform @ _dh(q[i] + kinematics.delta_theta[i], kinematics.d[i],
+                                    kinematics.a[i], kinematics.alpha[i])
+    tool = np.eye(4)
+    tool[:3, :3] = _rotvec_to_matrix(tcp[3:])
+    tool[:3, 3] = tcp[:3]
+    transform = transform @ tool
+    rv = _matrix_to_rotvec(transform[:3, :3])
+    return tuple(float(x) for x in transform[:3, 3]) + tuple(float(x) for x in rv)
+
+
+# ---- the compiler --------------------------------------------------------------------------
+
+_PIN = re.compile(r"^([a-z_]+)\[(\d+)\]$")
+_SET_FUNCTIONS = {
+    "digital_out": "set_standard_digital_out", "configurable_out": "set_configurable_digital_out",
+    "tool_out": "set_tool_digital_out", "analog_out": "set_standard_analog_out",
+    "config_out": "set_configurable_digital_out",
+}
+_GET_FUNCTIONS = {
+    "digital_in": "get_standard_digital_in", "digital_out": "get_standard_digital_out",
+    "configurable_in": "get_configurable_digital_in", "config_in": "get_configurable_digital_in",
+    "configurable_out": "get_configurable_digital_out",
+    "config_out": "get_configurable_digital_out",
+    "tool_in": "get_tool_digital_in", "tool_out": "get_tool_digital_out",
+    "analog_in": "get_standard_analog_in", "tool_analog_in": "get_tool_analog_in",
+    "analog_out": "get_standard_analog_out",
+}
+_POPUP_TITLES = {"Message": "Message", "Warning": "Warning", "Error": "Error"}
+
+
+def _call(name: str, *args: Expr, **keywords: Expr) -> Call:
+    return Call(Name(name), tuple(args), tuple(Keyword(k, v) for k, v in keywords.items()))
+
+
+def _stmt(name: str, *args: Expr, **keywords: Expr) -> ExprStmt:
+    return ExprStmt(_call(name, *args, **keywords))
+
+
+def _num(value: float) -> Expr:
+    return literal(float(value))
+
+
+def compile_program(program: Program, installation: Installation | None = None) -> Compiled:
+    """Compile ``program`` as PolyScope does. Raises :class:`CompileError` naming the file
+    and node for a node it cannot compile."""
+    return _Compiler(program, installation).run()
+
+
+class _Compiler:
+    def __init__(self, program: Program, installation: Installation | None) -> None:
+        self.program = program
+        self.installation = installation
+        self.numbers: dict[int, Node] = {}
+        self.number_of: dict[int, int] = {}
+        self.waypoints: dict[str, Node] = {}
+        self.counter = 0
+        self.pins = dict(getattr(installation, "io_names", ()) or ())
+        self.version = program.major_version or 5
+
+    # -- numbering
+    def _number_tree(self, node: Node) -> None:
+        stack = [node]
+        while stack:
+            current = stack.pop()
+            if current.suppressed:
+                continue
+            self.counter += 1
+            self.number_of[id(current)] = self.counter
+            self.numbers[self.counter] = current
+            if current.kind == "CallSubProgram" or current.kind == "Contributed":
+                continue
+            stack.extend(reversed(current.children))
+
+    def number(self, node: Node) -> int:
+        return self.number_of.get(id(node), 0)
+
+    def run(self) -> Compiled:
+        program = self.program
+        for node in program.top:
+            self._number_tree(node)
+        body: list[Item] = []
+        body.extend(self.preamble())
+        for node in self._all_nodes():
+            if node.kind == "Waypoint" and node.fields.get("type") == "Fixed":
+                self.waypoints.setdefault(node.name or "Waypoint", node)
+        body.extend(self.waypoint_globals())
+        for sub in program.subprograms:
+            body.extend(self.subprogram(sub))
+        if program.before_start is not None:
+            body.extend(self.node(program.before_start))
+        for thread in program.threads:
+            body.extend(self.thread(thread))
+        main = self.node(program.main)
+        if program.main.attrs.get("runOnlyOnce") == "true":
+            body.extend(main)
+        else:
+            body.append(While(Paren(Bool(True)), tuple(main)))
+        name = re.sub(r"[^A-Za-z0-9_]", "", program.name) or "program"
+        if name[0].isdigit():
+            name = "_" + name
+        return Compiled(Module((FunctionDef(name, (), tuple(body)),)), self.numbers)
+
+    def _all_nodes(self):
+        roots = [self.program.before_start, self.program.main, *self.program.threads,
+                 *self.program.subprograms]
+        for root in roots:
+            if root is not None:
+                for node in root.walk():
+                    if not node.suppressed:
+                        yield node
+
+    # -- errors and user code
+    def error(self, node: Node, message: str) -> CompileError:
+        return CompileError(f"{self.program.path}: error: node {node.path}: {message}")
+
+    def expr(self, text: str, node: Node) -> Expr:
+        try:
+            module = parse(text, self.program.path)
+        except ScriptError as error:
+            raise self.error(node, f"the expression {text.strip()!r} is not URScript "
+                                   f"({str(error).splitlines()[0]})") from None
+        items = [item for item in module.body if not isinstance(item, Comment)]
+        if len(items) != 1 or not isinstance(items[0], ExprStmt):
+            raise self.error(node, f"{text.strip()!r} is not one expression")
+        return items[0].expr
+
+    def code(self, text: str, node: Node) -> list[Item]:
+        try:
+            module = parse(text, self.program.path)
+        except ScriptError as error:
+            raise self.error(node, f"the script code is not URScript "
+                                   f"({str(error).splitlines()[0]})") from None
+        return list(module.body)
+
+    def marker(self, node: Node, label: str, flag: str | None = None) -> Marker:
+        return Marker(self.number(node), label.replace('"', "'"), flag)
+
+    # -- preamble
+    def preamble(self) -> list[Item]:
+        return []
+
+    def waypoint_globals(self) -> list[Item]:
+        items: list[Item] = []
+        if self.version < 5:
+            return items
+        for name, node in self.waypoints.items():
+            q = node.fields.get("q")
+            if not q:
+                continue
+            pose = self.pose_of(node)
+            if pose is None:
+                continue
+            items.append(Declare("global", f"{name}_p", Pose(tuple(_num(v) for v in pose))))
+            items.append(Declare("global", f"{name}_q", List(tuple(_num(v) for v in q))))
+        return items
+
+    def pose_of(self, node: Node) -> tuple[float, ...] | None:
+        q = node.fields.get("q")
+        tcp = node.fields.get("tcp_offset") or (0.0,) * 6
+        kinematics = node.fields.get("kinematics") or self.program.kinematics
+        if not q or kinematics is None:
+            return None
+        return waypoint_pose(q, tcp, kinematics)
+
+    # -- nodes
+    def block(self, nodes: list[Node]) -> list[Item]:
+        items: list[Item] = []
+        index = 0
+        while index < len(nodes):
+            node = nodes[index]
+            if node.suppressed:
+                index += 1
+                continue
+            if node.kind == "If" and node.fields.get("type") == "If":
+                chain = [node]
+                index += 1
+                while index < len(nodes) and nodes[index].kind == "If" and \
+                        nodes[index].fields.get("type") in ("ElseIf", "Else"):
+                    chain.append(nodes[index])
+                    index += 1
+                items.extend(self.if_chain(chain))
+                continue
+            items.extend(self.node(node))
+            index += 1
+        return items
+
+    def node(self, node: Node) -> list[Item]:
+        method = getattr(self, f"n_{node.kind}", None)
+        if method is None:
+            return self.n_unknown(node)
+        return method(node)
+
+    def n_unknown(self, node: Node) -> list[Item]:
+        return [self.marker(node, node.title), *self.block(node.children)]
+
+    def n_MainProgram(self, node: Node) -> list[Item]:
+        return [self.marker(node, "Robot Program"), *self.block(node.children)]
+
+    def n_SpecialSequence(self, node: Node) -> list[Item]:
+        return [self.marker(node, node.attrs.get("type", "BeforeStart")),
+                *self.block(node.children)]
+
+    def n_Folder(self, node: Node) -> list[Item]:
+        return [self.marker(node, node.name or "Folder"), *self.block(node.children)]
+
+    def n_Comment(self, node: Node) -> list[Item]:
+        text = str(node.fields.get("text", ""))
+        return [self.marker(node, text), Comment(f"# {text}")]
+
+    def n_Halt(self, node: Node) -> list[Item]:
+        return [self.marker(node, "Halt", "noBreak"), Halt()]
+
+    def n_Contributed(self, node: Node) -> list[Item]:
+        return [self.marker(node, node.title),
+                Comment("# begin: URCap Program Node"),
+                Comment(f"#   Source: {node.attrs.get('strategyURCapName', '?')}, "
+                        f"{node.attrs.get('strategyURCapDeveloper', '?')}"),
+                Comment(f"#   Type: {node.title}"),
+                Comment("# end: URCap Program Node")]
+
+    def n_Wait(self, node: Node) -> list[Item]:
+        kind = node.fields.get("type")
+        if kind == "Sleep":
+            seconds = node.fields.get("seconds", 0.0)
+            return [self.marker(node, f"Wait: {seconds}"), _stmt("sleep", _num(seconds))]
+        if kind == "DigitalInput":
+            pin = str(node.fields.get("pin"))
+            value = node.fields.get("digital") in ("1", "true", "True")
+            test = BinOp("==", self.pin_read(pin, node), Bool(value))
+            label = f"Wait {self.pin_label(pin)}={'HI' if value else 'LO'}"
+        elif kind == "Condition":
+            expression = node.fields["expression"]
+            test = self.expr(expression.script, node)
+            label = f"Wait {expression.label}"
+        else:
+            return self.n_unknown(node)
+        return [self.marker(node, label),
+                While(Paren(_call("not", Paren(test))), (_stmt("sync"),))]
+
+    def pin_label(self, pin: str) -> str:
+        for name, target in self.pins.items():
+            if target == pin:
+                return name
+        return pin
+
+    def resolve_pin(self, pin: str, node: Node) -> tuple[str, int]:
+        target = self.pins.get(pin, pin)
+        match = _PIN.match(target)
+        if not match:
+            raise self.error(node, f"the I/O {pin!r} is not named in the installation")
+        return match.group(1), int(match.group(2))
+
+    def pin_read(self, pin: str, node: Node) -> Expr:
+        kind, index = self.resolve_pin(pin, node)
+        function = _GET_FUNCTIONS.get(kind)
+        if function is None:
+            raise self.error(node, f"cannot read the I/O {pin!r}")
+        return _call(function, Number(index))
+
+    def n_Set(self, node: Node) -> list[Item]:
+        kind = node.fields.get("type")
+        if kind == "DigitalOutput":
+            pin = str(node.fields.get("pin"))
+            value = node.fields.get("digitalValue") in ("1", "true", "True")
+            bank, index = self.resolve_pin(pin, node)
+            function = _SET_FUNCTIONS.get(bank)
+            if function is None:
+                raise self.error(node, f"cannot set the I/O {pin!r}")
+            label = f"Set {self.pin_label(pin)}={'On' if value else 'Off'}"
+            return [self.marker(node, label), _stmt(function, Number(index), Bool(value))]
+        if kind == "AnalogOutput":
+            pin = str(node.fields.get("pin"))
+            bank, index = self.resolve_pin(pin, node)
+            value = float(str(node.fields.get("analogValue", "0")))
+            return [self.marker(node, f"Set {self.pin_label(pin)}={value}"),
+                    _stmt("set_standard_analog_out", Number(index), _num(value))]
+        if kind == "NoAction":
+            return [self.marker(node, "Set")]
+        return self.n_unknown(node)
+
+    def n_Assignment(self, node: Node) -> list[Item]:
+        expression = node.fields["expression"]
+        name = node.name or "var"
+        label = f"{name}≔{expression.label}"
+        return [self.marker(node, label),
+                Declare("global", name, self.expr(expression.script, node))]
+
+    def n_Script(self, node: Node) -> list[Item]:
+        kind = node.fields.get("type")
+        if kind == "Line":
+            expression = node.fields["expression"]
+            return [self.marker(node, expression.label), *self.code(expression.script, node)]
+        contents = str(node.fields.get("contents", ""))
+        if kind == "File":
+            file = str(node.fields.get("file", "")).rsplit("/", 1)[-1]
+            label = f"Script: {file}"
+        else:
+            label = "Script"
+        return [self.marker(node, label), *self.code(contents, node)]
+
+    def n_Popup(self, node: Node) -> list[Item]:
+        kind = str(node.fields.get("type", "Message"))
+        message = str(node.fields.get("message", ""))
+        halt = bool(node.fields.get("halt"))
+        title = _POPUP_TITLES.get(kind, kind)
+        items: list[Item] = [
+            self.marker(node, f"Popup: {message}"),
+            _stmt("popup", String(message.replace('"', "'")), String(title),
+                  Bool(kind == "Warning"), Bool(kind == "Error"), blocking=Bool(not halt))]
+        if halt:
+            items.append(Halt())
+        return items
+
+    def n_CallSubProgram(self, node: Node) -> list[Item]:
+        name = node.name or "subprogram"
+        return [self.marker(node, f"Call {name}"), _stmt(name)]
+
+    def subprogram(self, node: Node) -> list[Item]:
+        name = node.name or "subprogram"
+        body = [self.marker(node, name, "noBreak"), *self.block(node.children)]
+        return [FunctionDef(name, (), tuple(body))]
+
+    def thread(self, node: Node) -> list[Item]:
+        name = node.name or "Thread"
+        body = self.block(node.children)
+        if node.attrs.get("runOnlyOnce") != "true":
+            body = [While(Paren(Bool(True)), tuple(body))]
+        return [self.marker(node, name), ThreadDef(name, tuple(body)),
+                Assign(Name(f"threadId_{name}"), Run(name))]
+
+    def n_Loop(self, node: Node) -> list[Item]:
+        kind = node.fields.get("type")
+        body = self.block(node.children)
+        if kind == "Counting":
+            count = int(node.fields.get("count", 1))
+            variable = str(node.fields.get("variable") or f"Loop_{self.number(node)}")
+            return [self.marker(node, f"Loop {count} times"),
+                    Assign(Name(variable), Number(0)),
+                    While(Paren(BinOp("<", Name(variable), Number(count))),
+                          (*body, Assign(Name(variable),
+                                         BinOp("+", Name(variable), Number(1)))))]
+        if kind == "While":
+            expression = node.fields["expression"]
+            return [self.marker(node, f"Loop {expression.label}"),
+                    While(Paren(self.expr(expression.script, node)), tuple(body))]
+        return [self.marker(node, "Loop"), While(Paren(Bool(True)), tuple(body))]
+
+    def if_chain(self, chain: list[Node]) -> list[Item]:
+        head = chain[0]
+        expression = head.fields["expression"]
+        body = [self.marker(head, f"If {expression.label}"), ]
+        test = self.expr(expression.script, head)
+        inner = self.block(head.children)
+        orelse: tuple[Item, ...] | None = None
+        if len(chain) > 1:
+            nxt = chain[1]
+            if nxt.fields.get("type") == "Else":
+                orelse = (self.marker(nxt, "Else", "noBreak"), *self.block(nxt.children))
+            else:
+                rest = [Node(nxt.kind, nxt.attrs, nxt.children, nxt.name,
+                             {**nxt.fields, "type": "If"}, nxt.element, nxt.parent)]
+                self.number_of[id(rest[0])] = self.number(nxt)
+                orelse = tuple(self._elseif(nxt, rest[0], chain[2:]))
+        return [*body, If(Paren(test), tuple(inner), (), orelse)]
+
+    def _elseif(self, original: Node, copy: Node, rest: list[Node]) -> list[Item]:
+        items = self.if_chain([copy, *rest])
+        first = items[0]
+        assert isinstance(first, Marker)
+        expression = original.fields["expression"]
+        return [Marker(first.number, f"ElseIf {expression.label}".replace('"', "'")),
+                *items[1:]]
+
+    # -- moves
+    def n_Move(self, node: Node) -> list[Item]:
+        items: list[Item] = [self.marker(node, str(node.fields.get("motion_type", "Move")))]
+        items.extend(self.block(node.children))
+        return items
+
+    def move_of(self, node: Node) -> Node | None:
+        parent = node.parent
+        while parent is not None and parent.kind != "Move":
+            parent = parent.parent
+        return parent
+
+    def n_Waypoint(self, node: Node) -> list[Item]:
+        move = self.move_of(node)
+        name = node.name or "Waypoint"
+        kind = node.fields.get("type")
+        if move is None:
+            return [self.marker(node, name, "breakAfter")]
+        motion = str(move.fields.get("motion_type", "MoveJ"))
+        if kind == "Variable":
+            variable = str(node.fields.get("variable") or name)
+            target: Expr = Name(variable)
+            label = variable
+        elif kind == "Fixed":
+            label = name
+            if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
+                target = Name(f"{name}_q")
+            elif motion == "MoveJ":
+                target = _call("get_inverse_kin", Name(f"{name}_p"),
+                               qnear=Name(f"{name}_q"))
+            else:
+                target = Name(f"{name}_p")
+        else:
+            return [self.marker(node, name, "breakAfter")]
+        keywords = self.motion_keywords(move, node)
+        function = {"MoveJ": "movej", "MoveL": "movel", "MoveP": "movep"}.get(motion, "movel")
+        return [self.marker(node, label, "breakAfter"),
+                ExprStmt(Call(Name(function), (target,),
+                              tuple(Keyword(k, v) for k, v in keywords)))]
+
+    def motion_keywords(self, move: Node, waypoint: Node) -> list[tuple[str, Expr]]:
+        params = waypoint.fields.get("params") or {}
+        motion = move.fields.get("motion_type")
+        if "nextMotionTime" in params:
+            out = [("t", _num(params["nextMotionTime"]))]
+        else:
+            joint = motion == "MoveJ"
+            speed = params.get("jointSpeed" if joint else "cartesianSpeed",
+                               move.fields.get("speed"))
+            accel = params.get("jointAcceleration" if joint else "cartesianAcceleration",
+                               move.fields.get("acceleration"))
+            out = []
+            if accel is not None:
+                out.append(("a", _num(accel)))
+            if speed is not None:
+                out.append(("v", _num(speed)))
+        blend = params.get("blendRadius", move.fields.get("blend"))
+        if blend and blend > 0:
+            out.append(("r", _num(blend)))
+        return out
+
