@@ -197,7 +197,7 @@ def main(argv: list[str] | None = None) -> int:
             compiled = compile_program(program, installation)
             ours_tree = _clean(compiled.module)
         except (UrpError, CompileError) as error:
-            st["errors"][str(error).split("error: ", 1)[-1][:60]] += 1
+            st["errors"][str(error).split("error: ", 1)[-1][:150]] += 1
             continue
         theirs = canonical_lines(theirs_tree)
         ours = canonical_lines(ours_tree)

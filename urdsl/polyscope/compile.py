@@ -220,12 +220,10 @@ class _Compiler:
         stack = [node]
         while stack:
             current = stack.pop()
-            if current.suppressed:
-                continue
             self.counter += 1
             self.number_of[id(current)] = self.counter
             self.numbers[self.counter] = current
-            if current.kind == "CallSubProgram" or current.kind == "Contributed":
+            if current.kind == "CallSubProgram":
                 continue
             stack.extend(reversed(current.children))
 
@@ -238,10 +236,14 @@ class _Compiler:
             self._number_tree(node)
         body: list[Item] = []
         body.extend(self.preamble())
+        timers: list[str] = []
         for node in self._all_nodes():
-            if node.kind == "Waypoint" and node.fields.get("type") == "Fixed":
+            if node.kind == "Waypoint" and node.fields.get("type") in ("Fixed", "Relative"):
                 self.waypoints.setdefault(node.name or "Waypoint", node)
+            if node.kind == "Timer" and node.name and node.name not in timers:
+                timers.append(node.name)
         body.extend(self.waypoint_globals())
+        body.extend(self.timer_thread(timers))
         for sub in program.subprograms:
             body.extend(self.subprogram(sub))
         if program.before_start is not None:
@@ -308,14 +310,48 @@ class _Compiler:
             pose = self.pose_of(node)
             if pose is None:
                 continue
+            if node.fields.get("type") == "Relative":
+                start = self.pose_of(node, "from_")
+                if start is None:
+                    continue
+                items.append(Declare("global", f"{name}_from_p",
+                                     Pose(tuple(_num(v) for v in start))))
+                items.append(Declare("global", f"{name}_to_p",
+                                     Pose(tuple(_num(v) for v in pose))))
+                continue
             items.append(Declare("global", f"{name}_p", Pose(tuple(_num(v) for v in pose))))
             items.append(Declare("global", f"{name}_q", List(tuple(_num(v) for v in q))))
         return items
 
-    def pose_of(self, node: Node) -> tuple[float, ...] | None:
-        q = node.fields.get("q")
-        tcp = node.fields.get("tcp_offset") or (0.0,) * 6
-        kinematics = node.fields.get("kinematics") or self.program.kinematics
+    def timer_thread(self, timers: list[str]) -> list[Item]:
+        """The globals and the thread that count PolyScope's timers."""
+        if not timers:
+            return []
+        items: list[Item] = [Declare("global", f"{name}_is_counting", Bool(False))
+                             for name in timers]
+        body: list[Item] = [
+            If(Paren(Name(f"{name}_is_counting")),
+               (Assign(Name(name), BinOp("+", Name(name), _call("get_steptime"))),))
+            for name in timers]
+        body.append(_stmt("sync"))
+        items.append(ThreadDef("Timer_Thread", (While(Paren(Bool(True)), tuple(body)),)))
+        items.append(ExprStmt(Run("Timer_Thread")))
+        return items
+
+    def n_Timer(self, node: Node) -> list[Item]:
+        name = node.name or "timer"
+        action = str(node.fields.get("action", "Start"))
+        label = f"{name}: {action}"
+        if action == "Start":
+            return [self.marker(node, label), Assign(Name(f"{name}_is_counting"), Bool(True))]
+        if action == "Stop":
+            return [self.marker(node, label), Assign(Name(f"{name}_is_counting"), Bool(False))]
+        return [self.marker(node, label), Assign(Name(name), Number(0))]
+
+    def pose_of(self, node: Node, prefix: str = "") -> tuple[float, ...] | None:
+        q = node.fields.get(prefix + "q")
+        tcp = node.fields.get(prefix + "tcp_offset") or (0.0,) * 6
+        kinematics = node.fields.get(prefix + "kinematics") or self.program.kinematics
         if not q or kinematics is None:
             return None
         return waypoint_pose(q, tcp, kinematics)
@@ -561,6 +597,10 @@ class _Compiler:
                                qnear=Name(f"{name}_q"))
             else:
                 target = Name(f"{name}_p")
+        elif kind == "Relative":
+            label = name
+            target = _call("pose_add", _call("get_target_tcp_pose"),
+                           _call("pose_sub", Name(f"{name}_to_p"), Name(f"{name}_from_p")))
         else:
             return [self.marker(node, name, "breakAfter")]
         keywords = self.motion_keywords(move, node)

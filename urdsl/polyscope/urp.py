@@ -304,8 +304,17 @@ class _Reader:
             return known
         kind = element.tag
         suppressed = False
-        if kind == "SuppressedNode" or kind == "suppressedNode":
-            suppressed = True
+        if kind == "SuppressedNode":  # a suppressed node: the node itself is inside
+            inner = element.find("suppressedNode")
+            if inner is None:
+                raise UrpError(f"{self.path}: error: an empty <SuppressedNode> in "
+                               f"{parent.path if parent else 'the program'}")
+            node = self.node(inner, parent)
+            node.suppressed = True
+            self.nodes[element] = node
+            return node
+        if kind == "suppressedNode":
+            kind = element.get("class", "Unknown").rsplit(".", 1)[-1]
         if kind.endswith("MoveDirectionNode"):
             kind = "Direction"
         elif kind == "subprogram":
@@ -346,7 +355,8 @@ class _Reader:
     def _reference_part(self, piece: ElementTree.Element) -> tuple[str, str]:
         for inner in piece:
             target = self.resolve(inner)
-            name = target.get("name") or target.get("referencedName") or ""
+            name = (target.get("name") or target.get("featureName")
+                    or target.get("referencedName") or "")
             if piece.tag == "ExpressionIO":
                 return ("io", name or inner.get("referencedName", ""))
             if piece.tag == "ExpressionWaypoint":
@@ -420,6 +430,18 @@ def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None
         kin = position.find("Kinematics")
         if kin is not None:
             node.fields["kinematics"] = _kinematics(reader.resolve(kin))
+    relative = element.find("relativeFromPosition")
+    if relative is not None:
+        relative = reader.resolve(relative)
+        angles = relative.find("JointAngles")
+        if angles is not None:
+            node.fields["from_q"] = _floats(reader.resolve(angles).get("angles"))
+        offset = relative.find("TCPOffset")
+        if offset is not None:
+            node.fields["from_tcp_offset"] = _floats(reader.resolve(offset).get("pose"))
+        kin = relative.find("Kinematics")
+        if kin is not None:
+            node.fields["from_kinematics"] = _kinematics(reader.resolve(kin))
     base = element.find("BaseToFeature")
     if base is not None:
         node.fields["base_to_feature"] = _floats(reader.resolve(base).get("pose"))
@@ -502,6 +524,11 @@ def _comment(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["text"] = element.get("comment", "")
 
 
+def _timer(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["action"] = element.get("action", "Start")
+    node.name = reader.variable_name(element.find("variable"))
+
+
 def _subprogram(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     file = element.find("programFile")
     node.fields["file"] = (file.text or "").strip() if file is not None else None
@@ -518,5 +545,5 @@ def _call(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
 _FIELDS = {
     "Move": _move, "Waypoint": _waypoint, "Loop": _loop, "If": _if, "Wait": _wait,
     "Set": _set, "Assignment": _assignment, "Script": _script, "Popup": _popup,
-    "Comment": _comment, "SubProgram": _subprogram, "CallSubProgram": _call,
+    "Comment": _comment, "Timer": _timer, "SubProgram": _subprogram, "CallSubProgram": _call,
 }
