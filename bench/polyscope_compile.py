@@ -124,19 +124,33 @@ def canonical_lines(module: Module) -> list[str]:
     return lines
 
 
-def program_part(module: Module) -> Module:
-    """The top-level statements of the program's def from the first waypoint global,
-    definition or marker on."""
+def program_part(module: Module, waypoints: frozenset[str]) -> Module:
+    """The top-level statements of the program's def from the first global of a waypoint of
+    the program (``waypoints``: their names in the .urp), definition or marker on."""
     body = module.body
     if len(body) == 1 and isinstance(body[0], FunctionDef):
         items = body[0].body
         for index, item in enumerate(items):
             if isinstance(item, Marker) or (
                     isinstance(item, (FunctionDef, ThreadDef)) and not _ID.search(item.name)) \
-                    or (isinstance(item, Declare) and re.search(r"_[pq]$", item.name)):
+                    or (isinstance(item, Declare) and re.sub(r"(_from|_to)?_[pq]$", "", item.name)
+                        in waypoints and item.name != re.sub(r"_[pq]$", "", item.name)):
                 return Module(items[index:])
         return Module(())
     return module
+
+
+def _walk_items(module: Module):
+    stack = list(module.body)
+    while stack:
+        item = stack.pop()
+        yield item
+        for name in ("body", "orelse"):
+            value = getattr(item, name, None)
+            if isinstance(value, tuple):
+                stack.extend(value)
+        for elif_ in getattr(item, "elifs", ()) or ():
+            stack.extend(elif_.body)
 
 
 def compare(ours: list[str], theirs: list[str]) -> float:
@@ -169,7 +183,8 @@ def main(argv: list[str] | None = None) -> int:
             continue
         st = stats.setdefault(split, {"n": 0, "exact": 0, "exact_prog": 0, "share": 0.0,
                                       "share_prog": 0.0, "errors": collections.Counter(),
-                                      "kinds": collections.Counter(), "missing": 0})
+                                      "kinds": collections.Counter(), "missing": 0,
+                                      "not_polyscope": 0})
         gitdir = git_dir(args.repos, repo)
         urp = git_show(gitdir, commit, urp_path)
         script = git_show(gitdir, commit, script_path)
@@ -181,6 +196,10 @@ def main(argv: list[str] | None = None) -> int:
             theirs_tree = _clean(parse(script.decode("utf-8", "replace"), script_path))
         except ScriptError:
             st["errors"]["reference does not parse"] += 1
+            continue
+        if not any(isinstance(item, Marker) for item in _walk_items(theirs_tree)):
+            st["n"] -= 1
+            st["not_polyscope"] += 1
             continue
         try:
             program = parse_urp(urp, urp_path)
@@ -201,8 +220,10 @@ def main(argv: list[str] | None = None) -> int:
             continue
         theirs = canonical_lines(theirs_tree)
         ours = canonical_lines(ours_tree)
-        theirs_prog = canonical_lines(program_part(theirs_tree))
-        ours_prog = canonical_lines(program_part(ours_tree))
+        names = frozenset(node.name for root in program.top for node in root.walk()
+                          if node.kind == "Waypoint" and node.name)
+        theirs_prog = canonical_lines(program_part(theirs_tree, names))
+        ours_prog = canonical_lines(program_part(ours_tree, names))
         share = compare(ours, theirs)
         share_prog = compare(ours_prog, theirs_prog)
         st["share"] += share
@@ -223,7 +244,8 @@ def main(argv: list[str] | None = None) -> int:
                     print(line[:160])
     for split, st in sorted(stats.items(), reverse=True):
         n = max(st["n"], 1)
-        print(f"[{split}] {st['n']} programs ({st['missing']} missing): "
+        print(f"[{split}] {st['n']} programs ({st['missing']} missing, "
+              f"{st['not_polyscope']} .script not written by PolyScope: no $ markers): "
               f"exact {st['exact'] / n:.1%} whole, {st['exact_prog'] / n:.1%} program part; "
               f"mean matching lines {st['share'] / n:.1%} whole, "
               f"{st['share_prog'] / n:.1%} program part")

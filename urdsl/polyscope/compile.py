@@ -64,7 +64,7 @@ from ..script.nodes import (
 )
 from ..script.printer import format as print_tree
 from .installation import Installation
-from .urp import Kinematics, Node, Program
+from .urp import Expression, Kinematics, Node, Program
 
 __all__ = ["CompileError", "Compiled", "compile_program", "waypoint_pose"]
 
@@ -183,6 +183,8 @@ _GET_FUNCTIONS = {
     "analog_in": "get_standard_analog_in", "tool_analog_in": "get_tool_analog_in",
     "analog_out": "get_standard_analog_out",
 }
+_BASE_FEATURES = frozenset(("Joint_0_name", "Base", "base"))
+"""Names PolyScope gives the base frame in a move's feature reference."""
 _POPUP_TITLES = {"Message": "Message", "Warning": "Warning", "Error": "Error"}
 
 
@@ -264,10 +266,15 @@ class _Compiler:
         roots = [self.program.before_start, self.program.main, *self.program.threads,
                  *self.program.subprograms]
         for root in roots:
-            if root is not None:
-                for node in root.walk():
-                    if not node.suppressed:
-                        yield node
+            if root is None:
+                continue
+            stack = [root]
+            while stack:
+                node = stack.pop()
+                if node.suppressed:
+                    continue
+                yield node
+                stack.extend(reversed(node.children))
 
     # -- errors and user code
     def error(self, node: Node, message: str) -> CompileError:
@@ -283,6 +290,17 @@ class _Compiler:
         if len(items) != 1 or not isinstance(items[0], ExprStmt):
             raise self.error(node, f"{text.strip()!r} is not one expression")
         return items[0].expr
+
+    def script_of(self, expression: Expression, node: Node) -> str:
+        """The URScript text of a PolyScope expression, its I/O pins read as PolyScope
+        reads them."""
+        out = []
+        for kind, text in expression.parts:
+            if kind == "io":
+                out.append(print_tree(self.pin_read(text, node)))
+            else:
+                out.append(Expression(((kind, text),)).script)
+        return "".join(out)
 
     def code(self, text: str, node: Node) -> list[Item]:
         try:
@@ -405,11 +423,11 @@ class _Compiler:
         return [self.marker(node, "Halt", "noBreak"), Halt()]
 
     def n_Contributed(self, node: Node) -> list[Item]:
-        return [self.marker(node, node.title),
-                Comment("# begin: URCap Program Node"),
+        return [Comment("# begin: URCap Program Node"),
                 Comment(f"#   Source: {node.attrs.get('strategyURCapName', '?')}, "
                         f"{node.attrs.get('strategyURCapDeveloper', '?')}"),
                 Comment(f"#   Type: {node.title}"),
+                self.marker(node, node.title),
                 Comment("# end: URCap Program Node")]
 
     def n_Wait(self, node: Node) -> list[Item]:
@@ -420,16 +438,15 @@ class _Compiler:
         if kind == "DigitalInput":
             pin = str(node.fields.get("pin"))
             value = node.fields.get("digital") in ("1", "true", "True")
-            test = BinOp("==", self.pin_read(pin, node), Bool(value))
+            test = BinOp("==", self.pin_read(pin, node), Bool(not value))
             label = f"Wait {self.pin_label(pin)}={'HI' if value else 'LO'}"
-        elif kind == "Condition":
+            return [self.marker(node, label), While(Paren(test), (_stmt("sync"),))]
+        if kind == "Condition":
             expression = node.fields["expression"]
-            test = self.expr(expression.script, node)
-            label = f"Wait {expression.label}"
-        else:
-            return self.n_unknown(node)
-        return [self.marker(node, label),
-                While(Paren(_call("not", Paren(test))), (_stmt("sync"),))]
+            test = self.expr(self.script_of(expression, node), node)
+            return [self.marker(node, f"Wait {expression.label}"),
+                    While(Paren(_call("not", Paren(test))), (_stmt("sync"),))]
+        return self.n_unknown(node)
 
     def pin_label(self, pin: str) -> str:
         for name, target in self.pins.items():
@@ -477,13 +494,13 @@ class _Compiler:
         name = node.name or "var"
         label = f"{name}≔{expression.label}"
         return [self.marker(node, label),
-                Declare("global", name, self.expr(expression.script, node))]
+                Declare("global", name, self.expr(self.script_of(expression, node), node))]
 
     def n_Script(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
         if kind == "Line":
             expression = node.fields["expression"]
-            return [self.marker(node, expression.label), *self.code(expression.script, node)]
+            return [self.marker(node, expression.label), *self.code(self.script_of(expression, node), node)]
         contents = str(node.fields.get("contents", ""))
         if kind == "File":
             file = str(node.fields.get("file", "")).rsplit("/", 1)[-1]
@@ -536,14 +553,14 @@ class _Compiler:
         if kind == "While":
             expression = node.fields["expression"]
             return [self.marker(node, f"Loop {expression.label}"),
-                    While(Paren(self.expr(expression.script, node)), tuple(body))]
+                    While(Paren(self.expr(self.script_of(expression, node), node)), tuple(body))]
         return [self.marker(node, "Loop"), While(Paren(Bool(True)), tuple(body))]
 
     def if_chain(self, chain: list[Node]) -> list[Item]:
         head = chain[0]
         expression = head.fields["expression"]
         body = [self.marker(head, f"If {expression.label}"), ]
-        test = self.expr(expression.script, head)
+        test = self.expr(self.script_of(expression, head), head)
         inner = self.block(head.children)
         orelse: tuple[Item, ...] | None = None
         if len(chain) > 1:
@@ -587,6 +604,9 @@ class _Compiler:
         if kind == "Variable":
             variable = str(node.fields.get("variable") or name)
             target: Expr = Name(variable)
+            feature = move.fields.get("feature")
+            if feature and feature not in _BASE_FEATURES:
+                target = _call("pose_trans", Name(str(feature)), target)
             label = variable
         elif kind == "Fixed":
             label = name
