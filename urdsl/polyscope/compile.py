@@ -43,6 +43,7 @@ from ..script.nodes import (
     Call,
     Comment,
     Declare,
+    Elif,
     Expr,
     ExprStmt,
     FunctionDef,
@@ -214,6 +215,7 @@ class _Compiler:
         self.number_of: dict[int, int] = {}
         self.waypoints: dict[str, Node] = {}
         self.counter = 0
+        self.switches = 0
         self.pins = dict(getattr(installation, "io_names", ()) or ())
         self.version = program.major_version or 5
 
@@ -416,8 +418,60 @@ class _Compiler:
         return [self.marker(node, node.name or "Folder"), *self.block(node.children)]
 
     def n_Comment(self, node: Node) -> list[Item]:
-        text = str(node.fields.get("text", ""))
+        text = f"'{node.fields.get('text', '')}'"
         return [self.marker(node, text), Comment(f"# {text}")]
+
+    def n_Switch(self, node: Node) -> list[Item]:
+        self.switches += 1
+        variable = f"switch_{self.switches}"
+        expression = node.fields["expression"]
+        items: list[Item] = [self.marker(node, f"Switch {expression.label}"),
+                             Assign(Name(variable),
+                                    self.expr(self.script_of(expression, node), node))]
+        cases = [child for child in node.children if not child.suppressed]
+        tests: list[tuple[Expr, tuple[Item, ...]]] = []
+        default: tuple[Item, ...] | None = None
+        for case in cases:
+            body = (self.marker(case, case.title), *self.block(case.children))
+            value = case.attrs.get("caseValue")
+            if case.kind == "Case" and value is not None:
+                tests.append((Paren(BinOp("==", self.expr(value, case), Name(variable))),
+                              body))
+            else:
+                default = body
+        if not tests:
+            return items + list(default or ())
+        first, *rest = tests
+        items.append(If(first[0], first[1], tuple(Elif(test, body) for test, body in rest),
+                        default))
+        return items
+
+    def n_CircleMove(self, node: Node) -> list[Item]:
+        move = self.move_of(node)
+        points = [child for child in node.children if child.kind == "Waypoint"]
+        items: list[Item] = [self.marker(node, "CircleMove")]
+        if move is None or len(points) != 2:
+            return items + self.block(node.children)
+        via, end = points
+        items.append(self.marker(via, via.name or "ViaPoint", "noBreak"))
+        items.append(self.marker(end, end.name or "EndPoint", "breakAfter"))
+        keywords = [(k, v) for k, v in self.motion_keywords(move, end) if k in ("a", "v")]
+        siblings = move.children
+        index = siblings.index(node) if node in siblings else -1
+        blend = 0.0
+        if 0 <= index < len(siblings) - 1:
+            following = siblings[index + 1]
+            blend = (following.fields.get("params") or {}).get("blendRadius", 0.0)
+        keywords.append(("r", _num(blend)))
+        items.append(ExprStmt(Call(Name("movec"), (self.target_of(via, move),
+                                                    self.target_of(end, move)),
+                                   tuple(Keyword(k, v) for k, v in keywords))))
+        return items
+
+    def target_of(self, node: Node, move: Node) -> Expr:
+        if node.fields.get("type") == "Variable":
+            return Name(str(node.fields.get("variable") or node.name))
+        return Name(f"{node.name}_p")
 
     def n_Halt(self, node: Node) -> list[Item]:
         return [self.marker(node, "Halt", "noBreak"), Halt()]
@@ -500,7 +554,8 @@ class _Compiler:
         kind = node.fields.get("type")
         if kind == "Line":
             expression = node.fields["expression"]
-            return [self.marker(node, expression.label), *self.code(self.script_of(expression, node), node)]
+            return [self.marker(node, expression.label),
+                    *self.code(self.script_of(expression, node), node)]
         contents = str(node.fields.get("contents", ""))
         if kind == "File":
             file = str(node.fields.get("file", "")).rsplit("/", 1)[-1]
