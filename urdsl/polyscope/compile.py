@@ -76,10 +76,13 @@ class CompileError(Exception):
 
 @dataclass
 class Compiled:
-    """The result: ``module`` (the URScript tree) and ``numbers`` (marker number → node)."""
+    """The result: ``module`` (the URScript tree), ``numbers`` (marker number → node) and
+    ``labels`` (marker number → label)."""
 
     module: Module
     numbers: dict[int, Node] = field(default_factory=dict)
+    labels: dict[int, str] = field(default_factory=dict)
+    """Marker number → the label PolyScope shows (in English)."""
 
     @property
     def text(self) -> str:
@@ -216,6 +219,7 @@ class _Compiler:
         self.waypoints: dict[str, Node] = {}
         self.counter = 0
         self.switches = 0
+        self.labels: dict[int, str] = {}
         self.pins = dict(getattr(installation, "io_names", ()) or ())
         self.version = program.major_version or 5
 
@@ -262,7 +266,7 @@ class _Compiler:
         name = re.sub(r"[^A-Za-z0-9_]", "", program.name) or "program"
         if name[0].isdigit():
             name = "_" + name
-        return Compiled(Module((FunctionDef(name, (), tuple(body)),)), self.numbers)
+        return Compiled(Module((FunctionDef(name, (), tuple(body)),)), self.numbers, self.labels)
 
     def _all_nodes(self):
         roots = [self.program.before_start, self.program.main, *self.program.threads,
@@ -313,7 +317,9 @@ class _Compiler:
         return list(module.body)
 
     def marker(self, node: Node, label: str, flag: str | None = None) -> Marker:
-        return Marker(self.number(node), label.replace('"', "'"), flag)
+        label = label.replace('"', "'")
+        self.labels[self.number(node)] = label
+        return Marker(self.number(node), label, flag)
 
     # -- preamble
     def preamble(self) -> list[Item]:
@@ -405,7 +411,10 @@ class _Compiler:
         return method(node)
 
     def n_unknown(self, node: Node) -> list[Item]:
-        return [self.marker(node, node.title), *self.block(node.children)]
+        """A node type urdsl does not know: its marker, a comment naming it, its children."""
+        return [self.marker(node, node.title),
+                Comment(f" urdsl: PolyScope node <{node.kind}> is not compiled"),
+                *self.block(node.children)]
 
     def n_MainProgram(self, node: Node) -> list[Item]:
         return [self.marker(node, "Robot Program"), *self.block(node.children)]
@@ -419,7 +428,7 @@ class _Compiler:
 
     def n_Comment(self, node: Node) -> list[Item]:
         text = f"'{node.fields.get('text', '')}'"
-        return [self.marker(node, text), Comment(f"# {text}")]
+        return [self.marker(node, text), Comment(f" {text}")]
 
     def n_Switch(self, node: Node) -> list[Item]:
         self.switches += 1
@@ -432,8 +441,9 @@ class _Compiler:
         tests: list[tuple[Expr, tuple[Item, ...]]] = []
         default: tuple[Item, ...] | None = None
         for case in cases:
-            body = (self.marker(case, case.title), *self.block(case.children))
             value = case.attrs.get("caseValue")
+            label = f"Case {value}" if value is not None else "Default Case"
+            body = (self.marker(case, label), *self.block(case.children))
             if case.kind == "Case" and value is not None:
                 tests.append((Paren(BinOp("==", self.expr(value, case), Name(variable))),
                               body))
@@ -477,12 +487,12 @@ class _Compiler:
         return [self.marker(node, "Halt", "noBreak"), Halt()]
 
     def n_Contributed(self, node: Node) -> list[Item]:
-        return [Comment("# begin: URCap Program Node"),
-                Comment(f"#   Source: {node.attrs.get('strategyURCapName', '?')}, "
+        return [Comment(" begin: URCap Program Node"),
+                Comment(f"   Source: {node.attrs.get('strategyURCapName', '?')}, "
                         f"{node.attrs.get('strategyURCapDeveloper', '?')}"),
-                Comment(f"#   Type: {node.title}"),
+                Comment(f"   Type: {node.title}"),
                 self.marker(node, node.title),
-                Comment("# end: URCap Program Node")]
+                Comment(" end: URCap Program Node")]
 
     def n_Wait(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
@@ -634,8 +644,9 @@ class _Compiler:
         first = items[0]
         assert isinstance(first, Marker)
         expression = original.fields["expression"]
-        return [Marker(first.number, f"ElseIf {expression.label}".replace('"', "'")),
-                *items[1:]]
+        label = f"ElseIf {expression.label}".replace('"', "'")
+        self.labels[first.number or 0] = label
+        return [Marker(first.number, label), *items[1:]]
 
     # -- moves
     def n_Move(self, node: Node) -> list[Item]:
