@@ -45,6 +45,7 @@ from urdsl.script.nodes import (  # noqa: E402
     Marker,
     Module,
     ThreadDef,
+    While,
 )
 from urdsl.script.printer import format as print_tree  # noqa: E402
 
@@ -133,6 +134,7 @@ def program_part(module: Module, waypoints: frozenset[str]) -> Module:
         for index, item in enumerate(items):
             if isinstance(item, Marker) or (
                     isinstance(item, (FunctionDef, ThreadDef)) and not _ID.search(item.name)) \
+                    or isinstance(item, While) \
                     or (isinstance(item, Declare) and re.sub(r"(_from|_to)?_[pq]$", "", item.name)
                         in waypoints and item.name != re.sub(r"_[pq]$", "", item.name)):
                 return Module(items[index:])

@@ -40,24 +40,31 @@ from ..script.nodes import (
     Assign,
     BinOp,
     Bool,
+    Break,
     Call,
     Comment,
     Declare,
     Elif,
+    EnterCritical,
+    ExitCritical,
     Expr,
     ExprStmt,
     FunctionDef,
     Halt,
     If,
+    Index,
     Item,
+    Join,
     Keyword,
     List,
     Marker,
     Module,
     Name,
     Number,
+    Param,
     Paren,
     Pose,
+    Return,
     Run,
     String,
     ThreadDef,
@@ -189,6 +196,42 @@ _GET_FUNCTIONS = {
 }
 _BASE_FEATURES = frozenset(("Joint_0_name", "Base", "base"))
 """Names PolyScope gives the base frame in a move's feature reference."""
+_TOOL_FEATURES = frozenset(("Joint_6_name", "Tool", "tool"))
+"""... and the tool flange."""
+
+
+def _floats_or_none(text: str | None) -> tuple[float, ...] | None:
+    if not text:
+        return None
+    try:
+        return tuple(float(x) for x in text.split(","))
+    except ValueError:
+        return None
+
+
+def _direction_helper() -> list[Item]:
+    """The function PolyScope defines for Direction nodes: the waypoint ``position_distance``
+    (m) from the target along ``direction`` given in ``feature``."""
+    posdir = List(tuple(Index(Name("direction"), (Number(i),)) for i in range(3)))
+    normalized = "direction_vector_normalized"
+    displacement = Pose(tuple(
+        BinOp("*", Index(Name(normalized), (Number(i),)), Name("position_distance"))
+        for i in range(3)) + (Number(0), Number(0), Number(0)))
+    body: tuple[Item, ...] = (
+        Declare("local", "posDir", posdir),
+        If(Paren(BinOp("<", _call("norm", Name("posDir")), _num(1e-6))),
+           (Return(_call("get_target_waypoint")),)),
+        Declare("local", normalized, _call("normalize", Name("posDir"))),
+        Declare("local", "displacement_pose", displacement),
+        Declare("local", "wanted_displacement_in_base_frame",
+                _call("pose_sub", _call("pose_trans", Name("feature"),
+                                        Name("displacement_pose")), Name("feature"))),
+        Return(_call("pose_add", _call("get_target_waypoint"),
+                     Name("wanted_displacement_in_base_frame"))),
+    )
+    return [FunctionDef("calculate_point_to_move_towards",
+                        (Param("feature"), Param("direction"), Param("position_distance")),
+                        body)]
 _POPUP_TITLES = {"Message": "Message", "Warning": "Warning", "Error": "Error"}
 
 
@@ -245,12 +288,19 @@ class _Compiler:
         body: list[Item] = []
         body.extend(self.preamble())
         timers: list[str] = []
-        for node in self._all_nodes():
+        direction_helper = False
+        for node in self._all_nodes(suppressed=True):
+            if node.kind == "Direction" and not direction_helper:
+                direction_helper = True  # PolyScope defines it where the first one is
+                body.extend(_direction_helper())
+            if node.suppressed:
+                continue
             if node.kind == "Waypoint" and node.fields.get("type") in ("Fixed", "Relative"):
-                self.waypoints.setdefault(node.name or "Waypoint", node)
+                if (node.name or "Waypoint") not in self.waypoints:
+                    self.waypoints[node.name or "Waypoint"] = node
+                    body.extend(self.waypoint_globals(node))
             if node.kind == "Timer" and node.name and node.name not in timers:
                 timers.append(node.name)
-        body.extend(self.waypoint_globals())
         body.extend(self.timer_thread(timers))
         for sub in program.subprograms:
             body.extend(self.subprogram(sub))
@@ -268,7 +318,9 @@ class _Compiler:
             name = "_" + name
         return Compiled(Module((FunctionDef(name, (), tuple(body)),)), self.numbers, self.labels)
 
-    def _all_nodes(self):
+    def _all_nodes(self, suppressed: bool = False):
+        """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
+        them has ``suppressed`` set)."""
         roots = [self.program.before_start, self.program.main, *self.program.threads,
                  *self.program.subprograms]
         for root in roots:
@@ -277,8 +329,11 @@ class _Compiler:
             stack = [root]
             while stack:
                 node = stack.pop()
-                if node.suppressed:
+                if node.suppressed and not suppressed:
                     continue
+                if node.suppressed:
+                    for inner in node.walk():
+                        inner.suppressed = True
                 yield node
                 stack.extend(reversed(node.children))
 
@@ -325,29 +380,21 @@ class _Compiler:
     def preamble(self) -> list[Item]:
         return []
 
-    def waypoint_globals(self) -> list[Item]:
-        items: list[Item] = []
-        if self.version < 5:
-            return items
-        for name, node in self.waypoints.items():
-            q = node.fields.get("q")
-            if not q:
-                continue
-            pose = self.pose_of(node)
-            if pose is None:
-                continue
-            if node.fields.get("type") == "Relative":
-                start = self.pose_of(node, "from_")
-                if start is None:
-                    continue
-                items.append(Declare("global", f"{name}_from_p",
-                                     Pose(tuple(_num(v) for v in start))))
-                items.append(Declare("global", f"{name}_to_p",
-                                     Pose(tuple(_num(v) for v in pose))))
-                continue
-            items.append(Declare("global", f"{name}_p", Pose(tuple(_num(v) for v in pose))))
-            items.append(Declare("global", f"{name}_q", List(tuple(_num(v) for v in q))))
-        return items
+    def waypoint_globals(self, node: Node) -> list[Item]:
+        """The globals PolyScope 5 writes for a fixed or relative waypoint."""
+        name = node.name or "Waypoint"
+        q = node.fields.get("q")
+        pose = self.pose_of(node)
+        if self.version < 5 or not q or pose is None:
+            return []
+        if node.fields.get("type") == "Relative":
+            start = self.pose_of(node, "from_")
+            if start is None:
+                return []
+            return [Declare("global", f"{name}_from_p", Pose(tuple(_num(v) for v in start))),
+                    Declare("global", f"{name}_to_p", Pose(tuple(_num(v) for v in pose)))]
+        return [Declare("global", f"{name}_p", Pose(tuple(_num(v) for v in pose))),
+                Declare("global", f"{name}_q", List(tuple(_num(v) for v in q)))]
 
     def timer_thread(self, timers: list[str]) -> list[Item]:
         """The globals and the thread that count PolyScope's timers."""
@@ -647,6 +694,84 @@ class _Compiler:
         label = f"ElseIf {expression.label}".replace('"', "'")
         self.labels[first.number or 0] = label
         return [Marker(first.number, label), *items[1:]]
+
+    # -- direction / until
+    def n_Direction(self, node: Node) -> list[Item]:
+        """A Direction node: a thread moves towards a far point while the program waits for
+        its Until nodes (only the distance Until is compiled as PolyScope does)."""
+        number = self.number(node)
+        move = self.move_of(node)
+        selected = node.attrs.get("selectedDirection")
+        expression = node.fields.get("expression")
+        feature = node.fields.get("feature")
+        frame = "Tool" if feature in _TOOL_FEATURES else (
+            "Base" if feature in (None, *_BASE_FEATURES) else str(feature))
+        if selected:
+            axis = {"X": 0, "Y": 1, "Z": 2}[selected[0]]
+            sign = -1.0 if selected.endswith("Minus") else 1.0
+            vector: Expr = List(tuple(_num(sign if i == axis else 0.0) for i in range(3)))
+            label = f"Direction: {frame} {selected[0]}{'-' if sign < 0 else '+'}"
+        elif expression:
+            vector = self.expr(self.script_of(expression, node), node)
+            label = f"Direction: {frame}"
+        else:
+            return self.n_unknown(node)
+        if frame == "Tool":
+            feature_pose: Expr = _call("get_forward_kin")
+        elif frame == "Base":
+            feature_pose = Pose(tuple(_num(0.0) for _ in range(6)))
+        else:
+            feature_pose = Name(frame)
+        untils = [child for child in node.children if child.kind == "Until"]
+        distance = 1000.0
+        for until in untils:
+            if until.attrs.get("type") == "DISTANCE" and until.element is not None:
+                text = until.element.findtext("Distance")
+                if text:
+                    distance = float(text)
+        speed = move.fields.get("speed") if move is not None else None
+        accel = move.fields.get("acceleration") if move is not None else None
+        params = _floats_or_none(node.attrs.get("toolParams"))
+        if params is not None and len(params) == 2:
+            speed, accel = params
+        flag, thread, handle = (f"move_thread_flag_{number}", f"move_thread_{number}",
+                                f"move_thread_han_{number}")
+        keywords = []
+        if accel is not None:
+            keywords.append(Keyword("a", _num(accel)))
+        if speed is not None:
+            keywords.append(Keyword("v", _num(speed)))
+        thread_body: tuple[Item, ...] = (
+            EnterCritical(),
+            Assign(Name(flag), Number(1)),
+            Declare("local", "towardsPos", _call("calculate_point_to_move_towards",
+                                                 feature_pose, vector, _num(distance))),
+            ExprStmt(Call(Name("movel"), (Name("towardsPos"),), tuple(keywords))),
+            Assign(Name(flag), Number(2)),
+            ExitCritical(),
+        )
+        items: list[Item] = [
+            self.marker(node, label),
+            Declare("global", flag, Number(0)),
+            ThreadDef(thread, thread_body),
+            Assign(Name(flag), Number(0)),
+            Assign(Name(handle), Run(thread)),
+        ]
+        done: list[Item] = [Join(Name(handle))]
+        for until in untils:
+            if until.attrs.get("type") != "DISTANCE":
+                done.append(Comment(f" urdsl: Until ({until.attrs.get('type', '?').lower()}) "
+                                    "is not compiled"))
+            done.append(self.marker(until, f"Until ({until.attrs.get('type', '').lower()})"))
+            done.extend(self.block(until.children))
+        done.append(Break())
+        items.append(While(Paren(Bool(True)), (
+            _stmt("sleep", _num(1e-10)),
+            If(Paren(BinOp(">", Name(flag), Number(1))), tuple(done)),
+            _stmt("sync"))))
+        others = [child for child in node.children if child.kind != "Until"]
+        items.extend(self.block(others))
+        return items
 
     # -- moves
     def n_Move(self, node: Node) -> list[Item]:

@@ -524,6 +524,13 @@ def _comment(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["text"] = element.get("comment", "")
 
 
+def _direction(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    feature = element.find("feature")
+    if feature is not None:
+        node.fields["feature"] = reader.resolve(feature).get("referencedName")
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
 def _timer(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["action"] = element.get("action", "Start")
     node.name = reader.variable_name(element.find("variable"))
@@ -545,5 +552,6 @@ def _call(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
 _FIELDS = {
     "Move": _move, "Waypoint": _waypoint, "Loop": _loop, "If": _if, "Wait": _wait,
     "Set": _set, "Assignment": _assignment, "Script": _script, "Popup": _popup,
-    "Comment": _comment, "Timer": _timer, "SubProgram": _subprogram, "CallSubProgram": _call,
+    "Comment": _comment, "Timer": _timer, "Direction": _direction,
+    "SubProgram": _subprogram, "CallSubProgram": _call,
 }
