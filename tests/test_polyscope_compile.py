@@ -56,7 +56,7 @@ def test_markers_are_numbered_in_program_order_with_flags(lines):
                            '$ 2 "BeforeStart"', '$ 3 "count≔0"']
     assert '$ 5 "Robot Program"' in markers  # 1 is the variables setup: no marker
     assert '$ 7 "Waypoint_1" "breakAfter"' in markers
-    assert '$ 17 "Halt" "noBreak"' in markers
+    assert '$ 17 "Halt"' in markers
     assert '$ 18 "Else" "noBreak"' in markers
     assert '$ 31 "Thread_1"' in markers
     # the suppressed Wait (23) writes nothing but keeps its number

@@ -209,6 +209,26 @@ def _floats_or_none(text: str | None) -> tuple[float, ...] | None:
         return None
 
 
+def _blend_kept(move: Node, motion: Node) -> bool:
+    """Whether a process move (MoveP) keeps the blend of ``motion``: not at its last motion
+    unless the next node is another MoveP, into which it can blend."""
+    if move.fields.get("motion_type") != "MoveP":
+        return True
+    motions = [child for child in move.children
+               if child.kind in ("Waypoint", "CircleMove") and not child.suppressed]
+    if not motions or motion is not motions[-1]:
+        return True
+    parent = move.parent
+    if parent is None:
+        return False
+    siblings = [child for child in parent.children if not child.suppressed]
+    index = siblings.index(move) if move in siblings else -1
+    if 0 <= index < len(siblings) - 1:
+        following = siblings[index + 1]
+        return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
+    return False
+
+
 def _direction_helper() -> list[Item]:
     """The function PolyScope defines for Direction nodes: the waypoint ``position_distance``
     (m) from the target along ``direction`` given in ``feature``."""
@@ -513,13 +533,12 @@ class _Compiler:
         items.append(self.marker(via, via.name or "ViaPoint", "noBreak"))
         items.append(self.marker(end, end.name or "EndPoint", "breakAfter"))
         keywords = [(k, v) for k, v in self.motion_keywords(move, end) if k in ("a", "v")]
-        siblings = move.children
-        index = siblings.index(node) if node in siblings else -1
-        blend = 0.0
-        if 0 <= index < len(siblings) - 1:
-            following = siblings[index + 1]
-            blend = (following.fields.get("params") or {}).get("blendRadius", 0.0)
-        keywords.append(("r", _num(blend)))
+        blend = (end.fields.get("params") or {}).get("blendRadius", move.fields.get("blend"))
+        if not _blend_kept(move, node):
+            blend = 0.0
+        keywords.append(("r", _num(blend or 0.0)))
+        if node.attrs.get("OrientationMode") == "FIXED":
+            keywords.append(("mode", Number(1)))
         items.append(ExprStmt(Call(Name("movec"), (self.target_of(via, move),
                                                     self.target_of(end, move)),
                                    tuple(Keyword(k, v) for k, v in keywords))))
@@ -531,7 +550,7 @@ class _Compiler:
         return Name(f"{node.name}_p")
 
     def n_Halt(self, node: Node) -> list[Item]:
-        return [self.marker(node, "Halt", "noBreak"), Halt()]
+        return [self.marker(node, "Halt"), Halt()]
 
     def n_Contributed(self, node: Node) -> list[Item]:
         return [Comment(" begin: URCap Program Node"),
@@ -626,9 +645,14 @@ class _Compiler:
         message = str(node.fields.get("message", ""))
         halt = bool(node.fields.get("halt"))
         title = _POPUP_TITLES.get(kind, kind)
+        text: Expr = String(message.replace('"', "'"))
+        if node.fields.get("input") == "Variable" and node.fields.get("variable"):
+            variable = str(node.fields["variable"])
+            text = _call("str_cat", String(""), Name(variable))
+            message = variable
         items: list[Item] = [
             self.marker(node, f"Popup: {message}"),
-            _stmt("popup", String(message.replace('"', "'")), String(title),
+            _stmt("popup", text, String(title),
                   Bool(kind == "Warning"), Bool(kind == "Error"), blocking=Bool(not halt))]
         if halt:
             items.append(Halt())
@@ -837,7 +861,9 @@ class _Compiler:
             if speed is not None:
                 out.append(("v", _num(speed)))
         blend = params.get("blendRadius", move.fields.get("blend"))
-        if blend and blend > 0:
+        if motion == "MoveP":
+            out.append(("r", _num(blend if blend and _blend_kept(move, waypoint) else 0.0)))
+        elif blend and blend > 0:
             out.append(("r", _num(blend)))
         return out
 

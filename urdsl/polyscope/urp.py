@@ -367,7 +367,8 @@ class _Reader:
     def variable_name(self, element: ElementTree.Element | None) -> str | None:
         if element is None:
             return None
-        return self.resolve(element).get("name")
+        target = self.resolve(element)
+        return target.get("name") or target.get("featureName")
 
 
 def _floats(text: str | None) -> tuple[float, ...]:
@@ -496,7 +497,7 @@ def _assignment(reader: _Reader, node: Node, element: ElementTree.Element) -> No
     variable = element.find("variable")
     if variable is not None:
         target = reader.resolve(variable)
-        node.name = target.get("name")
+        node.name = target.get("name") or target.get("featureName")
         node.fields["persistent"] = target.get("prefersPersistentValue") == "true"
     node.fields["source"] = element.get("valueSource", "Expression")
     node.fields["expression"] = reader.expression(element.find("expression"))
@@ -517,6 +518,8 @@ def _popup(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["type"] = element.get("type", "Message")
     node.fields["message"] = element.get("message", "")
     node.fields["halt"] = element.get("haltProgram") == "true"
+    node.fields["input"] = element.get("inputType", "Text")
+    node.fields["variable"] = reader.variable_name(element.find("variable"))
     node.fields["expression"] = reader.expression(element.find("expression"))
 
 
