@@ -65,6 +65,23 @@ def git_show(gitdir: Path, commit: str, path: str) -> bytes | None:
     return result.stdout if result.returncode == 0 else None
 
 
+def strip_urcap_text(text: str) -> str:
+    """The text without the lines from each ``# begin: URCap`` to its ``# end: URCap``
+    (counted in text order: a URCap's nested blocks may end inside a statement it opened)."""
+    out, depth = [], 0
+    for line in text.splitlines():
+        stripped = line.strip()
+        if stripped.startswith("# begin: URCap"):
+            depth += 1
+            continue
+        if stripped.startswith("# end: URCap"):
+            depth = max(0, depth - 1)
+            continue
+        if depth == 0:
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def _strip_urcap(items: tuple) -> list:
     out, depth = [], 0
     for item in items:
@@ -194,11 +211,17 @@ def main(argv: list[str] | None = None) -> int:
             st["missing"] += 1
             continue
         st["n"] += 1
+        reference = script.decode("utf-8", "replace")
+        by_text = True
         try:
-            theirs_tree = _clean(parse(script.decode("utf-8", "replace"), script_path))
+            theirs_tree = _clean(parse(strip_urcap_text(reference), script_path))
         except ScriptError:
-            st["errors"]["reference does not parse"] += 1
-            continue
+            by_text = False  # a URCap block cut a statement: leave the blocks out by tree
+            try:
+                theirs_tree = _clean(parse(reference, script_path))
+            except ScriptError:
+                st["errors"]["reference does not parse"] += 1
+                continue
         if not any(isinstance(item, Marker) for item in _walk_items(theirs_tree)):
             st["n"] -= 1
             st["not_polyscope"] += 1
@@ -216,7 +239,8 @@ def main(argv: list[str] | None = None) -> int:
                     except InstallationError:
                         installation = None
             compiled = compile_program(program, installation)
-            ours_tree = _clean(compiled.module)
+            ours_tree = _clean(parse(strip_urcap_text(compiled.text), "compiled")
+                               if by_text else compiled.module)
         except (UrpError, CompileError) as error:
             st["errors"][str(error).split("error: ", 1)[-1][:150]] += 1
             continue
