@@ -56,6 +56,7 @@ from ..script.nodes import (
     Item,
     Join,
     Keyword,
+    Kill,
     List,
     Marker,
     Module,
@@ -781,6 +782,12 @@ class _Compiler:
             Assign(Name(flag), Number(0)),
             Assign(Name(handle), Run(thread)),
         ]
+        contact = [until for until in untils
+                   if until.attrs.get("type") == "TOOL_CONTACT_DETECTION"]
+        if len(untils) == 1 and contact:
+            items.append(self._tool_contact(contact[0], handle))
+            items.extend(self.block([c for c in node.children if c.kind != "Until"]))
+            return items
         done: list[Item] = [Join(Name(handle))]
         for until in untils:
             if until.attrs.get("type") != "DISTANCE":
@@ -796,6 +803,43 @@ class _Compiler:
         others = [child for child in node.children if child.kind != "Until"]
         items.extend(self.block(others))
         return items
+
+    def _tool_contact(self, until: Node, handle: str) -> While:
+        """The wait of a Direction that stops on tool contact: back off along the way it
+        came by ``retraction`` (m), decelerating at ``decelerationAcceleration`` (m/s²)."""
+        decel = float(until.attrs.get("decelerationAcceleration", "3.0"))
+        retraction = float(until.attrs.get("retraction", "0.0"))
+        direction = Name("targetTcpDirection")
+        normalized = Name("normalizedPosDir")
+        retract = Pose(tuple(BinOp("*", Index(normalized, (Number(i),)), _num(retraction))
+                             for i in range(3)) + (Number(0), Number(0), Number(0)))
+        found: tuple[Item, ...] = (
+            Kill(Name(handle)),
+            _stmt("stopl", _num(decel)),
+            Declare("local", "backTrackMovement",
+                    _call("get_actual_joint_positions_history", Name("stepsToRetract"))),
+            Declare("local", "contactPose", _call("get_forward_kin", Name("backTrackMovement"))),
+            Declare("local", "posDir", List(tuple(Index(direction, (Number(i),))
+                                                  for i in range(3)))),
+            Declare("local", "retractTo", Name("contactPose")),
+            If(Paren(BinOp(">", _call("norm", Name("posDir")), _num(1e-6))), (
+                Declare("local", "normalizedPosDir", _call("normalize", Name("posDir"))),
+                Declare("local", "additionalRetraction", retract),
+                Assign(Name("retractTo"), _call("pose_sub", Name("contactPose"),
+                                                Name("additionalRetraction"))),
+            )),
+            ExprStmt(Call(Name("movel"), (Name("retractTo"),),
+                          (Keyword("a", _num(decel)), Keyword("v", _num(0.1))))),
+            self.marker(until, "Until (tool_contact_detection)"),
+            *self.block(until.children),
+            Break(),
+        )
+        return While(Paren(Bool(True)), (
+            Declare("local", "targetTcpDirection", _call("get_target_tcp_speed")),
+            Declare("local", "stepsToRetract",
+                    Call(Name("tool_contact"), (), (Keyword("direction", direction),))),
+            If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), found),
+            _stmt("sync")))
 
     # -- moves
     def n_Move(self, node: Node) -> list[Item]:
