@@ -443,6 +443,11 @@ class _Compiler:
         return [self.marker(node, label), Assign(Name(name), Number(0))]
 
     def pose_of(self, node: Node, prefix: str = "") -> tuple[float, ...] | None:
+        """The waypoint's TCP pose: as stored (PolyScope 3), else by forward kinematics of its
+        joint angles with the arm's calibration and the waypoint's TCP (PolyScope 5)."""
+        stored = node.fields.get(prefix + "pose")
+        if stored and len(stored) == 6:
+            return tuple(stored)
         q = node.fields.get(prefix + "q")
         tcp = node.fields.get(prefix + "tcp_offset") or (0.0,) * 6
         kinematics = node.fields.get(prefix + "kinematics") or self.program.kinematics
@@ -548,7 +553,20 @@ class _Compiler:
     def target_of(self, node: Node, move: Node) -> Expr:
         if node.fields.get("type") == "Variable":
             return Name(str(node.fields.get("variable") or node.name))
-        return Name(f"{node.name}_p")
+        return self.fixed_values(node)[0]
+
+    def fixed_values(self, node: Node) -> tuple[Expr, Expr]:
+        """The pose and joints of a fixed waypoint: its globals (PolyScope 5), or literals
+        written in place (PolyScope 3)."""
+        name = node.name or "Waypoint"
+        if self.version >= 5:
+            return Name(f"{name}_p"), Name(f"{name}_q")
+        shared = self.waypoints.get(name, node)
+        q = shared.fields.get("q") or node.fields.get("q")
+        pose = self.pose_of(shared) or self.pose_of(node)
+        if not q or pose is None:
+            raise self.error(node, "a fixed waypoint without joint angles or calibration")
+        return Pose(tuple(_num(v) for v in pose)), List(tuple(_num(v) for v in q))
 
     def n_Halt(self, node: Node) -> list[Item]:
         return [self.marker(node, "Halt"), Halt()]
@@ -869,13 +887,13 @@ class _Compiler:
             label = variable
         elif kind == "Fixed":
             label = name
+            pose_expr, q_expr = self.fixed_values(node)
             if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
-                target = Name(f"{name}_q")
+                target = q_expr
             elif motion == "MoveJ":
-                target = _call("get_inverse_kin", Name(f"{name}_p"),
-                               qnear=Name(f"{name}_q"))
+                target = _call("get_inverse_kin", pose_expr, qnear=q_expr)
             else:
-                target = Name(f"{name}_p")
+                target = pose_expr
         elif kind == "Relative":
             label = name
             target = _call("pose_add", _call("get_target_tcp_pose"),

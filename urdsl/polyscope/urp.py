@@ -422,6 +422,10 @@ def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None
     position = element.find("position")
     if position is not None:
         position = reader.resolve(position)
+        if position.get("joints"):  # PolyScope 3: joints and the TCP pose as attributes
+            node.fields["q"] = _floats(position.get("joints"))
+        if position.get("pose"):
+            node.fields["pose"] = _floats(position.get("pose"))
         angles = position.find("JointAngles")
         if angles is not None:
             node.fields["q"] = _floats(reader.resolve(angles).get("angles"))
@@ -434,6 +438,10 @@ def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None
     relative = element.find("relativeFromPosition")
     if relative is not None:
         relative = reader.resolve(relative)
+        if relative.get("joints"):
+            node.fields["from_q"] = _floats(relative.get("joints"))
+        if relative.get("pose"):
+            node.fields["from_pose"] = _floats(relative.get("pose"))
         angles = relative.find("JointAngles")
         if angles is not None:
             node.fields["from_q"] = _floats(reader.resolve(angles).get("angles"))
