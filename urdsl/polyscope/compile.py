@@ -800,29 +800,27 @@ class _Compiler:
             Assign(Name(flag), Number(0)),
             Assign(Name(handle), Run(thread)),
         ]
-        contact = [until for until in untils
-                   if until.attrs.get("type") == "TOOL_CONTACT_DETECTION"]
-        if len(untils) == 1 and contact:
-            items.append(self._tool_contact(contact[0], handle))
-            items.extend(self.block([c for c in node.children if c.kind != "Until"]))
-            return items
-        done: list[Item] = [Join(Name(handle))]
+        loop: list[Item] = []
         for until in untils:
-            if until.attrs.get("type") != "DISTANCE":
-                done.append(Comment(f" urdsl: Until ({until.attrs.get('type', '?').lower()}) "
-                                    "is not compiled"))
-            done.append(self.marker(until, f"Until ({until.attrs.get('type', '').lower()})"))
+            kind = until.attrs.get("type", "")
+            if kind == "TOOL_CONTACT_DETECTION":
+                loop.extend(self._tool_contact(until, handle))
+                continue
+            done: list[Item] = [Join(Name(handle))]
+            if kind != "DISTANCE":
+                done.append(Comment(f" urdsl: Until ({kind.lower()}) is not compiled"))
+            done.append(self.marker(until, f"Until ({kind.lower()})"))
             done.extend(self.block(until.children))
-        done.append(Break())
-        items.append(While(Paren(Bool(True)), (
-            _stmt("sleep", _num(1e-10)),
-            If(Paren(BinOp(">", Name(flag), Number(1))), tuple(done)),
-            _stmt("sync"))))
+            done.append(Break())
+            loop.append(_stmt("sleep", _num(1e-10)))
+            loop.append(If(Paren(BinOp(">", Name(flag), Number(1))), tuple(done)))
+        loop.append(_stmt("sync"))
+        items.append(While(Paren(Bool(True)), tuple(loop)))
         others = [child for child in node.children if child.kind != "Until"]
         items.extend(self.block(others))
         return items
 
-    def _tool_contact(self, until: Node, handle: str) -> While:
+    def _tool_contact(self, until: Node, handle: str) -> list[Item]:
         """The wait of a Direction that stops on tool contact: back off along the way it
         came by ``retraction`` (m), decelerating at ``decelerationAcceleration`` (m/s²)."""
         decel = float(until.attrs.get("decelerationAcceleration", "3.0"))
@@ -852,12 +850,11 @@ class _Compiler:
             *self.block(until.children),
             Break(),
         )
-        return While(Paren(Bool(True)), (
+        return [
             Declare("local", "targetTcpDirection", _call("get_target_tcp_speed")),
             Declare("local", "stepsToRetract",
                     Call(Name("tool_contact"), (), (Keyword("direction", direction),))),
-            If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), found),
-            _stmt("sync")))
+            If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), found)]
 
     # -- moves
     def n_Move(self, node: Node) -> list[Item]:
