@@ -856,6 +856,37 @@ class _Compiler:
                     Call(Name("tool_contact"), (), (Keyword("direction", direction),))),
             If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), found)]
 
+    def n_Force(self, node: Node) -> list[Item]:
+        """Force mode around the node's children: selected axes are compliant (limited by
+        the speed limits, m/s and rad/s), the others by the allowed deviation (m, rad)."""
+        selection = node.fields.get("selection")
+        wrench = node.fields.get("wrench")
+        speeds = node.fields.get("limitsForce")
+        deviations = node.fields.get("limitsMotion")
+        if not (selection and wrench and speeds and deviations):
+            return self.n_unknown(node)
+        feature = node.fields.get("feature")
+        frame: Expr
+        if feature in _TOOL_FEATURES:
+            frame = _call("tool_pose")
+        elif feature in (None, *_BASE_FEATURES):
+            frame = Pose(tuple(_num(0.0) for _ in range(6)))
+        else:
+            frame = Name(str(feature))
+        kind = {"Point": 1, "Motion": 3}.get(str(node.fields.get("type")), 2)
+        limits = [speeds[i] if selection[i] else deviations[i] for i in range(6)]
+        body = self.block(node.children)
+        for index in range(len(body) - 1, -1, -1):
+            item = body[index]
+            if isinstance(item, Marker):
+                body[index] = Marker(item.number, item.text, "noBreak")
+                break
+        return [self.marker(node, "Force"), _stmt("sleep", _num(0.02)), _stmt("zero_ftsensor"),
+                _stmt("force_mode", frame, List(tuple(Number(int(v)) for v in selection)),
+                      List(tuple(_num(v) for v in wrench)), Number(kind),
+                      List(tuple(_num(v) for v in limits))),
+                *body, _stmt("end_force_mode"), _stmt("stopl", _num(5.0))]
+
     # -- moves
     def n_Move(self, node: Node) -> list[Item]:
         items: list[Item] = [self.marker(node, str(node.fields.get("motion_type", "Move")))]

@@ -542,6 +542,17 @@ def _direction(reader: _Reader, node: Node, element: ElementTree.Element) -> Non
     node.fields["expression"] = reader.expression(element.find("expression"))
 
 
+def _force(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "Frame")
+    feature = element.find("feature")
+    if feature is not None:
+        node.fields["feature"] = reader.resolve(feature).get("referencedName")
+    for key in ("selection", "wrench", "limitsForce", "limitsMotion"):
+        child = element.find(key)
+        if child is not None:
+            node.fields[key] = _floats(reader.resolve(child).get("value"))
+
+
 def _timer(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["action"] = element.get("action", "Start")
     node.name = reader.variable_name(element.find("variable"))
@@ -563,6 +574,6 @@ def _call(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
 _FIELDS = {
     "Move": _move, "Waypoint": _waypoint, "Loop": _loop, "If": _if, "Wait": _wait,
     "Set": _set, "Assignment": _assignment, "Script": _script, "Popup": _popup,
-    "Comment": _comment, "Timer": _timer, "Direction": _direction,
+    "Comment": _comment, "Timer": _timer, "Direction": _direction, "Force": _force,
     "SubProgram": _subprogram, "CallSubProgram": _call,
 }
