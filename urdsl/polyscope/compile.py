@@ -801,7 +801,8 @@ class _Compiler:
             Assign(Name(handle), Run(thread)),
         ]
         loop: list[Item] = []
-        for until in untils:
+        # PolyScope checks tool contact before the other conditions, whatever their order
+        for until in sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION"):
             kind = until.attrs.get("type", "")
             if kind == "TOOL_CONTACT_DETECTION":
                 loop.extend(self._tool_contact(until, handle))
