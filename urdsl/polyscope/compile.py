@@ -69,6 +69,7 @@ from ..script.nodes import (
     Run,
     String,
     ThreadDef,
+    UnaryOp,
     While,
 )
 from ..script.printer import format as print_tree
@@ -594,7 +595,7 @@ class _Compiler:
             expression = node.fields["expression"]
             test = self.expr(self.script_of(expression, node), node)
             return [self.marker(node, f"Wait {expression.label}"),
-                    While(Paren(_call("not", Paren(test))), (_stmt("sync"),))]
+                    While(Paren(UnaryOp("not", Paren(test))), (_stmt("sync"),))]
         return self.n_unknown(node)
 
     def pin_label(self, pin: str) -> str:
@@ -707,8 +708,19 @@ class _Compiler:
                                          BinOp("+", Name(variable), Number(1)))))]
         if kind == "While":
             expression = node.fields["expression"]
-            return [self.marker(node, f"Loop {expression.label}"),
-                    While(Paren(self.expr(self.script_of(expression, node), node)), tuple(body))]
+            text = self.script_of(expression, node)
+            marker = self.marker(node, f"Loop {expression.label}")
+            if node.attrs.get("checkContinuously") != "true":
+                return [marker, While(Paren(self.expr(text, node)), tuple(body))]
+            # checked continuously: the body runs in a thread killed when the test fails
+            number = self.number(node)
+            thread, handler = f"Thread_while_{number}", f"thread_handler_{number}"
+            return [marker,
+                    ThreadDef(thread, (While(Paren(Bool(True)), tuple(body)),)),
+                    If(Paren(self.expr(text, node)), (
+                        Declare("global", handler, Run(thread)),
+                        While(Paren(self.expr(text, node)), (_stmt("sync"),)),
+                        Kill(Name(handler))))]
         return [self.marker(node, "Loop"), While(Paren(Bool(True)), tuple(body))]
 
     def if_chain(self, chain: list[Node]) -> list[Item]:
@@ -727,7 +739,26 @@ class _Compiler:
                              {**nxt.fields, "type": "If"}, nxt.element, nxt.parent)]
                 self.number_of[id(rest[0])] = self.number(nxt)
                 orelse = tuple(self._elseif(nxt, rest[0], chain[2:]))
-        return [*body, If(Paren(test), tuple(inner), (), orelse)]
+        if head.attrs.get("checkContinuously") != "true":
+            return [*body, If(Paren(test), tuple(inner), (), orelse)]
+        # checked continuously: the body runs in a thread killed when the test fails
+        number = self.number(head)
+        flag, thread, handler = (f"thread_flag_{number}", f"Thread_if_{number}",
+                                 f"thread_handler_{number}")
+        items: list[Item] = [
+            *body,
+            Declare("global", flag, Number(0)),
+            ThreadDef(thread, (*inner, Assign(Name(flag), Number(1)))),
+            If(Paren(test), (
+                Declare("global", handler, Run(thread)),
+                While(Paren(BinOp("==", Name(flag), Number(0))), (
+                    If(UnaryOp("not", Paren(test)),
+                       (Kill(Name(handler)), Assign(Name(flag), Number(2))), (),
+                       (_stmt("sync"),)),)),
+            ), (), (Assign(Name(flag), Number(2)),))]
+        if orelse is not None:
+            items.append(If(Paren(BinOp("==", Name(flag), Number(2))), orelse))
+        return items
 
     def _elseif(self, original: Node, copy: Node, rest: list[Node]) -> list[Item]:
         items = self.if_chain([copy, *rest])
