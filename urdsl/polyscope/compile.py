@@ -526,7 +526,9 @@ class _Compiler:
         if not tests:
             return items + list(default or ())
         first, *rest = tests
-        items.append(If(first[0], first[1], tuple(Elif(test, body) for test, body in rest),
+        # the first case's marker stands before the `if`, the others inside their branch
+        items.append(first[1][0])
+        items.append(If(first[0], first[1][1:], tuple(Elif(test, body) for test, body in rest),
                         default))
         return items
 
@@ -553,7 +555,11 @@ class _Compiler:
 
     def target_of(self, node: Node, move: Node) -> Expr:
         if node.fields.get("type") == "Variable":
-            return Name(str(node.fields.get("variable") or node.name))
+            target: Expr = Name(str(node.fields.get("variable") or node.name))
+            feature = move.fields.get("feature")
+            if feature and feature not in _BASE_FEATURES:
+                target = _call("pose_trans", Name(str(feature)), target)
+            return target
         return self.fixed_values(node)[0]
 
     def fixed_values(self, node: Node) -> tuple[Expr, Expr]:
