@@ -142,6 +142,16 @@ def canonical_lines(module: Module) -> list[str]:
     return lines
 
 
+def preamble_part(module: Module, waypoints: frozenset[str]) -> Module:
+    """The top-level statements before the program part: what the installation generates."""
+    body = module.body
+    if len(body) == 1 and isinstance(body[0], FunctionDef):
+        items = body[0].body
+        rest = program_part(module, waypoints).body
+        return Module(items[:len(items) - len(rest)])
+    return Module(())
+
+
 def program_part(module: Module, waypoints: frozenset[str]) -> Module:
     """The top-level statements of the program's def from the first global of a waypoint of
     the program (``waypoints``: their names in the .urp), definition or marker on."""
@@ -203,7 +213,8 @@ def main(argv: list[str] | None = None) -> int:
         st = stats.setdefault(split, {"n": 0, "exact": 0, "exact_prog": 0, "share": 0.0,
                                       "share_prog": 0.0, "errors": collections.Counter(),
                                       "kinds": collections.Counter(), "missing": 0,
-                                      "not_polyscope": 0})
+                                      "not_polyscope": 0, "pre_total": 0, "pre_found": 0,
+                                      "pre_extra": 0})
         gitdir = git_dir(args.repos, repo)
         urp = git_show(gitdir, commit, urp_path)
         script = git_show(gitdir, commit, script_path)
@@ -250,6 +261,11 @@ def main(argv: list[str] | None = None) -> int:
                           if node.kind == "Waypoint" and node.name)
         theirs_prog = canonical_lines(program_part(theirs_tree, names))
         ours_prog = canonical_lines(program_part(ours_tree, names))
+        theirs_pre = collections.Counter(canonical_lines(preamble_part(theirs_tree, names)))
+        ours_pre = collections.Counter(canonical_lines(preamble_part(ours_tree, names)))
+        st["pre_total"] += sum(theirs_pre.values())
+        st["pre_found"] += sum((theirs_pre & ours_pre).values())
+        st["pre_extra"] += sum((ours_pre - theirs_pre).values())
         share = compare(ours, theirs)
         share_prog = compare(ours_prog, theirs_prog)
         st["share"] += share
@@ -275,6 +291,9 @@ def main(argv: list[str] | None = None) -> int:
               f"exact {st['exact'] / n:.1%} whole, {st['exact_prog'] / n:.1%} program part; "
               f"mean matching lines {st['share'] / n:.1%} whole, "
               f"{st['share_prog'] / n:.1%} program part")
+        print(f"  preamble statements (any order; PolyScope's block order changes from save "
+              f"to save): {st['pre_found']} of {st['pre_total']} written "
+              f"({st['pre_found'] / max(st['pre_total'], 1):.1%}), {st['pre_extra']} extra")
         if st["errors"]:
             print("  not compiled: " + "; ".join(f"{k} ({v})" for k, v in
                                                  st["errors"].most_common(5)))

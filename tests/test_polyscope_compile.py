@@ -48,6 +48,14 @@ def test_the_text_is_the_printers_and_reads_back(compiled):
     text = compiled.text
     assert text.startswith("def celltest1():\n")  # the name without . and space
     assert print_tree(parse(text)) == text
+    assert compile_program(read_urp(CELL), read_installation(DATA / "cell.installation")
+                           ).text == text  # generated ids are the same every time
+
+
+def test_the_step_counter_thread_of_polyscope_5(lines):
+    assert lines[1].startswith("step_count_") and lines[1].endswith(" = 0.0")
+    assert lines[2].startswith("thread Step_Counter_Thread_")
+    assert lines[8].startswith("run Step_Counter_Thread_")
 
 
 def test_markers_are_numbered_in_program_order_with_flags(lines):
@@ -65,7 +73,7 @@ def test_markers_are_numbered_in_program_order_with_flags(lines):
 
 
 def test_waypoint_globals_are_calibrated_forward_kinematics(lines):
-    tree = parse("\n".join(lines[1:5]))
+    tree = parse("\n".join(line for line in lines if line.startswith("global Waypoint_")))
     names = [item.name for item in tree.body]
     assert names == ["Waypoint_1_p", "Waypoint_1_q", "Waypoint_2_p", "Waypoint_2_q"]
     pose = [float(print_tree(v)) for v in tree.body[0].value.items]
@@ -187,3 +195,29 @@ def test_show_command_prints_the_tree_with_numbers(tmp_path, capsys):
     assert "  23     Wait  (suppressed)" in out or any(
         line.startswith("  23") and "(suppressed)" in line for line in out)
     assert any("Grip  [URCap Example_Gripper]" in line for line in out)
+
+
+def test_the_preamble_from_the_installation(lines):
+    start = lines.index("set_safety_mode_transition_hardness(1)")
+    end = lines.index("set_tcp(p[0.0, 0.0, 0.1, 0.0, 0.0, 0.0])")
+    assert lines[start + 1:end] == [
+        "set_tool_communication(True, 115200, 0, 1, 1.5, 3.5)",
+        "set_tool_output_mode(0)",
+        "set_tool_digital_output_mode(0, 1)",
+        "set_tool_digital_output_mode(1, 2)",
+        "set_tool_voltage(24)",
+        "set_gravity([0.0, 0.0, 9.82])",
+        "set_standard_analog_input_domain(0, 1)",
+        "set_standard_analog_input_domain(1, 0)",
+        "set_tool_analog_input_domain(0, 1)",
+        "set_tool_analog_input_domain(1, 1)",
+        "set_analog_outputdomain(0, 0)",
+        "set_analog_outputdomain(1, 1)",
+        "set_input_actions_to_default()",
+        'set_tool_digital_input_action(0, "freedrive")',
+        'set_standard_digital_input_action(2, "pause")',
+        "set_target_payload(1.25, [0.002, 0.001, 0.051], "
+        "[0.002233, 0.002233, 0.002233, 0.0, 0.0, 0.0])",
+    ]
+    assert end < lines.index("global Waypoint_1_p = p[-0.8171999999999999, -0.2329, "
+                             "0.06280000000000001, 1.5707963267948966, 0.0, 0.0]")

@@ -84,6 +84,10 @@ class Installation:
     active_payload: str | None = None
     mounting: tuple[float, float] | None = None
     version: str | None = None
+    settings: dict[str, dict[str, str]] | None = None
+    """Raw attributes of the settings the program's preamble is written from: element tag
+    (``SmoothTransitionSettings``, ``ToolCommSettings``, and ``IOs/NAME`` for the I/O
+    settings such as ``IOs/analogInputRange``) → attributes as written."""
     io_names: tuple[tuple[str, str], ...] = ()
     """The I/O names the user gave: (name, pin) pairs, pin as PolyScope refers to it
     (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``)."""
@@ -198,7 +202,7 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
     if element is not None and element.get("major") is not None:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
-                        mounting, version, _io_names(root))
+                        mounting, version, _settings(root), _io_names(root))
 
 
 _IO_BANKS = {
@@ -209,6 +213,23 @@ _IO_BANKS = {
     "ToolAnalogInputNames": "tool_analog_in",
 }
 """``<IOs>`` name lists (comma-separated, empty for an unnamed pin) and the pins they name."""
+
+
+def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
+    settings: dict[str, dict[str, str]] = {}
+    for tag in ("SmoothTransitionSettings", "ToolCommSettings"):
+        element = root.find(tag)
+        if element is not None:
+            settings[tag] = dict(element.attrib)
+    ios = root.find("IOs")
+    if ios is not None:
+        for element in ios:
+            if "value" in element.attrib:
+                settings[f"IOs/{element.tag}"] = dict(element.attrib)
+    for element in root.iter("Payload"):
+        if element.get("inertiaParameters"):
+            settings[f"Payload/{element.get('name', '')}"] = dict(element.attrib)
+    return settings
 
 
 def _io_names(root: ElementTree.Element) -> tuple[tuple[str, str], ...]:
