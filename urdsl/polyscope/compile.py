@@ -151,14 +151,15 @@ def _matrix_to_rotvec(m: np.ndarray) -> np.ndarray:
     if angle < 1e-12:
         return np.zeros(3)
     if math.pi - angle < 1e-6:
-        # near π the antisymmetric part vanishes: take the axis from the symmetric part
+        # near π the antisymmetric part vanishes: take the axis from the symmetric part,
+        # its largest component positive (as PolyScope writes a half turn [U: one project])
         b = (m + np.eye(3)) / 2.0
         column = int(np.argmax(np.diag(b)))
         axis = b[:, column] / math.sqrt(b[column, column])
-        if sin2 > 1e-300:  # keep the sign the antisymmetric part still shows
-            anti = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
-            if float(anti @ axis) < 0:
-                axis = -axis
+        axis = axis / np.linalg.norm(axis)
+        if math.pi - angle > 1e-9 and float(axis @ np.array(
+                [m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])) < 0:
+            axis = -axis  # not quite a half turn: the antisymmetric part gives the sign
         return axis * angle
     return axis / sin2 * angle
 
@@ -960,7 +961,7 @@ class _Compiler:
         for until in sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION"):
             kind = until.attrs.get("type", "")
             if kind == "TOOL_CONTACT_DETECTION":
-                loop.extend(self._tool_contact(until, handle))
+                loop.extend(self._tool_contact(until, handle, accel))
                 continue
             done: list[Item] = [Join(Name(handle))]
             if kind != "DISTANCE":
@@ -976,10 +977,12 @@ class _Compiler:
         items.extend(self.block(others))
         return items
 
-    def _tool_contact(self, until: Node, handle: str) -> list[Item]:
+    def _tool_contact(self, until: Node, handle: str, accel: float | None) -> list[Item]:
         """The wait of a Direction that stops on tool contact: back off along the way it
-        came by ``retraction`` (m), decelerating at ``decelerationAcceleration`` (m/s²)."""
-        decel = float(until.attrs.get("decelerationAcceleration", "3.0"))
+        came by ``retraction`` (m), decelerating at ``decelerationAcceleration`` (m/s²; older
+        files have none: the Direction's own acceleration)."""
+        decel = float(until.attrs.get("decelerationAcceleration",
+                                      accel if accel is not None else 3.0))
         retraction = float(until.attrs.get("retraction", "0.0"))
         direction = Name("targetTcpDirection")
         normalized = Name("normalizedPosDir")
