@@ -213,7 +213,8 @@ def main(argv: list[str] | None = None) -> int:
         st = stats.setdefault(split, {"n": 0, "exact": 0, "exact_prog": 0, "share": 0.0,
                                       "share_prog": 0.0, "errors": collections.Counter(),
                                       "kinds": collections.Counter(), "missing": 0,
-                                      "not_polyscope": 0, "pre_total": 0, "pre_found": 0,
+                                      "not_polyscope": 0, "exact_any": 0, "pre_total": 0,
+                                      "pre_found": 0,
                                       "pre_extra": 0})
         gitdir = git_dir(args.repos, repo)
         urp = git_show(gitdir, commit, urp_path)
@@ -272,6 +273,7 @@ def main(argv: list[str] | None = None) -> int:
         st["share_prog"] += share_prog
         st["exact"] += ours == theirs
         st["exact_prog"] += ours_prog == theirs_prog
+        st["exact_any"] += ours_prog == theirs_prog and theirs_pre == ours_pre
         if ours_prog != theirs_prog:
             for kind in compiled.kinds_in_diff(ours_prog, theirs_prog):
                 st["kinds"][kind] += 1
@@ -291,6 +293,7 @@ def main(argv: list[str] | None = None) -> int:
               f"exact {st['exact'] / n:.1%} whole, {st['exact_prog'] / n:.1%} program part; "
               f"mean matching lines {st['share'] / n:.1%} whole, "
               f"{st['share_prog'] / n:.1%} program part")
+        print(f"  exact with the preamble compared in any order: {st['exact_any'] / n:.1%}")
         print(f"  preamble statements (any order; PolyScope's block order changes from save "
               f"to save): {st['pre_found']} of {st['pre_total']} written "
               f"({st['pre_found'] / max(st['pre_total'], 1):.1%}), {st['pre_extra']} extra")
