@@ -215,7 +215,6 @@ def test_the_preamble_from_the_installation(lines):
         "set_analog_outputdomain(1, 1)",
         "set_input_actions_to_default()",
         'set_tool_digital_input_action(0, "freedrive")',
-        'set_standard_digital_input_action(2, "pause")',
         "set_target_payload(1.25, [0.002, 0.001, 0.051], "
         "[0.002233, 0.002233, 0.002233, 0.0, 0.0, 0.0])",
     ]

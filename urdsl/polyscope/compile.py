@@ -477,10 +477,9 @@ class _Compiler:
             items.append(_stmt("set_analog_outputdomain", Number(index), Number(domain)))
         if "IOs/DigitalInputActions" in settings:
             items.append(_stmt("set_input_actions_to_default"))
-            for key, function in (("ToolDigitalInputActions", "set_tool_digital_input_action"),
-                                  ("DigitalInputActions", "set_standard_digital_input_action"),
-                                  ("ConfigurableInputActions",
-                                   "set_configurable_digital_input_action")):
+            # only the tool inputs' actions are written (seen: "freedrive"); the controller
+            # keeps the standard and configurable inputs' actions itself
+            for key, function in (("ToolDigitalInputActions", "set_tool_digital_input_action"),):
                 actions = settings.get(f"IOs/{key}", {}).get("value", "").split(",")
                 for index, action in enumerate(a.strip() for a in actions):
                     if action and action != "NONE":

@@ -179,8 +179,11 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
             tcps.append(Tcp(name, _numbers(element.get("offset"), 6, f"TCP {name!r} offset",
                                            path)))
         if settings.get("toolPayload") is not None:
+            cog = settings.get("centerOfGravity")
             payloads.append(Payload("Payload", _number(settings.get("toolPayload"),
-                                                       "toolPayload", path)))
+                                                       "toolPayload", path),
+                                    _numbers(cog, 3, "payload centre of gravity", path)
+                                    if cog else None))  # type: ignore[arg-type]
     for element in root.iter("Payload"):
         name = element.get("name") or f"Payload {len(payloads) + 1}"
         cog = element.get("centerOfGravity")
