@@ -33,7 +33,11 @@ from pathlib import Path, PurePosixPath
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from urdsl.polyscope.compile import CompileError, compile_program  # noqa: E402
+from urdsl.polyscope.compile import (  # noqa: E402
+    CompileError,
+    compile_program,
+    parse_variables,
+)
 from urdsl.polyscope.installation import InstallationError, parse_installation  # noqa: E402
 from urdsl.polyscope.urp import UrpError, parse_urp  # noqa: E402
 from urdsl.script import parse  # noqa: E402
@@ -241,6 +245,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             program = parse_urp(urp, urp_path)
             installation = None
+            variables: list[tuple[str, str]] = []
             if program.installation:
                 folder = PurePosixPath(urp_path).parent
                 data = git_show(gitdir, commit, str(folder / f"{program.installation}"
@@ -250,7 +255,11 @@ def main(argv: list[str] | None = None) -> int:
                         installation = parse_installation(data, program.installation)
                     except InstallationError:
                         installation = None
-            compiled = compile_program(program, installation)
+                text = git_show(gitdir, commit, str(folder / f"{program.installation}"
+                                                             ".variables"))
+                if installation is not None and text is not None:
+                    variables = parse_variables(text)
+            compiled = compile_program(program, installation, variables)
             ours_tree = _clean(parse(strip_urcap_text(compiled.text), "compiled")
                                if by_text else compiled.module)
         except (UrpError, CompileError) as error:

@@ -220,3 +220,25 @@ def test_the_preamble_from_the_installation(lines):
     ]
     assert end < lines.index("global Waypoint_1_p = p[-0.8171999999999999, -0.2329, "
                              "0.06280000000000001, 1.5707963267948966, 0.0, 0.0]")
+
+
+def test_installation_variables_and_point_features_follow_the_settings():
+    from urdsl.polyscope.compile import parse_variables
+    from urdsl.polyscope.installation import parse_installation
+
+    installation = parse_installation(
+        b'<Installation><Features><GeomPoseNode><GeomPoseNode name="Pick" isVariable="true">'
+        b'<toolPosition value="0.1, 0.2, 0.3"/><toolAxisAngle value="0.0, 3.14, 0.0"/>'
+        b'</GeomPoseNode></GeomPoseNode><GeomPoseNode><GeomPoseNode name="Above">'
+        b'<toolPosition value="0.1, 0.2, 0.5"/><toolAxisAngle value="0.0, 3.14, 0.0"/>'
+        b'</GeomPoseNode></GeomPoseNode></Features></Installation>', "cell.installation")
+    variables = parse_variables(gzip.compress(b"#saved\ncount=3\nhome=p[0, 0, 0.1, 0, 0, 0]\n"))
+    assert variables == [("count", "3"), ("home", "p[0, 0, 0.1, 0, 0, 0]")]
+    assert parse_variables(b'<InstallationVariables><variable name="n" value="2"/>'
+                           b'</InstallationVariables>') == [("n", "2")]
+    text = compile_program(read_urp(DATA / "moves.urp"), installation, variables).text
+    lines = [line.strip() for line in text.splitlines()]
+    at = lines.index("global count = 3")
+    assert lines[at + 1:at + 4] == ["global home = p[0, 0, 0.1, 0, 0, 0]",
+                                    "global Above = p[0.1, 0.2, 0.5, 0.0, 3.14, 0.0]",
+                                    "global Pick = p[0.1, 0.2, 0.3, 0.0, 3.14, 0.0]"]

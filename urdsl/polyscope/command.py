@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .compile import Compiled, CompileError, compile_program
+from .compile import Compiled, CompileError, compile_program, parse_variables
 from .installation import Installation, InstallationError, find_installation, read_installation
 from .urp import Node, Program, UrpError, read_urp
 
@@ -36,10 +36,19 @@ def _installation_for(program: Program, path: str | Path) -> Installation | None
 
 
 def load(path: str | Path) -> tuple[Program, Compiled]:
-    """Read and compile the ``.urp`` at ``path``. Raises :class:`UrpError` or
-    :class:`CompileError` (messages name the file and node)."""
+    """Read and compile the ``.urp`` at ``path`` with its installation and the
+    installation's variables. Raises :class:`UrpError` or :class:`CompileError` (messages
+    name the file and node)."""
     program = read_urp(path)
-    return program, compile_program(program, _installation_for(program, path))
+    installation = _installation_for(program, path)
+    variables: list[tuple[str, str]] = []
+    if installation is not None:
+        file = Path(installation.path).with_suffix(".variables")
+        try:
+            variables = parse_variables(file.read_bytes())
+        except OSError:
+            variables = []
+    return program, compile_program(program, installation, variables)
 
 
 def compile_urp(path: str, output: str | None) -> int:

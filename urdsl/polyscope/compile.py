@@ -27,10 +27,13 @@ Marker labels are the English ones; PolyScope writes them in the language it run
 
 from __future__ import annotations
 
+import gzip
 import math
 import re
 import uuid
+import zlib
 from dataclasses import dataclass, field
+from xml.etree import ElementTree
 
 import numpy as np
 
@@ -77,7 +80,7 @@ from ..script.printer import format as print_tree
 from .installation import Installation
 from .urp import Expression, Kinematics, Node, Program
 
-__all__ = ["CompileError", "Compiled", "compile_program", "waypoint_pose"]
+__all__ = ["CompileError", "Compiled", "compile_program", "parse_variables", "waypoint_pose"]
 
 
 class CompileError(Exception):
@@ -315,16 +318,47 @@ def _num(value: float) -> Expr:
     return literal(float(value))
 
 
-def compile_program(program: Program, installation: Installation | None = None) -> Compiled:
-    """Compile ``program`` as PolyScope does. Raises :class:`CompileError` naming the file
-    and node for a node it cannot compile."""
-    return _Compiler(program, installation).run()
+def compile_program(program: Program, installation: Installation | None = None,
+                    variables: list[tuple[str, str]] | None = None) -> Compiled:
+    """Compile ``program`` as PolyScope does, with its installation and the installation's
+    variables (``NAME.variables`` beside it: (name, value as written) pairs, see
+    :func:`parse_variables`). Raises :class:`CompileError` naming the file and node for a
+    node it cannot compile."""
+    return _Compiler(program, installation, variables or []).run()
+
+
+def parse_variables(data: bytes) -> list[tuple[str, str]]:
+    """The installation variables of a ``.variables`` file (Java properties: ``name=value``
+    lines, ``#`` comments; gzip-compressed or plain) in file order."""
+    if data[:2] == b"\x1f\x8b":
+        try:
+            data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error):
+            return []
+    text = data.decode("utf-8", "replace")
+    if text.lstrip().startswith("<"):  # PolyScope 5.x later: XML
+        try:
+            root = ElementTree.fromstring(text)
+        except ElementTree.ParseError:
+            return []
+        return [(v.get("name", ""), v.get("value", "")) for v in root.iter("variable")
+                if v.get("name")]
+    out = []
+    for line in text.splitlines():
+        line = line.strip()
+        if not line or line.startswith(("#", "!")) or "=" not in line:
+            continue
+        name, value = line.split("=", 1)
+        out.append((name.strip(), value.strip()))
+    return out
 
 
 class _Compiler:
-    def __init__(self, program: Program, installation: Installation | None) -> None:
+    def __init__(self, program: Program, installation: Installation | None,
+                 variables: list[tuple[str, str]]) -> None:
         self.program = program
         self.installation = installation
+        self.variables = variables
         self.numbers: dict[int, Node] = {}
         self.number_of: dict[int, int] = {}
         self.waypoints: dict[str, Node] = {}
@@ -500,6 +534,13 @@ class _Compiler:
         tcp = installation.tcp
         if tcp is not None:
             items.append(_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset))))
+        for name, value in self.variables:
+            try:
+                items.append(Declare("global", name, self.expr(value, self.program.main)))
+            except CompileError:  # not a value URScript reads: PolyScope would not run it
+                items.append(Comment(f" urdsl: installation variable {name} is not URScript"))
+        for name, pose in sorted(installation.features or ()):
+            items.append(Declare("global", name, Pose(tuple(_num(v) for v in pose))))
         return items
 
     def step_counter(self) -> list[Item]:

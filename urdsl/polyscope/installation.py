@@ -88,6 +88,9 @@ class Installation:
     """Raw attributes of the settings the program's preamble is written from: element tag
     (``SmoothTransitionSettings``, ``ToolCommSettings``, and ``IOs/NAME`` for the I/O
     settings such as ``IOs/analogInputRange``) → attributes as written."""
+    features: tuple[tuple[str, tuple[float, ...]], ...] = ()
+    """Named point features (``GeomPoseNode``): (name, pose in the base frame: x, y, z in m,
+    rotation vector in rad), in file order."""
     io_names: tuple[tuple[str, str], ...] = ()
     """The I/O names the user gave: (name, pin) pairs, pin as PolyScope refers to it
     (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``)."""
@@ -205,7 +208,8 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
     if element is not None and element.get("major") is not None:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
-                        mounting, version, _settings(root), _io_names(root))
+                        mounting, version, _settings(root), _features(root, path),
+                        _io_names(root))
 
 
 _IO_BANKS = {
@@ -216,6 +220,22 @@ _IO_BANKS = {
     "ToolAnalogInputNames": "tool_analog_in",
 }
 """``<IOs>`` name lists (comma-separated, empty for an unnamed pin) and the pins they name."""
+
+
+def _features(root: ElementTree.Element, path: str) -> tuple[tuple[str, tuple[float, ...]], ...]:
+    features = []
+    block = root.find("Features")
+    if block is None:
+        return ()
+    for element in block.iter("GeomPoseNode"):
+        name = element.get("name")
+        position, axis = element.find("toolPosition"), element.find("toolAxisAngle")
+        if not name or element.get("hiddenSubFeature") == "true" or position is None \
+                or axis is None:
+            continue
+        features.append((name, _numbers(position.get("value"), 3, f"feature {name!r}", path)
+                         + _numbers(axis.get("value"), 3, f"feature {name!r}", path)))
+    return tuple(features)
 
 
 def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
