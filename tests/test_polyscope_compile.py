@@ -242,3 +242,12 @@ def test_installation_variables_and_point_features_follow_the_settings():
     assert lines[at + 1:at + 4] == ["global home = p[0, 0, 0.1, 0, 0, 0]",
                                     "global Above = p[0.1, 0.2, 0.5, 0.0, 3.14, 0.0]",
                                     "global Pick = p[0.1, 0.2, 0.3, 0.0, 3.14, 0.0]"]
+
+
+def test_show_lines_puts_each_nodes_script_under_it(tmp_path, capsys):
+    for name in ("cell.urp", "cell.installation"):
+        shutil.copy(DATA / name, tmp_path / name)
+    assert main(["show", "--lines", str(tmp_path / "cell.urp")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    at = out.index("  13     Set gripper=On")
+    assert out[at + 1].strip() == "| set_standard_digital_out(2, True)"

@@ -74,10 +74,27 @@ def compile_urp(path: str, output: str | None) -> int:
     return EXIT_OK
 
 
-def tree_lines(program: Program, compiled: Compiled) -> list[str]:
+def _generated(compiled: Compiled) -> dict[int, list[str]]:
+    """Marker number → the script lines after that marker up to the next one."""
+    out: dict[int, list[str]] = {}
+    current: list[str] | None = None
+    for line in compiled.text.splitlines():
+        stripped = line.strip()
+        if stripped.startswith("$ "):
+            number = stripped[2:].split(" ", 1)[0]
+            current = out.setdefault(int(number), []) if number.isdigit() else None
+        elif current is not None and stripped not in ("end", "else:") and stripped \
+                and not stripped.startswith("#"):
+            current.append(stripped)
+    return out
+
+
+def tree_lines(program: Program, compiled: Compiled, with_lines: bool = False) -> list[str]:
     """The program tree as PolyScope shows it, one node a line, with its marker number
-    (``suppressed`` nodes marked, URCap nodes with their URCap's name)."""
+    (``suppressed`` nodes marked, URCap nodes with their URCap's name); ``with_lines``: each
+    node followed by the script lines it generates."""
     numbers = {id(node): number for number, node in compiled.numbers.items()}
+    generated = _generated(compiled) if with_lines else {}
     lines = [f"Program {program.name}  (saved by PolyScope {program.saved_in or '?'}, "
              f"installation {program.installation or '?'})"]
 
@@ -92,6 +109,8 @@ def tree_lines(program: Program, compiled: Compiled) -> list[str]:
             label += "  (suppressed)"
         prefix = f"{number:>4} " if number is not None else "     "
         lines.append(f"{prefix}{'  ' * depth}{label}")
+        for code in generated.get(number, []) if number is not None else []:
+            lines.append(f"     {'  ' * depth}  | {code}")
         if node.kind != "CallSubProgram":
             for child in node.children:
                 show(child, depth + 1)
@@ -107,6 +126,8 @@ def add_commands(commands) -> None:
                             "as PolyScope shows it, each node with the number of its `$` "
                             "marker in the compiled script (`urdsl compile X.urp`).")
     p.add_argument("program", metavar="PROGRAM.urp")
+    p.add_argument("--lines", action="store_true",
+                   help="under each node, the script lines it generates")
     p.set_defaults(run=cmd_show)
 
 
@@ -123,5 +144,5 @@ def cmd_show(args: argparse.Namespace) -> int:
     except (UrpError, CompileError) as error:
         print(str(error), file=sys.stderr)
         return EXIT_PROBLEMS
-    sys.stdout.write("\n".join(tree_lines(program, compiled)) + "\n")
+    sys.stdout.write("\n".join(tree_lines(program, compiled, args.lines)) + "\n")
     return EXIT_OK
