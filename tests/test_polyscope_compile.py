@@ -251,3 +251,23 @@ def test_show_lines_puts_each_nodes_script_under_it(tmp_path, capsys):
     out = capsys.readouterr().out.splitlines()
     at = out.index("  13     Set gripper=On")
     assert out[at + 1].strip() == "| set_standard_digital_out(2, True)"
+
+
+def test_operator_assignment_and_an_undefined_expression():
+    from urdsl.polyscope.urp import parse_urp
+
+    def program(assignment: str) -> bytes:
+        return (b'<URProgram name="p" lastSavedIn="5.9.1"><children><MainProgram '
+                b'runOnlyOnce="true"><children>' + assignment.encode() +
+                b'</children></MainProgram></children></URProgram>')
+
+    text = compile_program(parse_urp(program(
+        '<Assignment valueSource="Operator" message="Part number?" valueType="String">'
+        '<variable name="part"/></Assignment>'), "p.urp")).text
+    assert 'global part = request_string_from_primary_client("Part number?")' in text
+    with pytest.raises(CompileError) as error:
+        compile_program(parse_urp(program(
+            '<Assignment valueSource="Expression"><variable name="x"/><expression/>'
+            '</Assignment>'), "p.urp"))
+    assert str(error.value).startswith("p.urp: error: node Robot Program > x: the node has "
+                                       "no expression")

@@ -444,6 +444,9 @@ class _Compiler:
         return CompileError(f"{self.program.path}: error: node {node.path}: {message}")
 
     def expr(self, text: str, node: Node) -> Expr:
+        if not text.strip():
+            raise self.error(node, "the node has no expression (PolyScope shows it as not "
+                                   "defined and will not run the program)")
         try:
             module = parse(text, self.program.path)
         except ScriptError as error:
@@ -807,6 +810,13 @@ class _Compiler:
     def n_Assignment(self, node: Node) -> list[Item]:
         expression = node.fields["expression"]
         name = node.name or "var"
+        if node.fields.get("source") == "Operator":
+            # the operator types the value in; the form is unconfirmed [U]
+            kind = str(node.fields.get("value_type") or "Integer").lower()
+            message = str(node.fields.get("message", ""))
+            return [self.marker(node, f"{name}≔Operator"),
+                    Declare("global", name, _call(f"request_{kind}_from_primary_client",
+                                                  String(message.replace('"', "'"))))]
         label = f"{name}≔{expression.label}"
         return [self.marker(node, label),
                 Declare("global", name, self.expr(self.script_of(expression, node), node))]

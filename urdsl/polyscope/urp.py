@@ -508,6 +508,8 @@ def _assignment(reader: _Reader, node: Node, element: ElementTree.Element) -> No
         node.name = target.get("name") or target.get("featureName")
         node.fields["persistent"] = target.get("prefersPersistentValue") == "true"
     node.fields["source"] = element.get("valueSource", "Expression")
+    node.fields["message"] = element.get("message", "")
+    node.fields["value_type"] = element.get("valueType", "")
     node.fields["expression"] = reader.expression(element.find("expression"))
 
 
