@@ -271,3 +271,22 @@ def test_operator_assignment_and_an_undefined_expression():
             '</Assignment>'), "p.urp"))
     assert str(error.value).startswith("p.urp: error: node Robot Program > x: the node has "
                                        "no expression")
+
+
+def test_safe_home_moves_to_the_installations_position():
+    from urdsl.polyscope.installation import parse_installation
+    from urdsl.polyscope.urp import parse_urp
+
+    program = parse_urp(
+        b'<URProgram name="p" lastSavedIn="5.11.1"><children><MainProgram runOnlyOnce="true">'
+        b'<children><Move motionType="MoveJ" speed="1.0" acceleration="1.4"><children>'
+        b'<SafeHome positionOptionType="SPEED_AND_ACCELERATION" speed="1.05" '
+        b'acceleration="1.4" nextMotionTime="2.0"/></children></Move></children>'
+        b'</MainProgram></children></URProgram>', "p.urp")
+    installation = parse_installation(
+        b'<Installation><SafeHomeSettings enabled="true" position="0.1, -1.5, 1.5, -1.5, '
+        b'-1.5, 0.0"/></Installation>', "i")
+    text = compile_program(program, installation).text
+    assert "movej([0.1, -1.5, 1.5, -1.5, -1.5, 0.0], a=1.4, v=1.05)" in text
+    with pytest.raises(CompileError, match="safe home position is unknown"):
+        compile_program(program)

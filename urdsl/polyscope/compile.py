@@ -1065,6 +1065,24 @@ class _Compiler:
                     Call(Name("tool_contact"), (), (Keyword("direction", direction),))),
             If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), found)]
 
+    def n_SafeHome(self, node: Node) -> list[Item]:
+        """A move to the installation's safe home joint positions (rad)."""
+        settings = (self.installation.settings or {}) if self.installation else {}
+        position = settings.get("SafeHomeSettings", {}).get("position")
+        if not position:
+            raise self.error(node, "the installation's safe home position is unknown "
+                                   "(no installation with SafeHomeSettings beside the program)")
+        joints = List(tuple(_num(float(v)) for v in position.split(",")))
+        keywords: list[Keyword] = []
+        if node.attrs.get("positionOptionType") == "TIME" and node.attrs.get("nextMotionTime"):
+            keywords.append(Keyword("t", _num(float(node.attrs["nextMotionTime"]))))
+        else:
+            for key, attr in (("a", "acceleration"), ("v", "speed")):
+                if node.attrs.get(attr):
+                    keywords.append(Keyword(key, _num(float(node.attrs[attr]))))
+        return [self.marker(node, "Home"),
+                ExprStmt(Call(Name("movej"), (joints,), tuple(keywords)))]
+
     def n_Force(self, node: Node) -> list[Item]:
         """Force mode around the node's children: selected axes are compliant (limited by
         the speed limits, m/s and rad/s), the others by the allowed deviation (m, rad)."""

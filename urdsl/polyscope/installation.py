@@ -240,7 +240,7 @@ def _features(root: ElementTree.Element, path: str) -> tuple[tuple[str, tuple[fl
 
 def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
     settings: dict[str, dict[str, str]] = {}
-    for tag in ("SmoothTransitionSettings", "ToolCommSettings"):
+    for tag in ("SmoothTransitionSettings", "ToolCommSettings", "SafeHomeSettings"):
         element = root.find(tag)
         if element is not None:
             settings[tag] = dict(element.attrib)
