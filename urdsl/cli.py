@@ -214,6 +214,7 @@ _COMMAND_MODULES: list[str] = [
     "urdsl.robot.command",
     "urdsl.sim.command",
     "urdsl.lint.command",
+    "urdsl.polyscope.command",
 ]
 """Modules whose ``add_commands(subparsers)`` adds their ``urdsl`` subcommands."""
 

@@ -19,6 +19,9 @@ Program named `program`, or a function main() that returns one; it is run as Pyt
 your program), with __name__ set to "__urdsl__" so that an `if __name__ == "__main__":`
 block does not run. The output is exactly what `urdsl fmt` prints for it.
 
+A PolyScope program (.urp) is compiled as PolyScope does (its installation is read from
+the same folder when it is there); see `urdsl show X.urp` for its program tree.
+
 Exit status: 0 compiled, 1 the program has a mistake (shown with file:line), 2 usage errors.
 """
 
@@ -27,6 +30,7 @@ examples:
   urdsl compile programs/pick_and_place.py
   urdsl compile programs/toolpath.py -o toolpath.script
   urdsl compile programs/palletizing.py | urdsl check - --robot ur10e
+  urdsl compile usbdisk/pick.urp -o pick.script
 """
 
 
@@ -72,10 +76,12 @@ def _where(error: Exception, path: Path) -> str:
 
 
 def add_commands(commands) -> None:
-    p = commands.add_parser("compile", help="compile a Python DSL program to URScript",
+    p = commands.add_parser("compile", help="compile a Python DSL program or a PolyScope "
+                            "program (.urp) to URScript",
                             description=_DESCRIPTION, epilog=_EPILOG,
                             formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("program", metavar="PROGRAM.py", help="a Python file using urdsl.dsl")
+    p.add_argument("program", metavar="PROGRAM.py|PROGRAM.urp",
+                   help="a Python file using urdsl.dsl, or a PolyScope program")
     p.add_argument("-o", "--output", metavar="OUT.script",
                    help="write the URScript here instead of standard output")
     p.set_defaults(run=cmd_compile)
@@ -84,6 +90,14 @@ def add_commands(commands) -> None:
 def cmd_compile(args: argparse.Namespace) -> int:
     from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
 
+    suffix = Path(args.program).suffix.lower()
+    if suffix == ".urp":  # a PolyScope program: compiled as PolyScope does
+        from ..polyscope.command import compile_urp
+
+        return compile_urp(args.program, args.output)
+    if suffix != ".py":
+        raise UsageError(f"cannot compile {args.program}: urdsl compile takes a Python DSL "
+                         "program (.py) or a PolyScope program (.urp)")
     try:
         program = load_program(args.program)
         text = program.script()

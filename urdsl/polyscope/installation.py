@@ -84,6 +84,16 @@ class Installation:
     active_payload: str | None = None
     mounting: tuple[float, float] | None = None
     version: str | None = None
+    settings: dict[str, dict[str, str]] | None = None
+    """Raw attributes of the settings the program's preamble is written from: element tag
+    (``SmoothTransitionSettings``, ``ToolCommSettings``, and ``IOs/NAME`` for the I/O
+    settings such as ``IOs/analogInputRange``) → attributes as written."""
+    features: tuple[tuple[str, tuple[float, ...]], ...] = ()
+    """Named point features (``GeomPoseNode``): (name, pose in the base frame: x, y, z in m,
+    rotation vector in rad), in file order."""
+    io_names: tuple[tuple[str, str], ...] = ()
+    """The I/O names the user gave: (name, pin) pairs, pin as PolyScope refers to it
+    (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``)."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -172,8 +182,11 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
             tcps.append(Tcp(name, _numbers(element.get("offset"), 6, f"TCP {name!r} offset",
                                            path)))
         if settings.get("toolPayload") is not None:
+            cog = settings.get("centerOfGravity")
             payloads.append(Payload("Payload", _number(settings.get("toolPayload"),
-                                                       "toolPayload", path)))
+                                                       "toolPayload", path),
+                                    _numbers(cog, 3, "payload centre of gravity", path)
+                                    if cog else None))  # type: ignore[arg-type]
     for element in root.iter("Payload"):
         name = element.get("name") or f"Payload {len(payloads) + 1}"
         cog = element.get("centerOfGravity")
@@ -195,7 +208,66 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
     if element is not None and element.get("major") is not None:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
-                        mounting, version)
+                        mounting, version, _settings(root), _features(root, path),
+                        _io_names(root))
+
+
+_IO_BANKS = {
+    "DigitalInputNames": "digital_in", "DigitalOutputNames": "digital_out",
+    "ConfigurableInputNames": "configurable_in", "ConfigurableOutputNames": "configurable_out",
+    "ToolDigitalInputNames": "tool_in", "ToolDigitalOutputNames": "tool_out",
+    "AnalogInputNames": "analog_in", "AnalogOutputNames": "analog_out",
+    "ToolAnalogInputNames": "tool_analog_in",
+}
+"""``<IOs>`` name lists (comma-separated, empty for an unnamed pin) and the pins they name."""
+
+
+def _features(root: ElementTree.Element, path: str) -> tuple[tuple[str, tuple[float, ...]], ...]:
+    features = []
+    block = root.find("Features")
+    if block is None:
+        return ()
+    for element in block.iter("GeomPoseNode"):
+        name = element.get("name")
+        position, axis = element.find("toolPosition"), element.find("toolAxisAngle")
+        if not name or element.get("hiddenSubFeature") == "true" or position is None \
+                or axis is None:
+            continue
+        features.append((name, _numbers(position.get("value"), 3, f"feature {name!r}", path)
+                         + _numbers(axis.get("value"), 3, f"feature {name!r}", path)))
+    return tuple(features)
+
+
+def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
+    settings: dict[str, dict[str, str]] = {}
+    for tag in ("SmoothTransitionSettings", "ToolCommSettings", "SafeHomeSettings"):
+        element = root.find(tag)
+        if element is not None:
+            settings[tag] = dict(element.attrib)
+    ios = root.find("IOs")
+    if ios is not None:
+        for element in ios:
+            if "value" in element.attrib:
+                settings[f"IOs/{element.tag}"] = dict(element.attrib)
+    for element in root.iter("Payload"):
+        if element.get("inertiaParameters"):
+            settings[f"Payload/{element.get('name', '')}"] = dict(element.attrib)
+    return settings
+
+
+def _io_names(root: ElementTree.Element) -> tuple[tuple[str, str], ...]:
+    names: list[tuple[str, str]] = []
+    ios = root.find("IOs")
+    if ios is None:
+        return ()
+    for tag, bank in _IO_BANKS.items():
+        element = ios.find(tag)
+        if element is None:
+            continue
+        for index, name in enumerate((element.get("value") or "").split(",")):
+            if name.strip():
+                names.append((name.strip(), f"{bank}[{index}]"))
+    return tuple(names)
 
 
 def _legacy(root: ElementTree.Element, path: str) -> Installation:

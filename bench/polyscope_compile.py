@@ -1,0 +1,318 @@
+"""Benchmark: compile real PolyScope programs (.urp) and compare with the .script PolyScope
+wrote beside them.
+
+Pairs are listed in ``bench/polyscope/pairs.tsv`` (repository, commit, .urp path, .script path,
+licence, split). Files are read from local git directories (``--repos DIR`` holding
+``owner+name`` git dirs, as ``fetch`` leaves them: ``DIR/owner+name/repo`` or a bare git dir
+``DIR/owner+name``); nothing is downloaded. The installation the program names is read from
+the same folder when it is there.
+
+Both scripts are parsed and printed canonically, statement by statement: comments and URCap
+blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare to
+1e-9, PolyScope's generated ids (``_3f89b84f_1daa_...``) are masked, and ``$`` markers
+compare by number and flag (their label text is in the language PolyScope ran in, which the
+.urp does not record). Two views: the whole program, and the program part (the top-level
+statements from the first waypoint global, definition or marker on: what the program tree,
+not the installation, generates).
+
+Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back),
+the share of programs exact, the mean share of matching lines and the node types whose lines
+differ most. ``--show N`` prints the first differing lines of N programs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import difflib
+import re
+import subprocess
+import sys
+from pathlib import Path, PurePosixPath
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from urdsl.polyscope.compile import (  # noqa: E402
+    CompileError,
+    compile_program,
+    parse_variables,
+)
+from urdsl.polyscope.installation import InstallationError, parse_installation  # noqa: E402
+from urdsl.polyscope.urp import UrpError, parse_urp  # noqa: E402
+from urdsl.script import parse  # noqa: E402
+from urdsl.script.diagnostics import ScriptError  # noqa: E402
+from urdsl.script.nodes import (  # noqa: E402
+    Comment,
+    Declare,
+    FunctionDef,
+    Marker,
+    Module,
+    ThreadDef,
+    While,
+)
+from urdsl.script.printer import format as print_tree  # noqa: E402
+
+_ID = re.compile(r"_[0-9a-f]{8}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{12}")
+_NUMBER = re.compile(r"(?<![\w.])(\d+\.\d*|\.\d+|\d+)(e-?\d+)?(?![\w.])", re.IGNORECASE)
+_MARKER = re.compile(r'^(\s*)\$ (\d+) "(?:[^"]*)"(.*)$')
+
+
+def git_dir(repos: Path, repo: str) -> Path:
+    base = repos / repo.replace("/", "+")
+    return base / "repo" if (base / "repo").exists() else base
+
+
+def git_show(gitdir: Path, commit: str, path: str) -> bytes | None:
+    result = subprocess.run(["git", f"--git-dir={gitdir}", "show", f"{commit}:{path}"],
+                            capture_output=True)
+    return result.stdout if result.returncode == 0 else None
+
+
+def strip_urcap_text(text: str) -> str:
+    """The text without the lines from each ``# begin: URCap`` to its ``# end: URCap``
+    (counted in text order: a URCap's nested blocks may end inside a statement it opened)."""
+    out, depth = [], 0
+    for line in text.splitlines():
+        stripped = line.strip()
+        if stripped.startswith("# begin: URCap"):
+            depth += 1
+            continue
+        if stripped.startswith("# end: URCap"):
+            depth = max(0, depth - 1)
+            continue
+        if depth == 0:
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def _strip_urcap(items: tuple) -> list:
+    out, depth = [], 0
+    for item in items:
+        if isinstance(item, Comment):
+            text = item.text.lstrip("#").strip()
+            if text.startswith("begin: URCap"):
+                depth += 1
+            elif text.startswith("end: URCap"):
+                depth = max(0, depth - 1)
+            continue
+        if depth == 0:
+            out.append(item)
+    return out
+
+
+def _clean(module: Module) -> Module:
+    """The module with comments and URCap blocks left out, at every level."""
+    def block(items):
+        kept = []
+        for item in _strip_urcap(items):
+            kept.append(_clean_node(item))
+        return tuple(kept)
+
+    def _clean_node(node):
+        from dataclasses import fields, replace
+        changes = {}
+        for f in fields(node):
+            value = getattr(node, f.name)
+            if f.name in ("body", "orelse") and isinstance(value, tuple):
+                changes[f.name] = block(value)
+            elif f.name == "elifs":
+                changes[f.name] = tuple(replace(e, body=block(e.body)) for e in value)
+        return replace(node, **changes) if changes else node
+
+    return Module(block(module.body))
+
+
+def _number(match: re.Match) -> str:
+    value = float(match.group(0))
+    return f"{round(value, 9):.9f}".rstrip("0").rstrip(".") or "0"
+
+
+def canonical_lines(module: Module) -> list[str]:
+    """Canonical lines of a cleaned module: printed, ids masked, numbers rounded to 1e-9,
+    marker labels masked."""
+    text = print_tree(module)
+    lines = []
+    for line in text.splitlines():
+        if not line.strip():
+            continue
+        line = _ID.sub("_ID", line)
+        marker = _MARKER.match(line)
+        if marker:
+            line = f"{marker.group(1)}$ {marker.group(2)}{marker.group(3)}"
+        else:
+            line = _NUMBER.sub(_number, line)
+        lines.append(line)
+    return lines
+
+
+def preamble_part(module: Module, waypoints: frozenset[str]) -> Module:
+    """The top-level statements before the program part: what the installation generates."""
+    body = module.body
+    if len(body) == 1 and isinstance(body[0], FunctionDef):
+        items = body[0].body
+        rest = program_part(module, waypoints).body
+        return Module(items[:len(items) - len(rest)])
+    return Module(())
+
+
+def program_part(module: Module, waypoints: frozenset[str]) -> Module:
+    """The top-level statements of the program's def from the first global of a waypoint of
+    the program (``waypoints``: their names in the .urp), definition or marker on."""
+    body = module.body
+    if len(body) == 1 and isinstance(body[0], FunctionDef):
+        items = body[0].body
+        for index, item in enumerate(items):
+            if isinstance(item, Marker) or (
+                    isinstance(item, (FunctionDef, ThreadDef)) and not _ID.search(item.name)) \
+                    or isinstance(item, While) \
+                    or (isinstance(item, Declare) and re.sub(r"(_from|_to)?_[pq]$", "", item.name)
+                        in waypoints and item.name != re.sub(r"_[pq]$", "", item.name)):
+                return Module(items[index:])
+        return Module(())
+    return module
+
+
+def _walk_items(module: Module):
+    stack = list(module.body)
+    while stack:
+        item = stack.pop()
+        yield item
+        for name in ("body", "orelse"):
+            value = getattr(item, name, None)
+            if isinstance(value, tuple):
+                stack.extend(value)
+        for elif_ in getattr(item, "elifs", ()) or ():
+            stack.extend(elif_.body)
+
+
+def compare(ours: list[str], theirs: list[str]) -> float:
+    if not ours and not theirs:
+        return 1.0
+    matcher = difflib.SequenceMatcher(a=theirs, b=ours, autojunk=False)
+    same = sum(block.size for block in matcher.get_matching_blocks())
+    return same / max(len(theirs), len(ours))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--repos", type=Path, default=Path("/work/.mirror"),
+                        help="folder of owner+name git dirs")
+    parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
+    parser.add_argument("--split", choices=("tune", "held", "all"), default="all")
+    parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
+    parser.add_argument("--only", default="", help="only pairs whose .urp path contains this")
+    args = parser.parse_args(argv)
+
+    rows = [line.rstrip("\n").split("\t") for line in args.pairs.read_text().splitlines()
+            if line and not line.startswith("#")]
+    stats: dict[str, dict] = {}
+    shown = 0
+    for repo, commit, urp_path, script_path, _licence, split in rows:
+        if args.split != "all" and split != args.split:
+            continue
+        if args.only and args.only not in urp_path:
+            continue
+        st = stats.setdefault(split, {"n": 0, "exact": 0, "exact_prog": 0, "share": 0.0,
+                                      "share_prog": 0.0, "errors": collections.Counter(),
+                                      "kinds": collections.Counter(), "missing": 0,
+                                      "not_polyscope": 0, "exact_any": 0, "pre_total": 0,
+                                      "pre_found": 0,
+                                      "pre_extra": 0})
+        gitdir = git_dir(args.repos, repo)
+        urp = git_show(gitdir, commit, urp_path)
+        script = git_show(gitdir, commit, script_path)
+        if urp is None or script is None:
+            st["missing"] += 1
+            continue
+        st["n"] += 1
+        reference = script.decode("utf-8", "replace")
+        by_text = True
+        try:
+            theirs_tree = _clean(parse(strip_urcap_text(reference), script_path))
+        except ScriptError:
+            by_text = False  # a URCap block cut a statement: leave the blocks out by tree
+            try:
+                theirs_tree = _clean(parse(reference, script_path))
+            except ScriptError:
+                st["errors"]["reference does not parse"] += 1
+                continue
+        if not any(isinstance(item, Marker) for item in _walk_items(theirs_tree)):
+            st["n"] -= 1
+            st["not_polyscope"] += 1
+            continue
+        try:
+            program = parse_urp(urp, urp_path)
+            installation = None
+            variables: list[tuple[str, str]] = []
+            if program.installation:
+                folder = PurePosixPath(urp_path).parent
+                data = git_show(gitdir, commit, str(folder / f"{program.installation}"
+                                                             ".installation"))
+                if data is not None:
+                    try:
+                        installation = parse_installation(data, program.installation)
+                    except InstallationError:
+                        installation = None
+                text = git_show(gitdir, commit, str(folder / f"{program.installation}"
+                                                             ".variables"))
+                if installation is not None and text is not None:
+                    variables = parse_variables(text)
+            compiled = compile_program(program, installation, variables)
+            ours_tree = _clean(parse(strip_urcap_text(compiled.text), "compiled")
+                               if by_text else compiled.module)
+        except (UrpError, CompileError) as error:
+            st["errors"][str(error).split("error: ", 1)[-1][:150]] += 1
+            continue
+        theirs = canonical_lines(theirs_tree)
+        ours = canonical_lines(ours_tree)
+        names = frozenset(node.name for root in program.top for node in root.walk()
+                          if node.kind == "Waypoint" and node.name)
+        theirs_prog = canonical_lines(program_part(theirs_tree, names))
+        ours_prog = canonical_lines(program_part(ours_tree, names))
+        theirs_pre = collections.Counter(canonical_lines(preamble_part(theirs_tree, names)))
+        ours_pre = collections.Counter(canonical_lines(preamble_part(ours_tree, names)))
+        st["pre_total"] += sum(theirs_pre.values())
+        st["pre_found"] += sum((theirs_pre & ours_pre).values())
+        st["pre_extra"] += sum((ours_pre - theirs_pre).values())
+        share = compare(ours, theirs)
+        share_prog = compare(ours_prog, theirs_prog)
+        st["share"] += share
+        st["share_prog"] += share_prog
+        st["exact"] += ours == theirs
+        st["exact_prog"] += ours_prog == theirs_prog
+        st["exact_any"] += ours_prog == theirs_prog and theirs_pre == ours_pre
+        if ours_prog != theirs_prog:
+            for kind in compiled.kinds_in_diff(ours_prog, theirs_prog):
+                st["kinds"][kind] += 1
+            if shown < args.show:
+                shown += 1
+                print(f"==== {repo} {urp_path} ({share_prog:.0%})")
+                diff = difflib.unified_diff(theirs_prog, ours_prog, "polyscope", "urdsl",
+                                            n=1, lineterm="")
+                for number, line in enumerate(diff):
+                    if number > 40:
+                        break
+                    print(line[:160])
+    for split, st in sorted(stats.items(), reverse=True):
+        n = max(st["n"], 1)
+        print(f"[{split}] {st['n']} programs ({st['missing']} missing, "
+              f"{st['not_polyscope']} .script not written by PolyScope: no $ markers): "
+              f"exact {st['exact'] / n:.1%} whole, {st['exact_prog'] / n:.1%} program part; "
+              f"mean matching lines {st['share'] / n:.1%} whole, "
+              f"{st['share_prog'] / n:.1%} program part")
+        print(f"  exact with the preamble compared in any order: {st['exact_any'] / n:.1%}")
+        print(f"  preamble statements (any order; PolyScope's block order changes from save "
+              f"to save): {st['pre_found']} of {st['pre_total']} written "
+              f"({st['pre_found'] / max(st['pre_total'], 1):.1%}), {st['pre_extra']} extra")
+        if st["errors"]:
+            print("  not compiled: " + "; ".join(f"{k} ({v})" for k, v in
+                                                 st["errors"].most_common(5)))
+        print("  node types in differing lines: " + ", ".join(
+            f"{k} {v}" for k, v in st["kinds"].most_common(8)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,148 @@
+"""``urdsl show X.urp`` (the program tree as PolyScope shows it) and the ``.urp`` half of
+``urdsl compile``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .compile import Compiled, CompileError, compile_program, parse_variables
+from .installation import Installation, InstallationError, find_installation, read_installation
+from .urp import Node, Program, UrpError, read_urp
+
+__all__ = ["add_commands", "compile_urp", "load"]
+
+
+def _installation_for(program: Program, path: str | Path) -> Installation | None:
+    """The installation the program names, from its folder (``NAME.installation``), else the
+    only installation there; ``None`` when there is none. A broken installation is reported on
+    standard error and left out."""
+    folder = Path(path).parent
+    candidate: Path | None = None
+    if program.installation:
+        named = folder / f"{program.installation}.installation"
+        if named.is_file():
+            candidate = named
+    if candidate is None:
+        candidate = find_installation(path)
+    if candidate is None:
+        return None
+    try:
+        return read_installation(candidate)
+    except InstallationError as error:
+        print(f"warning: {error}; compiled without it", file=sys.stderr)
+        return None
+
+
+def load(path: str | Path) -> tuple[Program, Compiled]:
+    """Read and compile the ``.urp`` at ``path`` with its installation and the
+    installation's variables. Raises :class:`UrpError` or :class:`CompileError` (messages
+    name the file and node)."""
+    program = read_urp(path)
+    installation = _installation_for(program, path)
+    variables: list[tuple[str, str]] = []
+    if installation is not None:
+        file = Path(installation.path).with_suffix(".variables")
+        try:
+            variables = parse_variables(file.read_bytes())
+        except OSError:
+            variables = []
+    return program, compile_program(program, installation, variables)
+
+
+def compile_urp(path: str, output: str | None) -> int:
+    """``urdsl compile X.urp [-o X.script]``: the exit status."""
+    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+
+    if not Path(path).is_file():
+        raise UsageError(f"cannot read {path}: No such file")
+    try:
+        _program, compiled = load(path)
+        text = compiled.text
+    except (UrpError, CompileError) as error:
+        print(str(error), file=sys.stderr)
+        return EXIT_PROBLEMS
+    if output:
+        try:
+            Path(output).write_text(text, encoding="utf-8")
+        except OSError as error:
+            raise UsageError(f"cannot write {output}: {error.strerror}") from None
+        print(f"wrote {output} ({text.count(chr(10))} lines)", file=sys.stderr)
+    else:
+        sys.stdout.write(text)
+    return EXIT_OK
+
+
+def _generated(compiled: Compiled) -> dict[int, list[str]]:
+    """Marker number → the script lines after that marker up to the next one."""
+    out: dict[int, list[str]] = {}
+    current: list[str] | None = None
+    for line in compiled.text.splitlines():
+        stripped = line.strip()
+        if stripped.startswith("$ "):
+            number = stripped[2:].split(" ", 1)[0]
+            current = out.setdefault(int(number), []) if number.isdigit() else None
+        elif current is not None and stripped not in ("end", "else:") and stripped \
+                and not stripped.startswith("#"):
+            current.append(stripped)
+    return out
+
+
+def tree_lines(program: Program, compiled: Compiled, with_lines: bool = False) -> list[str]:
+    """The program tree as PolyScope shows it, one node a line, with its marker number
+    (``suppressed`` nodes marked, URCap nodes with their URCap's name); ``with_lines``: each
+    node followed by the script lines it generates."""
+    numbers = {id(node): number for number, node in compiled.numbers.items()}
+    generated = _generated(compiled) if with_lines else {}
+    lines = [f"Program {program.name}  (saved by PolyScope {program.saved_in or '?'}, "
+             f"installation {program.installation or '?'})"]
+
+    def show(node: Node, depth: int) -> None:
+        number = numbers.get(id(node))
+        label = compiled.labels.get(number) if number is not None else None
+        if label is None:
+            label = f"{node.kind} {node.name}" if node.name else node.title
+        if node.kind == "Contributed":
+            label += f"  [URCap {node.attrs.get('strategyURCapName', '?')}]"
+        if node.suppressed:
+            label += "  (suppressed)"
+        prefix = f"{number:>4} " if number is not None else "     "
+        lines.append(f"{prefix}{'  ' * depth}{label}")
+        for code in generated.get(number, []) if number is not None else []:
+            lines.append(f"     {'  ' * depth}  | {code}")
+        if node.kind != "CallSubProgram":
+            for child in node.children:
+                show(child, depth + 1)
+
+    for node in program.top:
+        show(node, 0)
+    return lines
+
+
+def add_commands(commands) -> None:
+    p = commands.add_parser("show", help="show a PolyScope program's tree (.urp)",
+                            description="Show the program tree of a PolyScope program (.urp) "
+                            "as PolyScope shows it, each node with the number of its `$` "
+                            "marker in the compiled script (`urdsl compile X.urp`).")
+    p.add_argument("program", metavar="PROGRAM.urp")
+    p.add_argument("--lines", action="store_true",
+                   help="under each node, the script lines it generates")
+    p.set_defaults(run=cmd_show)
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+
+    if Path(args.program).suffix.lower() != ".urp":
+        raise UsageError(f"cannot show {args.program}: urdsl show takes a PolyScope program "
+                         "(.urp)")
+    if not Path(args.program).is_file():
+        raise UsageError(f"cannot read {args.program}: No such file")
+    try:
+        program, compiled = load(args.program)
+    except (UrpError, CompileError) as error:
+        print(str(error), file=sys.stderr)
+        return EXIT_PROBLEMS
+    sys.stdout.write("\n".join(tree_lines(program, compiled, args.lines)) + "\n")
+    return EXIT_OK

@@ -1,0 +1,1186 @@
+"""Compiling a PolyScope program tree to URScript as PolyScope does.
+
+:func:`compile_program` turns a :class:`~urdsl.polyscope.urp.Program` (and, when known, its
+:class:`~urdsl.polyscope.installation.Installation`) into a URScript syntax tree; the one
+printer (:mod:`urdsl.script.printer`) writes the text. Nothing here writes URScript text:
+statements PolyScope generates are built as tree nodes, and the code users typed into the
+program (expressions, script lines, script files) is parsed into tree nodes.
+
+What PolyScope generates, learned from programs saved by PolyScope 3.x and 5.x beside their
+``.script``:
+
+* ``def NAME():`` where NAME is the program name with every character that is not a letter,
+  digit or ``_`` removed; the installation's preamble; one ``global W_p=p[...]`` (the
+  waypoint's pose: forward kinematics of its joint angles with the arm's calibration and the
+  waypoint's TCP) and ``global W_q=[...]`` per fixed waypoint; subprogram ``def``s; the
+  BeforeStart sequence; threads; then the Robot Program, inside ``while (True):`` unless it
+  runs only once.
+* Every program node gets a ``$ N "label"`` marker. N counts the nodes in program order:
+  BeforeStart, the Robot Program, then threads and subprograms in the order the file lists
+  them; a subprogram's nodes are counted with the subprogram, not at its calls.
+* URCap nodes become a block ``# begin: URCap Program Node`` / ``# end: URCap Program Node``
+  with ``#   Source: ...`` and ``#   Type: ...`` comments: their code only the URCap can
+  generate, so the block holds no statements.
+
+Marker labels are the English ones; PolyScope writes them in the language it runs in.
+"""
+
+from __future__ import annotations
+
+import gzip
+import math
+import re
+import uuid
+import zlib
+from dataclasses import dataclass, field
+from xml.etree import ElementTree
+
+import numpy as np
+
+from ..script import parse
+from ..script.build import literal
+from ..script.diagnostics import ScriptError
+from ..script.nodes import (
+    Assign,
+    BinOp,
+    Bool,
+    Break,
+    Call,
+    Comment,
+    Declare,
+    Elif,
+    EnterCritical,
+    ExitCritical,
+    Expr,
+    ExprStmt,
+    FunctionDef,
+    Halt,
+    If,
+    Index,
+    Item,
+    Join,
+    Keyword,
+    Kill,
+    List,
+    Marker,
+    Module,
+    Name,
+    Number,
+    Param,
+    Paren,
+    Pose,
+    Return,
+    Run,
+    String,
+    ThreadDef,
+    UnaryOp,
+    While,
+)
+from ..script.printer import format as print_tree
+from .installation import Installation
+from .urp import Expression, Kinematics, Node, Program
+
+__all__ = ["CompileError", "Compiled", "compile_program", "parse_variables", "waypoint_pose"]
+
+
+class CompileError(Exception):
+    """A program node that cannot be compiled; the message names the file and node path."""
+
+
+@dataclass
+class Compiled:
+    """The result: ``module`` (the URScript tree), ``numbers`` (marker number → node) and
+    ``labels`` (marker number → label)."""
+
+    module: Module
+    numbers: dict[int, Node] = field(default_factory=dict)
+    labels: dict[int, str] = field(default_factory=dict)
+    """Marker number → the label PolyScope shows (in English)."""
+
+    @property
+    def text(self) -> str:
+        """The URScript text, printed by the one printer."""
+        return print_tree(self.module)
+
+    def kinds_in_diff(self, ours: list[str], theirs: list[str]) -> list[str]:
+        """Node kinds owning the lines of ``ours`` that differ from ``theirs`` (both lists of
+        printed lines; a line belongs to the nearest marker above it)."""
+        import difflib
+
+        owner: list[str] = []
+        current = "preamble"
+        for line in ours:
+            match = re.match(r"\s*\$ (\d+)", line)
+            if match:
+                node = self.numbers.get(int(match.group(1)))
+                current = node.kind if node is not None else "?"
+            owner.append(current)
+        kinds = set()
+        matcher = difflib.SequenceMatcher(a=theirs, b=ours, autojunk=False)
+        for tag, _i1, _i2, j1, j2 in matcher.get_opcodes():
+            if tag == "equal":
+                continue
+            for index in range(max(0, j1 - (j1 == j2)), max(j2, j1 + 1)):
+                if index < len(owner):
+                    kinds.add(owner[index])
+        return sorted(kinds)
+
+
+# ---- waypoint poses ------------------------------------------------------------------------
+
+
+def _dh(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
+    ct, st, ca, sa = math.cos(theta), math.sin(theta), math.cos(alpha), math.sin(alpha)
+    return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
+                     [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]])
+
+
+def _rotvec_to_matrix(rv) -> np.ndarray:
+    rv = np.asarray(rv, dtype=float)
+    angle = float(np.linalg.norm(rv))
+    if angle < 1e-300:
+        return np.eye(3)
+    k = rv / angle
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
+
+
+def _matrix_to_rotvec(m: np.ndarray) -> np.ndarray:
+    """Rotation vector of a rotation matrix, angle in [0, π] (as the controller's
+    ``rotmat2rotvec``)."""
+    axis = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+    sin2 = float(np.linalg.norm(axis))
+    angle = math.atan2(sin2 / 2.0, (np.trace(m) - 1.0) / 2.0)  # acos loses digits near π
+    if angle < 1e-12:
+        return np.zeros(3)
+    if math.pi - angle < 1e-6:
+        # near π the antisymmetric part vanishes: take the axis from the symmetric part,
+        # its largest component positive (as PolyScope writes a half turn [U: one project])
+        b = (m + np.eye(3)) / 2.0
+        column = int(np.argmax(np.diag(b)))
+        axis = b[:, column] / math.sqrt(b[column, column])
+        axis = axis / np.linalg.norm(axis)
+        if math.pi - angle > 1e-9 and float(axis @ np.array(
+                [m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])) < 0:
+            axis = -axis  # not quite a half turn: the antisymmetric part gives the sign
+        return axis * angle
+    return axis / sin2 * angle
+
+
+def waypoint_pose(q, tcp, kinematics: Kinematics) -> tuple[float, ...]:
+    """The TCP pose (x, y, z in m, rotation vector in rad, in the base frame) of joint angles
+    ``q`` (rad) with TCP offset ``tcp`` on the arm described by ``kinematics`` (standard DH;
+    ``delta_theta`` added to each joint angle)."""
+    transform = np.eye(4)
+    for i in range(6):
+        transform = transform @ _dh(q[i] + kinematics.delta_theta[i], kinematics.d[i],
+                                    kinematics.a[i], kinematics.alpha[i])
+    tool = np.eye(4)
+    tool[:3, :3] = _rotvec_to_matrix(tcp[3:])
+    tool[:3, 3] = tcp[:3]
+    transform = transform @ tool
+    rv = _matrix_to_rotvec(transform[:3, :3])
+    return tuple(float(x) for x in transform[:3, 3]) + tuple(float(x) for x in rv)
+
+
+# ---- the compiler --------------------------------------------------------------------------
+
+_PIN = re.compile(r"^([a-z_]+)\[(\d+)\]$")
+_SET_FUNCTIONS = {
+    "digital_out": "set_standard_digital_out", "configurable_out": "set_configurable_digital_out",
+    "tool_out": "set_tool_digital_out", "analog_out": "set_standard_analog_out",
+    "config_out": "set_configurable_digital_out",
+}
+_GET_FUNCTIONS = {
+    "digital_in": "get_standard_digital_in", "digital_out": "get_standard_digital_out",
+    "configurable_in": "get_configurable_digital_in", "config_in": "get_configurable_digital_in",
+    "configurable_out": "get_configurable_digital_out",
+    "config_out": "get_configurable_digital_out",
+    "tool_in": "get_tool_digital_in", "tool_out": "get_tool_digital_out",
+    "analog_in": "get_standard_analog_in", "tool_analog_in": "get_tool_analog_in",
+    "analog_out": "get_standard_analog_out",
+}
+_BASE_FEATURES = frozenset(("Joint_0_name", "Base", "base"))
+"""Names PolyScope gives the base frame in a move's feature reference."""
+_TOOL_FEATURES = frozenset(("Joint_6_name", "Tool", "tool"))
+"""... and the tool flange."""
+
+
+def _floats_or_none(text: str | None) -> tuple[float, ...] | None:
+    if not text:
+        return None
+    try:
+        return tuple(float(x) for x in text.split(","))
+    except ValueError:
+        return None
+
+
+def _generated_id(name: str, purpose: str) -> str:
+    """A UUID in PolyScope's identifier form (``3f89b84f_1daa_4dd7_9152_f27885b7ee6c``),
+    fixed for a program name and purpose."""
+    return str(uuid.uuid5(uuid.NAMESPACE_URL, f"urdsl:{purpose}:{name}")).replace("-", "_")
+
+
+def _ints(text: str | None) -> list[int]:
+    try:
+        return [int(v) for v in (text or "").split(",") if v.strip()]
+    except ValueError:
+        return []
+
+
+_BAUD = {"BAUD_9600": 9600, "BAUD_19200": 19200, "BAUD_38400": 38400, "BAUD_57600": 57600,
+         "BAUD_115200": 115200, "BAUD_1M": 1000000, "BAUD_2M": 2000000, "BAUD_5M": 5000000}
+_PARITY = {"NONE": 0, "ODD": 1, "EVEN": 2}
+_STOP_BITS = {"ONE": 1, "TWO": 2}
+_OUTPUT_MODE = {"SINKING": 1, "SOURCING": 2, "PUSH_PULL": 3}
+_VOLTAGE = {"ZERO": 0, "TWELVE": 12, "TWENTY_FOUR": 24}
+
+
+def _tool_communication(attrs: dict[str, str] | None) -> list[Item]:
+    """The tool connector's settings as PolyScope writes them (baud rate in bit/s, idle
+    times in characters, voltage in V)."""
+    if not attrs:
+        return []
+    items: list[Item] = [_stmt(
+        "set_tool_communication", Bool(attrs.get("enabled") == "true"),
+        Number(_BAUD.get(attrs.get("baudRate", ""), 115200)),
+        Number(_PARITY.get(attrs.get("parity", ""), 0)),
+        Number(_STOP_BITS.get(attrs.get("stopBits", ""), 1)),
+        _num(float(attrs.get("rxIdleChars", "1.5"))), _num(float(attrs.get("txIdleChars", "3.5"))))]
+    items.append(_stmt("set_tool_output_mode",
+                       Number(0 if attrs.get("toolOutputMode", "OUTPUT") == "OUTPUT" else 1)))
+    for index in range(2):
+        mode = attrs.get(f"toolDigitalOutput{index}")
+        if mode in _OUTPUT_MODE:
+            items.append(_stmt("set_tool_digital_output_mode", Number(index),
+                               Number(_OUTPUT_MODE[mode])))
+    voltage = attrs.get("toolOutputVoltage")
+    if voltage in _VOLTAGE:
+        items.append(_stmt("set_tool_voltage", Number(_VOLTAGE[voltage])))
+    return items
+
+
+def _blend_kept(move: Node, motion: Node) -> bool:
+    """Whether a process move (MoveP) keeps the blend of ``motion``: not at its last motion
+    unless the next node is another MoveP, into which it can blend."""
+    if move.fields.get("motion_type") != "MoveP":
+        return True
+    motions = [child for child in move.children
+               if child.kind in ("Waypoint", "CircleMove") and not child.suppressed]
+    if not motions or motion is not motions[-1]:
+        return True
+    parent = move.parent
+    if parent is None:
+        return False
+    siblings = [child for child in parent.children if not child.suppressed]
+    index = siblings.index(move) if move in siblings else -1
+    if 0 <= index < len(siblings) - 1:
+        following = siblings[index + 1]
+        return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
+    return False
+
+
+def _direction_helper() -> list[Item]:
+    """The function PolyScope defines for Direction nodes: the waypoint ``position_distance``
+    (m) from the target along ``direction`` given in ``feature``."""
+    posdir = List(tuple(Index(Name("direction"), (Number(i),)) for i in range(3)))
+    normalized = "direction_vector_normalized"
+    displacement = Pose(tuple(
+        BinOp("*", Index(Name(normalized), (Number(i),)), Name("position_distance"))
+        for i in range(3)) + (Number(0), Number(0), Number(0)))
+    body: tuple[Item, ...] = (
+        Declare("local", "posDir", posdir),
+        If(Paren(BinOp("<", _call("norm", Name("posDir")), _num(1e-6))),
+           (Return(_call("get_target_waypoint")),)),
+        Declare("local", normalized, _call("normalize", Name("posDir"))),
+        Declare("local", "displacement_pose", displacement),
+        Declare("local", "wanted_displacement_in_base_frame",
+                _call("pose_sub", _call("pose_trans", Name("feature"),
+                                        Name("displacement_pose")), Name("feature"))),
+        Return(_call("pose_add", _call("get_target_waypoint"),
+                     Name("wanted_displacement_in_base_frame"))),
+    )
+    return [FunctionDef("calculate_point_to_move_towards",
+                        (Param("feature"), Param("direction"), Param("position_distance")),
+                        body)]
+_POPUP_TITLES = {"Message": "Message", "Warning": "Warning", "Error": "Error"}
+
+
+def _call(name: str, *args: Expr, **keywords: Expr) -> Call:
+    return Call(Name(name), tuple(args), tuple(Keyword(k, v) for k, v in keywords.items()))
+
+
+def _stmt(name: str, *args: Expr, **keywords: Expr) -> ExprStmt:
+    return ExprStmt(_call(name, *args, **keywords))
+
+
+def _num(value: float) -> Expr:
+    return literal(float(value))
+
+
+def compile_program(program: Program, installation: Installation | None = None,
+                    variables: list[tuple[str, str]] | None = None) -> Compiled:
+    """Compile ``program`` as PolyScope does, with its installation and the installation's
+    variables (``NAME.variables`` beside it: (name, value as written) pairs, see
+    :func:`parse_variables`). Raises :class:`CompileError` naming the file and node for a
+    node it cannot compile."""
+    return _Compiler(program, installation, variables or []).run()
+
+
+def parse_variables(data: bytes) -> list[tuple[str, str]]:
+    """The installation variables of a ``.variables`` file (Java properties: ``name=value``
+    lines, ``#`` comments; gzip-compressed or plain) in file order."""
+    if data[:2] == b"\x1f\x8b":
+        try:
+            data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error):
+            return []
+    text = data.decode("utf-8", "replace")
+    if text.lstrip().startswith("<"):  # PolyScope 5.x later: XML
+        try:
+            root = ElementTree.fromstring(text)
+        except ElementTree.ParseError:
+            return []
+        return [(v.get("name", ""), v.get("value", "")) for v in root.iter("variable")
+                if v.get("name")]
+    out = []
+    for line in text.splitlines():
+        line = line.strip()
+        if not line or line.startswith(("#", "!")) or "=" not in line:
+            continue
+        name, value = line.split("=", 1)
+        out.append((name.strip(), value.strip()))
+    return out
+
+
+class _Compiler:
+    def __init__(self, program: Program, installation: Installation | None,
+                 variables: list[tuple[str, str]]) -> None:
+        self.program = program
+        self.installation = installation
+        self.variables = variables
+        self.numbers: dict[int, Node] = {}
+        self.number_of: dict[int, int] = {}
+        self.waypoints: dict[str, Node] = {}
+        self.counter = 0
+        self.switches = 0
+        self.labels: dict[int, str] = {}
+        self.pins = dict(getattr(installation, "io_names", ()) or ())
+        self.version = program.major_version or 5
+
+    # -- numbering
+    def _number_tree(self, node: Node) -> None:
+        stack = [node]
+        while stack:
+            current = stack.pop()
+            self.counter += 1
+            self.number_of[id(current)] = self.counter
+            self.numbers[self.counter] = current
+            if current.kind == "CallSubProgram":
+                continue
+            stack.extend(reversed(current.children))
+
+    def number(self, node: Node) -> int:
+        return self.number_of.get(id(node), 0)
+
+    def run(self) -> Compiled:
+        program = self.program
+        for node in program.top:
+            self._number_tree(node)
+        body: list[Item] = []
+        body.extend(self.preamble())
+        timers: list[str] = []
+        direction_helper = False
+        for node in self._all_nodes(suppressed=True):
+            if node.kind == "Direction" and not direction_helper:
+                direction_helper = True  # PolyScope defines it where the first one is
+                body.extend(_direction_helper())
+            if node.suppressed:
+                continue
+            if node.kind == "Waypoint" and node.fields.get("type") in ("Fixed", "Relative"):
+                if (node.name or "Waypoint") not in self.waypoints:
+                    self.waypoints[node.name or "Waypoint"] = node
+                    body.extend(self.waypoint_globals(node))
+            if node.kind == "Timer" and node.name and node.name not in timers:
+                timers.append(node.name)
+        body.extend(self.timer_thread(timers))
+        for sub in program.subprograms:
+            body.extend(self.subprogram(sub))
+        if program.before_start is not None:
+            body.extend(self.node(program.before_start))
+        for thread in program.threads:
+            body.extend(self.thread(thread))
+        main = self.node(program.main)
+        if program.main.attrs.get("runOnlyOnce") == "true":
+            body.extend(main)
+        else:
+            body.append(While(Paren(Bool(True)), tuple(main)))
+        name = re.sub(r"[^A-Za-z0-9_]", "", program.name) or "program"
+        if name[0].isdigit():
+            name = "_" + name
+        return Compiled(Module((FunctionDef(name, (), tuple(body)),)), self.numbers, self.labels)
+
+    def _all_nodes(self, suppressed: bool = False):
+        """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
+        them has ``suppressed`` set)."""
+        roots = [self.program.before_start, self.program.main, *self.program.threads,
+                 *self.program.subprograms]
+        for root in roots:
+            if root is None:
+                continue
+            stack = [root]
+            while stack:
+                node = stack.pop()
+                if node.suppressed and not suppressed:
+                    continue
+                if node.suppressed:
+                    for inner in node.walk():
+                        inner.suppressed = True
+                yield node
+                stack.extend(reversed(node.children))
+
+    # -- errors and user code
+    def error(self, node: Node, message: str) -> CompileError:
+        return CompileError(f"{self.program.path}: error: node {node.path}: {message}")
+
+    def expr(self, text: str, node: Node) -> Expr:
+        if not text.strip():
+            raise self.error(node, "the node has no expression (PolyScope shows it as not "
+                                   "defined and will not run the program)")
+        try:
+            module = parse(text, self.program.path)
+        except ScriptError as error:
+            raise self.error(node, f"the expression {text.strip()!r} is not URScript "
+                                   f"({str(error).splitlines()[0]})") from None
+        items = [item for item in module.body if not isinstance(item, Comment)]
+        if len(items) != 1 or not isinstance(items[0], ExprStmt):
+            raise self.error(node, f"{text.strip()!r} is not one expression")
+        return items[0].expr
+
+    def script_of(self, expression: Expression, node: Node) -> str:
+        """The URScript text of a PolyScope expression, its I/O pins read as PolyScope
+        reads them."""
+        out = []
+        for kind, text in expression.parts:
+            if kind == "io":
+                out.append(print_tree(self.pin_read(text, node)))
+            else:
+                out.append(Expression(((kind, text),)).script)
+        return "".join(out)
+
+    def code(self, text: str, node: Node) -> list[Item]:
+        try:
+            module = parse(text, self.program.path)
+        except ScriptError as error:
+            raise self.error(node, f"the script code is not URScript "
+                                   f"({str(error).splitlines()[0]})") from None
+        return list(module.body)
+
+    def marker(self, node: Node, label: str, flag: str | None = None) -> Marker:
+        label = label.replace('"', "'")
+        self.labels[self.number(node)] = label
+        return Marker(self.number(node), label, flag)
+
+    # -- preamble
+    def preamble(self) -> list[Item]:
+        """What PolyScope 5 writes from the installation before the program: safety
+        transition, tool communication and output, gravity, analog domains, input actions,
+        payload and TCP. (PolyScope writes these blocks in an order that changes from one
+        save to the next; this is one of them.) Installation variables, features, Modbus
+        signals and URCap installation code are not written."""
+        items: list[Item] = self.step_counter()
+        installation = self.installation
+        if installation is None or self.version < 5:
+            return items
+        settings = installation.settings or {}
+        hardness = settings.get("SmoothTransitionSettings", {}).get("transitionHardness")
+        if hardness:
+            items.append(_stmt("set_safety_mode_transition_hardness",
+                               Number(1 if hardness == "SOFT" else 0)))
+        items.extend(_tool_communication(settings.get("ToolCommSettings")))
+        gravity = installation.gravity
+        if gravity is not None:
+            items.append(_stmt("set_gravity", List(tuple(_num(v) for v in gravity))))
+        ranges = _ints(settings.get("IOs/analogInputRange", {}).get("value"))
+        if len(ranges) == 4:
+            for index in range(2):
+                items.append(_stmt("set_standard_analog_input_domain", Number(index),
+                                   Number(ranges[index])))
+            for index in range(2):
+                items.append(_stmt("set_tool_analog_input_domain", Number(index),
+                                   Number(ranges[2 + index])))
+        domains = _ints(settings.get("IOs/analogOutputDomain", {}).get("value"))
+        for index, domain in enumerate(domains):
+            items.append(_stmt("set_analog_outputdomain", Number(index), Number(domain)))
+        if "IOs/DigitalInputActions" in settings:
+            items.append(_stmt("set_input_actions_to_default"))
+            # only the tool inputs' actions are written (seen: "freedrive"); the controller
+            # keeps the standard and configurable inputs' actions itself
+            for key, function in (("ToolDigitalInputActions", "set_tool_digital_input_action"),):
+                actions = settings.get(f"IOs/{key}", {}).get("value", "").split(",")
+                for index, action in enumerate(a.strip() for a in actions):
+                    if action and action != "NONE":
+                        items.append(_stmt(function, Number(index),
+                                           String(action.lower().replace("_", " "))))
+        payload = installation.payload
+        if payload is not None:
+            raw = settings.get(f"Payload/{payload.name}")
+            cog = payload.cog or (0.0, 0.0, 0.0)
+            if raw is not None and raw.get("inertiaParameters"):
+                inertia = tuple(float(v) for v in raw["inertiaParameters"].split(","))
+                items.append(_stmt("set_target_payload", _num(payload.mass),
+                                   List(tuple(_num(v) for v in cog)),
+                                   List(tuple(_num(v) for v in inertia))))
+            else:
+                items.append(_stmt("set_payload", _num(payload.mass),
+                                   List(tuple(_num(v) for v in cog))))
+        tcp = installation.tcp
+        if tcp is not None:
+            items.append(_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset))))
+        for name, value in self.variables:
+            try:
+                items.append(Declare("global", name, self.expr(value, self.program.main)))
+            except CompileError:  # not a value URScript reads: PolyScope would not run it
+                items.append(Comment(f" urdsl: installation variable {name} is not URScript"))
+        for name, pose in sorted(installation.features or ()):
+            items.append(Declare("global", name, Pose(tuple(_num(v) for v in pose))))
+        return items
+
+    def step_counter(self) -> list[Item]:
+        """The thread PolyScope (3.15 and 5.8 on) starts in every program to count its
+        controller steps; its names carry a generated id (here derived from the program's
+        name, so that compiling twice gives the same text)."""
+        version = self.program.saved_in or self.program.created_in or ""
+        parts = [int(p) if p.isdigit() else 0 for p in version.split(".")[:2]] + [0, 0]
+        major, minor = parts[0], parts[1]
+        if not ((major == 3 and minor >= 15) or (major == 5 and minor >= 8) or major > 5):
+            return []
+        count = "step_count_" + _generated_id(self.program.name, "count")
+        thread = "Step_Counter_Thread_" + _generated_id(self.program.name, "thread")
+        return [
+            Assign(Name(count), _num(0.0)),
+            ThreadDef(thread, (While(Paren(Bool(True)), (
+                Assign(Name(count), BinOp("+", Name(count), _num(1.0))),
+                _stmt("sync"))),)),
+            ExprStmt(Run(thread))]
+
+    def waypoint_globals(self, node: Node) -> list[Item]:
+        """The globals PolyScope 5 writes for a fixed or relative waypoint."""
+        name = node.name or "Waypoint"
+        q = node.fields.get("q")
+        pose = self.pose_of(node)
+        if self.version < 5 or not q or pose is None:
+            return []
+        if node.fields.get("type") == "Relative":
+            start = self.pose_of(node, "from_")
+            if start is None:
+                return []
+            return [Declare("global", f"{name}_from_p", Pose(tuple(_num(v) for v in start))),
+                    Declare("global", f"{name}_to_p", Pose(tuple(_num(v) for v in pose)))]
+        return [Declare("global", f"{name}_p", Pose(tuple(_num(v) for v in pose))),
+                Declare("global", f"{name}_q", List(tuple(_num(v) for v in q)))]
+
+    def timer_thread(self, timers: list[str]) -> list[Item]:
+        """The globals and the thread that count PolyScope's timers."""
+        if not timers:
+            return []
+        items: list[Item] = [Declare("global", f"{name}_is_counting", Bool(False))
+                             for name in timers]
+        body: list[Item] = [
+            If(Paren(Name(f"{name}_is_counting")),
+               (Assign(Name(name), BinOp("+", Name(name), _call("get_steptime"))),))
+            for name in timers]
+        body.append(_stmt("sync"))
+        items.append(ThreadDef("Timer_Thread", (While(Paren(Bool(True)), tuple(body)),)))
+        items.append(ExprStmt(Run("Timer_Thread")))
+        return items
+
+    def n_Timer(self, node: Node) -> list[Item]:
+        name = node.name or "timer"
+        action = str(node.fields.get("action", "Start"))
+        label = f"{name}: {action}"
+        if action == "Start":
+            return [self.marker(node, label), Assign(Name(f"{name}_is_counting"), Bool(True))]
+        if action == "Stop":
+            return [self.marker(node, label), Assign(Name(f"{name}_is_counting"), Bool(False))]
+        return [self.marker(node, label), Assign(Name(name), Number(0))]
+
+    def pose_of(self, node: Node, prefix: str = "") -> tuple[float, ...] | None:
+        """The waypoint's TCP pose: as stored (PolyScope 3), else by forward kinematics of its
+        joint angles with the arm's calibration and the waypoint's TCP (PolyScope 5)."""
+        stored = node.fields.get(prefix + "pose")
+        if stored and len(stored) == 6:
+            return tuple(stored)
+        q = node.fields.get(prefix + "q")
+        tcp = node.fields.get(prefix + "tcp_offset") or (0.0,) * 6
+        kinematics = node.fields.get(prefix + "kinematics") or self.program.kinematics
+        if not q or kinematics is None:
+            return None
+        return waypoint_pose(q, tcp, kinematics)
+
+    # -- nodes
+    def block(self, nodes: list[Node]) -> list[Item]:
+        items: list[Item] = []
+        index = 0
+        while index < len(nodes):
+            node = nodes[index]
+            if node.suppressed:
+                index += 1
+                continue
+            if node.kind == "If" and node.fields.get("type") == "If":
+                chain = [node]
+                index += 1
+                while index < len(nodes) and nodes[index].kind == "If" and \
+                        nodes[index].fields.get("type") in ("ElseIf", "Else"):
+                    chain.append(nodes[index])
+                    index += 1
+                items.extend(self.if_chain(chain))
+                continue
+            items.extend(self.node(node))
+            index += 1
+        return items
+
+    def node(self, node: Node) -> list[Item]:
+        method = getattr(self, f"n_{node.kind}", None)
+        if method is None:
+            return self.n_unknown(node)
+        return method(node)
+
+    def n_unknown(self, node: Node) -> list[Item]:
+        """A node type urdsl does not know: its marker, a comment naming it, its children."""
+        return [self.marker(node, node.title),
+                Comment(f" urdsl: PolyScope node <{node.kind}> is not compiled"),
+                *self.block(node.children)]
+
+    def n_MainProgram(self, node: Node) -> list[Item]:
+        return [self.marker(node, "Robot Program"), *self.block(node.children)]
+
+    def n_SpecialSequence(self, node: Node) -> list[Item]:
+        return [self.marker(node, node.attrs.get("type", "BeforeStart")),
+                *self.block(node.children)]
+
+    def n_Folder(self, node: Node) -> list[Item]:
+        return [self.marker(node, node.name or "Folder"), *self.block(node.children)]
+
+    def n_Comment(self, node: Node) -> list[Item]:
+        text = f"'{node.fields.get('text', '')}'"
+        return [self.marker(node, text), Comment(f" {text}")]
+
+    def n_Switch(self, node: Node) -> list[Item]:
+        self.switches += 1
+        variable = f"switch_{self.switches}"
+        expression = node.fields["expression"]
+        items: list[Item] = [self.marker(node, f"Switch {expression.label}"),
+                             Assign(Name(variable),
+                                    self.expr(self.script_of(expression, node), node))]
+        cases = [child for child in node.children if not child.suppressed]
+        tests: list[tuple[Expr, tuple[Item, ...]]] = []
+        default: tuple[Item, ...] | None = None
+        for case in cases:
+            value = case.attrs.get("caseValue")
+            label = f"Case {value}" if value is not None else "Default Case"
+            body = (self.marker(case, label), *self.block(case.children))
+            if case.kind == "Case" and value is not None:
+                tests.append((Paren(BinOp("==", self.expr(value, case), Name(variable))),
+                              body))
+            else:
+                default = body
+        if not tests:
+            return items + list(default or ())
+        first, *rest = tests
+        # the first case's marker stands before the `if`, the others inside their branch
+        items.append(first[1][0])
+        items.append(If(first[0], first[1][1:], tuple(Elif(test, body) for test, body in rest),
+                        default))
+        return items
+
+    def n_CircleMove(self, node: Node) -> list[Item]:
+        move = self.move_of(node)
+        points = [child for child in node.children if child.kind == "Waypoint"]
+        items: list[Item] = [self.marker(node, "CircleMove")]
+        if move is None or len(points) != 2:
+            return items + self.block(node.children)
+        via, end = points
+        items.append(self.marker(via, via.name or "ViaPoint", "noBreak"))
+        items.append(self.marker(end, end.name or "EndPoint", "breakAfter"))
+        keywords = [(k, v) for k, v in self.motion_keywords(move, end) if k in ("a", "v")]
+        blend = (end.fields.get("params") or {}).get("blendRadius", move.fields.get("blend"))
+        if not _blend_kept(move, node):
+            blend = 0.0
+        keywords.append(("r", _num(blend or 0.0)))
+        if node.attrs.get("OrientationMode") == "FIXED":
+            keywords.append(("mode", Number(1)))
+        items.append(ExprStmt(Call(Name("movec"), (self.target_of(via, move),
+                                                    self.target_of(end, move)),
+                                   tuple(Keyword(k, v) for k, v in keywords))))
+        return items
+
+    def target_of(self, node: Node, move: Node) -> Expr:
+        if node.fields.get("type") == "Variable":
+            target: Expr = Name(str(node.fields.get("variable") or node.name))
+            feature = move.fields.get("feature")
+            if feature and feature not in _BASE_FEATURES:
+                target = _call("pose_trans", Name(str(feature)), target)
+            return target
+        return self.fixed_values(node)[0]
+
+    def fixed_values(self, node: Node) -> tuple[Expr, Expr]:
+        """The pose and joints of a fixed waypoint: its globals (PolyScope 5), or literals
+        written in place (PolyScope 3)."""
+        name = node.name or "Waypoint"
+        if self.version >= 5:
+            return Name(f"{name}_p"), Name(f"{name}_q")
+        shared = self.waypoints.get(name, node)
+        q = shared.fields.get("q") or node.fields.get("q")
+        pose = self.pose_of(shared) or self.pose_of(node)
+        if not q or pose is None:
+            raise self.error(node, "a fixed waypoint without joint angles or calibration")
+        return Pose(tuple(_num(v) for v in pose)), List(tuple(_num(v) for v in q))
+
+    def n_Halt(self, node: Node) -> list[Item]:
+        return [self.marker(node, "Halt"), Halt()]
+
+    def n_Contributed(self, node: Node) -> list[Item]:
+        return [Comment(" begin: URCap Program Node"),
+                Comment(f"   Source: {node.attrs.get('strategyURCapName', '?')}, "
+                        f"{node.attrs.get('strategyURCapDeveloper', '?')}"),
+                Comment(f"   Type: {node.title}"),
+                self.marker(node, node.title),
+                Comment(" end: URCap Program Node")]
+
+    def n_Wait(self, node: Node) -> list[Item]:
+        kind = node.fields.get("type")
+        if kind == "Sleep":
+            seconds = node.fields.get("seconds", 0.0)
+            return [self.marker(node, f"Wait: {seconds}"), _stmt("sleep", _num(seconds))]
+        if kind == "DigitalInput":
+            pin = str(node.fields.get("pin"))
+            value = node.fields.get("digital") in ("1", "true", "True")
+            test = BinOp("==", self.pin_read(pin, node), Bool(not value))
+            label = f"Wait {self.pin_label(pin)}={'HI' if value else 'LO'}"
+            return [self.marker(node, label), While(Paren(test), (_stmt("sync"),))]
+        if kind == "Condition":
+            expression = node.fields["expression"]
+            test = self.expr(self.script_of(expression, node), node)
+            return [self.marker(node, f"Wait {expression.label}"),
+                    While(Paren(UnaryOp("not", Paren(test))), (_stmt("sync"),))]
+        return self.n_unknown(node)
+
+    def pin_label(self, pin: str) -> str:
+        for name, target in self.pins.items():
+            if target == pin:
+                return name
+        return pin
+
+    def resolve_pin(self, pin: str, node: Node) -> tuple[str, int]:
+        target = self.pins.get(pin, pin)
+        match = _PIN.match(target)
+        if not match:
+            raise self.error(node, f"the I/O {pin!r} is not named in the installation")
+        return match.group(1), int(match.group(2))
+
+    def pin_read(self, pin: str, node: Node) -> Expr:
+        kind, index = self.resolve_pin(pin, node)
+        function = _GET_FUNCTIONS.get(kind)
+        if function is None:
+            raise self.error(node, f"cannot read the I/O {pin!r}")
+        return _call(function, Number(index))
+
+    def n_Set(self, node: Node) -> list[Item]:
+        kind = node.fields.get("type")
+        if kind == "DigitalOutput":
+            pin = str(node.fields.get("pin"))
+            value = node.fields.get("digitalValue") in ("1", "true", "True")
+            bank, index = self.resolve_pin(pin, node)
+            function = _SET_FUNCTIONS.get(bank)
+            if function is None:
+                raise self.error(node, f"cannot set the I/O {pin!r}")
+            label = f"Set {self.pin_label(pin)}={'On' if value else 'Off'}"
+            return [self.marker(node, label), _stmt(function, Number(index), Bool(value))]
+        if kind == "AnalogOutput":
+            pin = str(node.fields.get("pin"))
+            bank, index = self.resolve_pin(pin, node)
+            value = float(str(node.fields.get("analogValue", "0")))
+            return [self.marker(node, f"Set {self.pin_label(pin)}={value}"),
+                    _stmt("set_standard_analog_out", Number(index), _num(value))]
+        if kind == "NoAction":
+            return [self.marker(node, "Set")]
+        return self.n_unknown(node)
+
+    def n_Assignment(self, node: Node) -> list[Item]:
+        expression = node.fields["expression"]
+        name = node.name or "var"
+        if node.fields.get("source") == "Operator":
+            # the operator types the value in; the form is unconfirmed [U]
+            kind = str(node.fields.get("value_type") or "Integer").lower()
+            message = str(node.fields.get("message", ""))
+            return [self.marker(node, f"{name}≔Operator"),
+                    Declare("global", name, _call(f"request_{kind}_from_primary_client",
+                                                  String(message.replace('"', "'"))))]
+        label = f"{name}≔{expression.label}"
+        return [self.marker(node, label),
+                Declare("global", name, self.expr(self.script_of(expression, node), node))]
+
+    def n_Script(self, node: Node) -> list[Item]:
+        kind = node.fields.get("type")
+        if kind == "Line":
+            expression = node.fields["expression"]
+            return [self.marker(node, expression.label),
+                    *self.code(self.script_of(expression, node), node)]
+        contents = str(node.fields.get("contents", ""))
+        if kind == "File":
+            file = str(node.fields.get("file", "")).rsplit("/", 1)[-1]
+            label = f"Script: {file}"
+        else:
+            label = "Script"
+        return [self.marker(node, label), *self.code(contents, node)]
+
+    def n_Popup(self, node: Node) -> list[Item]:
+        kind = str(node.fields.get("type", "Message"))
+        message = str(node.fields.get("message", ""))
+        halt = bool(node.fields.get("halt"))
+        title = _POPUP_TITLES.get(kind, kind)
+        text: Expr = String(message.replace('"', "'"))
+        if node.fields.get("input") == "Variable" and node.fields.get("variable"):
+            variable = str(node.fields["variable"])
+            text = _call("str_cat", String(""), Name(variable))
+            message = variable
+        items: list[Item] = [
+            self.marker(node, f"Popup: {message}"),
+            _stmt("popup", text, String(title),
+                  Bool(kind == "Warning"), Bool(kind == "Error"), blocking=Bool(not halt))]
+        if halt:
+            items.append(Halt())
+        return items
+
+    def n_CallSubProgram(self, node: Node) -> list[Item]:
+        name = node.name or "subprogram"
+        return [self.marker(node, f"Call {name}"), _stmt(name)]
+
+    def subprogram(self, node: Node) -> list[Item]:
+        name = node.name or "subprogram"
+        body = [self.marker(node, name, "noBreak"), *self.block(node.children)]
+        return [FunctionDef(name, (), tuple(body))]
+
+    def thread(self, node: Node) -> list[Item]:
+        name = node.name or "Thread"
+        body = self.block(node.children)
+        if node.attrs.get("runOnlyOnce") != "true":
+            body = [While(Paren(Bool(True)), tuple(body))]
+        return [self.marker(node, name), ThreadDef(name, tuple(body)),
+                Assign(Name(f"threadId_{name}"), Run(name))]
+
+    def n_Loop(self, node: Node) -> list[Item]:
+        kind = node.fields.get("type")
+        body = self.block(node.children)
+        if kind == "Counting":
+            count = int(node.fields.get("count", 1))
+            variable = str(node.fields.get("variable") or f"Loop_{self.number(node)}")
+            return [self.marker(node, f"Loop {count} times"),
+                    Assign(Name(variable), Number(0)),
+                    While(Paren(BinOp("<", Name(variable), Number(count))),
+                          (*body, Assign(Name(variable),
+                                         BinOp("+", Name(variable), Number(1)))))]
+        if kind == "While":
+            expression = node.fields["expression"]
+            text = self.script_of(expression, node)
+            marker = self.marker(node, f"Loop {expression.label}")
+            if node.attrs.get("checkContinuously") != "true":
+                return [marker, While(Paren(self.expr(text, node)), tuple(body))]
+            # checked continuously: the body runs in a thread killed when the test fails
+            number = self.number(node)
+            thread, handler = f"Thread_while_{number}", f"thread_handler_{number}"
+            return [marker,
+                    ThreadDef(thread, (While(Paren(Bool(True)), tuple(body)),)),
+                    If(Paren(self.expr(text, node)), (
+                        Declare("global", handler, Run(thread)),
+                        While(Paren(self.expr(text, node)), (_stmt("sync"),)),
+                        Kill(Name(handler))))]
+        return [self.marker(node, "Loop"), While(Paren(Bool(True)), tuple(body))]
+
+    def if_chain(self, chain: list[Node]) -> list[Item]:
+        head = chain[0]
+        expression = head.fields["expression"]
+        body = [self.marker(head, f"If {expression.label}"), ]
+        test = self.expr(self.script_of(expression, head), head)
+        inner = self.block(head.children)
+        orelse: tuple[Item, ...] | None = None
+        if len(chain) > 1:
+            nxt = chain[1]
+            if nxt.fields.get("type") == "Else":
+                orelse = (self.marker(nxt, "Else", "noBreak"), *self.block(nxt.children))
+            else:
+                rest = [Node(nxt.kind, nxt.attrs, nxt.children, nxt.name,
+                             {**nxt.fields, "type": "If"}, nxt.element, nxt.parent)]
+                self.number_of[id(rest[0])] = self.number(nxt)
+                orelse = tuple(self._elseif(nxt, rest[0], chain[2:]))
+        if head.attrs.get("checkContinuously") != "true":
+            return [*body, If(Paren(test), tuple(inner), (), orelse)]
+        # checked continuously: the body runs in a thread killed when the test fails
+        number = self.number(head)
+        flag, thread, handler = (f"thread_flag_{number}", f"Thread_if_{number}",
+                                 f"thread_handler_{number}")
+        items: list[Item] = [
+            *body,
+            Declare("global", flag, Number(0)),
+            ThreadDef(thread, (*inner, Assign(Name(flag), Number(1)))),
+            If(Paren(test), (
+                Declare("global", handler, Run(thread)),
+                While(Paren(BinOp("==", Name(flag), Number(0))), (
+                    If(UnaryOp("not", Paren(test)),
+                       (Kill(Name(handler)), Assign(Name(flag), Number(2))), (),
+                       (_stmt("sync"),)),)),
+            ), (), (Assign(Name(flag), Number(2)),))]
+        if orelse is not None:
+            items.append(If(Paren(BinOp("==", Name(flag), Number(2))), orelse))
+        return items
+
+    def _elseif(self, original: Node, copy: Node, rest: list[Node]) -> list[Item]:
+        items = self.if_chain([copy, *rest])
+        first = items[0]
+        assert isinstance(first, Marker)
+        expression = original.fields["expression"]
+        label = f"ElseIf {expression.label}".replace('"', "'")
+        self.labels[first.number or 0] = label
+        return [Marker(first.number, label), *items[1:]]
+
+    # -- direction / until
+    def n_Direction(self, node: Node) -> list[Item]:
+        """A Direction node: a thread moves towards a far point while the program waits for
+        its Until nodes (only the distance Until is compiled as PolyScope does)."""
+        number = self.number(node)
+        move = self.move_of(node)
+        selected = node.attrs.get("selectedDirection")
+        expression = node.fields.get("expression")
+        feature = node.fields.get("feature")
+        frame = "Tool" if feature in _TOOL_FEATURES else (
+            "Base" if feature in (None, *_BASE_FEATURES) else str(feature))
+        if selected:
+            axis = {"X": 0, "Y": 1, "Z": 2}[selected[0]]
+            sign = -1.0 if selected.endswith("Minus") else 1.0
+            vector: Expr = List(tuple(_num(sign if i == axis else 0.0) for i in range(3)))
+            label = f"Direction: {frame} {selected[0]}{'-' if sign < 0 else '+'}"
+        elif expression:
+            vector = self.expr(self.script_of(expression, node), node)
+            label = f"Direction: {frame}"
+        else:
+            return self.n_unknown(node)
+        if frame == "Tool":
+            feature_pose: Expr = _call("get_forward_kin")
+        elif frame == "Base":
+            feature_pose = Pose(tuple(_num(0.0) for _ in range(6)))
+        else:
+            feature_pose = Name(frame)
+        untils = [child for child in node.children if child.kind == "Until"]
+        distance = 1000.0
+        for until in untils:
+            if until.attrs.get("type") == "DISTANCE" and until.element is not None:
+                text = until.element.findtext("Distance")
+                if text:
+                    distance = float(text)
+        speed = move.fields.get("speed") if move is not None else None
+        accel = move.fields.get("acceleration") if move is not None else None
+        params = _floats_or_none(node.attrs.get("toolParams"))
+        if params is not None and len(params) == 2:
+            speed, accel = params
+        flag, thread, handle = (f"move_thread_flag_{number}", f"move_thread_{number}",
+                                f"move_thread_han_{number}")
+        keywords = []
+        if accel is not None:
+            keywords.append(Keyword("a", _num(accel)))
+        if speed is not None:
+            keywords.append(Keyword("v", _num(speed)))
+        thread_body: tuple[Item, ...] = (
+            EnterCritical(),
+            Assign(Name(flag), Number(1)),
+            Declare("local", "towardsPos", _call("calculate_point_to_move_towards",
+                                                 feature_pose, vector, _num(distance))),
+            ExprStmt(Call(Name("movel"), (Name("towardsPos"),), tuple(keywords))),
+            Assign(Name(flag), Number(2)),
+            ExitCritical(),
+        )
+        items: list[Item] = [
+            self.marker(node, label),
+            Declare("global", flag, Number(0)),
+            ThreadDef(thread, thread_body),
+            Assign(Name(flag), Number(0)),
+            Assign(Name(handle), Run(thread)),
+        ]
+        loop: list[Item] = []
+        # PolyScope checks tool contact before the other conditions, whatever their order
+        for until in sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION"):
+            kind = until.attrs.get("type", "")
+            if kind == "TOOL_CONTACT_DETECTION":
+                loop.extend(self._tool_contact(until, handle, accel))
+                continue
+            done: list[Item] = [Join(Name(handle))]
+            if kind != "DISTANCE":
+                done.append(Comment(f" urdsl: Until ({kind.lower()}) is not compiled"))
+            done.append(self.marker(until, f"Until ({kind.lower()})"))
+            done.extend(self.block(until.children))
+            done.append(Break())
+            loop.append(_stmt("sleep", _num(1e-10)))
+            loop.append(If(Paren(BinOp(">", Name(flag), Number(1))), tuple(done)))
+        loop.append(_stmt("sync"))
+        items.append(While(Paren(Bool(True)), tuple(loop)))
+        others = [child for child in node.children if child.kind != "Until"]
+        items.extend(self.block(others))
+        return items
+
+    def _tool_contact(self, until: Node, handle: str, accel: float | None) -> list[Item]:
+        """The wait of a Direction that stops on tool contact: back off along the way it
+        came by ``retraction`` (m), decelerating at ``decelerationAcceleration`` (m/s²; older
+        files have none: the Direction's own acceleration)."""
+        decel = float(until.attrs.get("decelerationAcceleration",
+                                      accel if accel is not None else 3.0))
+        retraction = float(until.attrs.get("retraction", "0.0"))
+        direction = Name("targetTcpDirection")
+        normalized = Name("normalizedPosDir")
+        retract = Pose(tuple(BinOp("*", Index(normalized, (Number(i),)), _num(retraction))
+                             for i in range(3)) + (Number(0), Number(0), Number(0)))
+        found: tuple[Item, ...] = (
+            Kill(Name(handle)),
+            _stmt("stopl", _num(decel)),
+            Declare("local", "backTrackMovement",
+                    _call("get_actual_joint_positions_history", Name("stepsToRetract"))),
+            Declare("local", "contactPose", _call("get_forward_kin", Name("backTrackMovement"))),
+            Declare("local", "posDir", List(tuple(Index(direction, (Number(i),))
+                                                  for i in range(3)))),
+            Declare("local", "retractTo", Name("contactPose")),
+            If(Paren(BinOp(">", _call("norm", Name("posDir")), _num(1e-6))), (
+                Declare("local", "normalizedPosDir", _call("normalize", Name("posDir"))),
+                Declare("local", "additionalRetraction", retract),
+                Assign(Name("retractTo"), _call("pose_sub", Name("contactPose"),
+                                                Name("additionalRetraction"))),
+            )),
+            ExprStmt(Call(Name("movel"), (Name("retractTo"),),
+                          (Keyword("a", _num(decel)), Keyword("v", _num(0.1))))),
+            self.marker(until, "Until (tool_contact_detection)"),
+            *self.block(until.children),
+            Break(),
+        )
+        return [
+            Declare("local", "targetTcpDirection", _call("get_target_tcp_speed")),
+            Declare("local", "stepsToRetract",
+                    Call(Name("tool_contact"), (), (Keyword("direction", direction),))),
+            If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), found)]
+
+    def n_SafeHome(self, node: Node) -> list[Item]:
+        """A move to the installation's safe home joint positions (rad)."""
+        settings = (self.installation.settings or {}) if self.installation else {}
+        position = settings.get("SafeHomeSettings", {}).get("position")
+        if not position:
+            raise self.error(node, "the installation's safe home position is unknown "
+                                   "(no installation with SafeHomeSettings beside the program)")
+        joints = List(tuple(_num(float(v)) for v in position.split(",")))
+        keywords: list[Keyword] = []
+        if node.attrs.get("positionOptionType") == "TIME" and node.attrs.get("nextMotionTime"):
+            keywords.append(Keyword("t", _num(float(node.attrs["nextMotionTime"]))))
+        else:
+            for key, attr in (("a", "acceleration"), ("v", "speed")):
+                if node.attrs.get(attr):
+                    keywords.append(Keyword(key, _num(float(node.attrs[attr]))))
+        return [self.marker(node, "Home"),
+                ExprStmt(Call(Name("movej"), (joints,), tuple(keywords)))]
+
+    def n_Force(self, node: Node) -> list[Item]:
+        """Force mode around the node's children: selected axes are compliant (limited by
+        the speed limits, m/s and rad/s), the others by the allowed deviation (m, rad)."""
+        selection = node.fields.get("selection")
+        wrench = node.fields.get("wrench")
+        speeds = node.fields.get("limitsForce")
+        deviations = node.fields.get("limitsMotion")
+        if not (selection and wrench and speeds and deviations):
+            return self.n_unknown(node)
+        feature = node.fields.get("feature")
+        frame: Expr
+        if feature in _TOOL_FEATURES:
+            frame = _call("tool_pose")
+        elif feature in (None, *_BASE_FEATURES):
+            frame = Pose(tuple(_num(0.0) for _ in range(6)))
+        else:
+            frame = Name(str(feature))
+        kind = {"Point": 1, "Motion": 3}.get(str(node.fields.get("type")), 2)
+        limits = [speeds[i] if selection[i] else deviations[i] for i in range(6)]
+        body = self.block(node.children)
+        for index in range(len(body) - 1, -1, -1):
+            item = body[index]
+            if isinstance(item, Marker):
+                body[index] = Marker(item.number, item.text, "noBreak")
+                break
+        return [self.marker(node, "Force"), _stmt("sleep", _num(0.02)), _stmt("zero_ftsensor"),
+                _stmt("force_mode", frame, List(tuple(Number(int(v)) for v in selection)),
+                      List(tuple(_num(v) for v in wrench)), Number(kind),
+                      List(tuple(_num(v) for v in limits))),
+                *body, _stmt("end_force_mode"), _stmt("stopl", _num(5.0))]
+
+    # -- moves
+    def n_Move(self, node: Node) -> list[Item]:
+        items: list[Item] = [self.marker(node, str(node.fields.get("motion_type", "Move")))]
+        items.extend(self.block(node.children))
+        return items
+
+    def move_of(self, node: Node) -> Node | None:
+        parent = node.parent
+        while parent is not None and parent.kind != "Move":
+            parent = parent.parent
+        return parent
+
+    def n_Waypoint(self, node: Node) -> list[Item]:
+        move = self.move_of(node)
+        name = node.name or "Waypoint"
+        kind = node.fields.get("type")
+        if move is None:
+            return [self.marker(node, name, "breakAfter")]
+        motion = str(move.fields.get("motion_type", "MoveJ"))
+        if kind == "Variable":
+            variable = str(node.fields.get("variable") or name)
+            target: Expr = Name(variable)
+            feature = move.fields.get("feature")
+            if feature and feature not in _BASE_FEATURES:
+                target = _call("pose_trans", Name(str(feature)), target)
+            label = variable
+        elif kind == "Fixed":
+            label = name
+            pose_expr, q_expr = self.fixed_values(node)
+            if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
+                target = q_expr
+            elif motion == "MoveJ":
+                target = _call("get_inverse_kin", pose_expr, qnear=q_expr)
+            else:
+                target = pose_expr
+        elif kind == "Relative":
+            label = name
+            target = _call("pose_add", _call("get_target_tcp_pose"),
+                           _call("pose_sub", Name(f"{name}_to_p"), Name(f"{name}_from_p")))
+        else:
+            return [self.marker(node, name, "breakAfter")]
+        keywords = self.motion_keywords(move, node)
+        function = {"MoveJ": "movej", "MoveL": "movel", "MoveP": "movep"}.get(motion, "movel")
+        return [self.marker(node, label, "breakAfter"),
+                ExprStmt(Call(Name(function), (target,),
+                              tuple(Keyword(k, v) for k, v in keywords)))]
+
+    def motion_keywords(self, move: Node, waypoint: Node) -> list[tuple[str, Expr]]:
+        params = waypoint.fields.get("params") or {}
+        motion = move.fields.get("motion_type")
+        if "nextMotionTime" in params:
+            out = [("t", _num(params["nextMotionTime"]))]
+        else:
+            joint = motion == "MoveJ"
+            speed = params.get("jointSpeed" if joint else "cartesianSpeed",
+                               move.fields.get("speed"))
+            accel = params.get("jointAcceleration" if joint else "cartesianAcceleration",
+                               move.fields.get("acceleration"))
+            out = []
+            if accel is not None:
+                out.append(("a", _num(accel)))
+            if speed is not None:
+                out.append(("v", _num(speed)))
+        blend = params.get("blendRadius", move.fields.get("blend"))
+        if motion == "MoveP":
+            out.append(("r", _num(blend if blend and _blend_kept(move, waypoint) else 0.0)))
+        elif blend and blend > 0:
+            out.append(("r", _num(blend)))
+        return out
+

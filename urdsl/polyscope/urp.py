@@ -1,0 +1,581 @@
+"""Reading PolyScope programs (``.urp``) into a typed, named program tree.
+
+A ``.urp`` file is XML, gzip-compressed as PolyScope saves it (plain XML is accepted too).
+PolyScope 3.x (from about 3.3) and 5.x write the same layout: a root ``<URProgram>`` with the
+arm's calibration (``<kinematics>``) and ``<children>`` holding ``<SpecialSequence
+type="BeforeStart">``, ``<MainProgram>``, ``<Thread>`` nodes and ``<SubProgram reference=../>``
+entries. Each program node is one XML element named after its type (``Move``, ``Waypoint``,
+``Loop``, ``If``, ``Wait``, ``Set``, ``Assignment``, ``Script``, ``Popup``, ...), its children
+inside ``<children>``. The XML is written by XStream: an element that appeared before is not
+repeated but written ``<Tag reference="../../path[2]/to"/>``, a path relative to the element
+itself; :func:`read_urp` resolves these.
+
+Expressions are stored one character at a time (``<ExpressionChar character="x"/>``) with
+tokens (``<ExpressionToken token=" True "/>``), references to program variables, I/O pins,
+waypoints and installation variables in between; :class:`Expression` keeps the pieces and gives
+both the text PolyScope shows (with its symbols ``≔ ≟ ≠ ≤ ≥``) and the URScript text.
+
+Older programs (PolyScope 1.x, root ``<gui.program.ProgramRootNode>``, a serialised Java
+object) are refused with :class:`UrpError` naming the version; so is any file that is not a
+program, truncated, corrupt or not XML. Node types this reader does not know, and URCap
+nodes (``<Contributed>``), are kept as :class:`Node` with their XML tag and attributes, never
+dropped.
+
+Units as PolyScope stores them: lengths in m, angles in rad, speeds in m/s or rad/s,
+accelerations in m/s² or rad/s², times in s.
+"""
+
+from __future__ import annotations
+
+import gzip
+import re
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from xml.etree import ElementTree
+
+__all__ = [
+    "UrpError", "Expression", "Node", "Program", "read_urp", "parse_urp", "Kinematics",
+]
+
+
+class UrpError(Exception):
+    """A ``.urp`` file that cannot be read: not a program, truncated, corrupt, an unsupported
+    version or a broken reference. The message names the file (and the node when known)."""
+
+
+_SYMBOLS = {"≔": "=", "≟": "==", "≠": "!=", "≤": "<=", "≥": ">=", "∧": " and ", "∨": " or ",
+            "⊕": " xor ", "¬": " not ", "≡": "=="}
+"""PolyScope's expression editor symbols and their URScript spelling."""
+
+
+@dataclass(frozen=True)
+class Expression:
+    """A PolyScope expression: ``parts`` are ``(kind, text)`` pairs in order, where kind is
+    ``char`` (one character), ``token``, ``var`` (a program or installation variable name),
+    ``io`` (a pin name), ``waypoint`` (a waypoint name). ``label`` is the text PolyScope shows,
+    ``script`` the URScript text it generates."""
+
+    parts: tuple[tuple[str, str], ...] = ()
+
+    @property
+    def label(self) -> str:
+        return "".join(text for _kind, text in self.parts)
+
+    @property
+    def script(self) -> str:
+        out = []
+        for kind, text in self.parts:
+            if kind == "char":
+                out.append(_SYMBOLS.get(text, text))
+            elif kind == "waypoint":
+                out.append(f"{text}_p")
+            else:
+                out.append(text)
+        return "".join(out)
+
+    def __bool__(self) -> bool:
+        return bool(self.parts)
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """The arm's calibrated Denavit-Hartenberg parameters as stored in the program (standard
+    DH, per joint: ``delta_theta`` in rad added to the joint angle, ``a`` and ``d`` in m,
+    ``alpha`` in rad)."""
+
+    delta_theta: tuple[float, ...]
+    a: tuple[float, ...]
+    d: tuple[float, ...]
+    alpha: tuple[float, ...]
+
+
+@dataclass(eq=False)
+class Node:
+    """One node of the program tree.
+
+    ``kind`` is PolyScope's node type (the XML tag: ``Move``, ``Waypoint``, ``Loop``, ... and
+    ``Contributed`` for URCap nodes; a ``gui.program.direction.MoveDirectionNode`` is kind
+    ``Direction``). ``attrs`` holds the XML attributes as written, ``children`` the program
+    child nodes, ``name`` the node's own name where it has one (waypoint, folder, subprogram,
+    thread, variable). ``fields`` carries what the reader parsed for the node's type (see
+    :func:`parse_urp`), with SI units. ``element`` is the XML element (after reference
+    resolution), for details no field covers.
+    """
+
+    kind: str
+    attrs: dict[str, str]
+    children: list[Node] = field(default_factory=list)
+    name: str | None = None
+    fields: dict[str, object] = field(default_factory=dict)
+    element: ElementTree.Element | None = field(default=None, repr=False)
+    parent: Node | None = field(default=None, repr=False)
+    suppressed: bool = False
+
+    @property
+    def path(self) -> str:
+        """The node path as PolyScope shows it: ``Robot Program > Loop > MoveL > Waypoint_1``."""
+        parts = []
+        node: Node | None = self
+        while node is not None:
+            parts.append(node.title)
+            node = node.parent
+        return " > ".join(reversed(parts))
+
+    @property
+    def title(self) -> str:
+        if self.kind == "MainProgram":
+            return "Robot Program"
+        if self.kind == "Move":
+            return self.attrs.get("motionType", "Move")
+        if self.kind == "SpecialSequence":
+            return self.attrs.get("type", "BeforeStart")
+        if self.kind == "Contributed":
+            return self.attrs.get("strategyProgramNodeType", "URCap node")
+        return self.name or self.kind
+
+    def walk(self):
+        """This node and its descendants, depth first, in program order."""
+        stack = [self]
+        while stack:
+            node = stack.pop()
+            yield node
+            stack.extend(reversed(node.children))
+
+
+@dataclass(eq=False)
+class Program:
+    """A PolyScope program: ``name``, the installation it names, the version that saved it,
+    the arm's calibration, and its top-level nodes (``before_start``, ``main``, ``threads``,
+    ``subprograms``, other nodes in ``others``)."""
+
+    path: str
+    name: str
+    installation: str | None
+    created_in: str | None
+    saved_in: str | None
+    kinematics: Kinematics | None
+    main: Node
+    before_start: Node | None = None
+    init_variables: Node | None = None
+    threads: list[Node] = field(default_factory=list)
+    subprograms: list[Node] = field(default_factory=list)
+    others: list[Node] = field(default_factory=list)
+    top: list[Node] = field(default_factory=list)
+    """Every top-level node in the order the file lists them (PolyScope numbers them so)."""
+
+    @property
+    def major_version(self) -> int | None:
+        version = self.saved_in or self.created_in
+        if not version:
+            return None
+        head = version.split(".")[0]
+        return int(head) if head.isdigit() else None
+
+
+# ---- reading -------------------------------------------------------------------------------
+
+
+def _decompress(data: bytes, path: str) -> bytes:
+    if data[:2] == b"\x1f\x8b":
+        try:
+            return gzip.decompress(data)
+        except (OSError, EOFError, zlib.error) as error:
+            raise UrpError(f"{path}: error: not a readable PolyScope program: the gzip data "
+                           f"is truncated or corrupt ({error})") from None
+    return data
+
+
+def read_urp(path: str | Path) -> Program:
+    """Read the ``.urp`` file at ``path``. Raises :class:`UrpError` (naming the file) for a
+    file that cannot be read as a program."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError as error:
+        raise UrpError(f"{path}: error: cannot read: {error.strerror}") from None
+    return parse_urp(data, str(path))
+
+
+def parse_urp(data: bytes, path: str = "<urp>") -> Program:
+    """Parse the bytes of a ``.urp`` file (gzip or plain XML) into a :class:`Program`."""
+    xml = _decompress(data, path)
+    try:
+        root = ElementTree.fromstring(xml)
+    except ElementTree.ParseError as error:
+        what = "truncated" if "no element found" in str(error) or "unclosed" in str(error) \
+            else "not well-formed XML"
+        raise UrpError(f"{path}: error: not a readable PolyScope program ({what}: "
+                       f"{error})") from None
+    if root.tag.startswith("gui.program."):
+        raise UrpError(f"{path}: error: a PolyScope 1.x program (<{root.tag}>); urdsl reads "
+                       "programs saved by PolyScope 3.x and 5.x (root <URProgram>): open and "
+                       "save it in PolyScope 3 or later")
+    if root.tag != "URProgram":
+        raise UrpError(f"{path}: error: not a PolyScope program (root element <{root.tag}>, "
+                       "expected <URProgram>)")
+    return _Reader(root, path).program()
+
+
+_INDEX = re.compile(r"^(.+)\[(\d+)\]$")
+
+
+class _Reader:
+    def __init__(self, root: ElementTree.Element, path: str) -> None:
+        self.root = root
+        self.path = path
+        self.parents: dict[ElementTree.Element, ElementTree.Element] = {
+            child: parent for parent in root.iter() for child in parent}
+        self.nodes: dict[ElementTree.Element, Node] = {}
+
+    # -- references
+    def resolve(self, element: ElementTree.Element) -> ElementTree.Element:
+        """The element an XStream ``reference`` attribute points to (or ``element``)."""
+        seen = 0
+        while "reference" in element.attrib and seen < 100:
+            seen += 1
+            target = element
+            for step in element.attrib["reference"].split("/"):
+                if step == "..":
+                    target = self.parents.get(target)
+                    if target is None:
+                        break
+                    continue
+                if step in ("", "."):
+                    continue
+                match = _INDEX.match(step)
+                tag, index = (match.group(1), int(match.group(2))) if match else (step, 1)
+                found = [child for child in target if child.tag == tag]
+                if len(found) < index:
+                    target = None
+                    break
+                target = found[index - 1]
+            if target is None:
+                raise UrpError(f"{self.path}: error: broken reference "
+                               f"{element.attrib['reference']!r} in <{element.tag}>")
+            element = target
+        return element
+
+    # -- the program
+    def program(self) -> Program:
+        root = self.root
+        kinematics = None
+        block = root.find("kinematics")
+        if block is not None:
+            kinematics = _kinematics(block)
+        children = root.find("children")
+        if children is None:
+            raise UrpError(f"{self.path}: error: a PolyScope program without <children>; the "
+                           "file is truncated or not a program")
+        main = before = init = None
+        threads: list[Node] = []
+        subs: list[Node] = []
+        others: list[Node] = []
+        top: list[Node] = []
+        for element in children:
+            target = self.resolve(element)
+            node = self.node(target, None)
+            if element.tag == "MainProgram":
+                main = node
+            elif element.tag == "SpecialSequence" and node.attrs.get("type") == "BeforeStart":
+                before = node
+            elif element.tag == "InitVariablesNode":
+                init = node
+            elif element.tag == "Thread":
+                threads.append(node)
+            elif element.tag == "SubProgram":
+                if target.tag == "subprogram":  # the subprogram's body lives in its Call
+                    node = self.node(target, None)
+                subs.append(node)
+            else:
+                others.append(node)
+            top.append(node)
+        if main is None:
+            raise UrpError(f"{self.path}: error: the program has no <MainProgram> (Robot "
+                           "Program) node")
+        return Program(self.path, root.get("name", Path(self.path).stem),
+                       root.get("installation"), root.get("createdIn"),
+                       root.get("lastSavedIn"), kinematics, main, before, init, threads, subs,
+                       others, top)
+
+    def node(self, element: ElementTree.Element, parent: Node | None) -> Node:
+        element = self.resolve(element)
+        known = self.nodes.get(element)
+        if known is not None:
+            return known
+        kind = element.tag
+        suppressed = False
+        if kind == "SuppressedNode":  # a suppressed node: the node itself is inside
+            inner = element.find("suppressedNode")
+            if inner is None:
+                raise UrpError(f"{self.path}: error: an empty <SuppressedNode> in "
+                               f"{parent.path if parent else 'the program'}")
+            node = self.node(inner, parent)
+            node.suppressed = True
+            self.nodes[element] = node
+            return node
+        if kind == "suppressedNode":
+            kind = element.get("class", "Unknown").rsplit(".", 1)[-1]
+        if kind.endswith("MoveDirectionNode"):
+            kind = "Direction"
+        elif kind == "subprogram":
+            kind = "SubProgram"
+        node = Node(kind, dict(element.attrib), name=element.get("name"), element=element,
+                    parent=parent, suppressed=suppressed)
+        self.nodes[element] = node
+        try:
+            _FIELDS.get(kind, _no_fields)(self, node, element)
+        except UrpError:
+            raise
+        except (ValueError, TypeError, IndexError) as error:
+            raise UrpError(f"{self.path}: error: node {node.path}: {error}") from None
+        children = element.find("children")
+        if children is not None:
+            for child in children:
+                node.children.append(self.node(child, node))
+        return node
+
+    # -- expressions
+    def expression(self, element: ElementTree.Element | None) -> Expression:
+        parts: list[tuple[str, str]] = []
+        if element is None:
+            return Expression()
+        for piece in element:
+            tag = piece.tag
+            if tag == "ExpressionChar":
+                parts.append(("char", piece.get("character", "")))
+            elif tag == "ExpressionToken":
+                parts.append(("token", piece.get("token", "")))
+            elif tag in ("ExpressionVariable", "ExpressionIO", "ExpressionWaypoint",
+                         "ExpressionFeature", "ExpressionGeomFeature"):
+                parts.append(self._reference_part(piece))
+            else:
+                parts.append(("token", piece.get("token", piece.get("name", ""))))
+        return Expression(tuple(parts))
+
+    def _reference_part(self, piece: ElementTree.Element) -> tuple[str, str]:
+        for inner in piece:
+            target = self.resolve(inner)
+            name = (target.get("name") or target.get("featureName")
+                    or target.get("referencedName") or "")
+            if piece.tag == "ExpressionIO":
+                return ("io", name or inner.get("referencedName", ""))
+            if piece.tag == "ExpressionWaypoint":
+                return ("waypoint", name)
+            return ("var", name)
+        return ("token", piece.get("name", ""))
+
+    def variable_name(self, element: ElementTree.Element | None) -> str | None:
+        if element is None:
+            return None
+        target = self.resolve(element)
+        return target.get("name") or target.get("featureName")
+
+
+def _floats(text: str | None) -> tuple[float, ...]:
+    if not text:
+        return ()
+    return tuple(float(x) for x in text.replace(" ", "").split(",") if x)
+
+
+def _kinematics(element: ElementTree.Element) -> Kinematics | None:
+    values = {}
+    for key in ("deltaTheta", "a", "d", "alpha"):
+        child = element.find(key)
+        values[key] = _floats(child.get("value") if child is not None else None)
+    if not all(len(v) == 6 for v in values.values()):
+        return None
+    return Kinematics(values["deltaTheta"], values["a"], values["d"], values["alpha"])
+
+
+def _no_fields(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    if element.find("expression") is not None:
+        node.fields["expression"] = reader.expression(element.find("expression"))
+
+
+def _float_attr(element: ElementTree.Element | None, name: str) -> float | None:
+    if element is None:
+        return None
+    value = element.get(name)
+    return float(value) if value not in (None, "") else None
+
+
+def _move(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["motion_type"] = element.get("motionType", "MoveJ")
+    node.fields["speed"] = _float_attr(element, "speed")
+    node.fields["acceleration"] = _float_attr(element, "acceleration")
+    node.fields["blend"] = _float_attr(element, "blendRadius")
+    feature = element.find("feature")
+    if feature is not None:
+        node.fields["feature"] = reader.resolve(feature).get("referencedName")
+    tcp = element.find("tcp")
+    if tcp is not None:
+        node.fields["tcp"] = reader.resolve(tcp).get("referencedName")
+
+
+def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "Fixed")
+    params = element.find("motionParameters")
+    if params is not None:
+        node.fields["params"] = {key: float(value) for key, value in params.attrib.items()
+                                 if re.fullmatch(r"-?[0-9.Ee+-]+", value)}
+        node.fields["params_attrs"] = dict(params.attrib)
+    position = element.find("position")
+    if position is not None:
+        position = reader.resolve(position)
+        if position.get("joints"):  # PolyScope 3: joints and the TCP pose as attributes
+            node.fields["q"] = _floats(position.get("joints"))
+        if position.get("pose"):
+            node.fields["pose"] = _floats(position.get("pose"))
+        angles = position.find("JointAngles")
+        if angles is not None:
+            node.fields["q"] = _floats(reader.resolve(angles).get("angles"))
+        offset = position.find("TCPOffset")
+        if offset is not None:
+            node.fields["tcp_offset"] = _floats(reader.resolve(offset).get("pose"))
+        kin = position.find("Kinematics")
+        if kin is not None:
+            node.fields["kinematics"] = _kinematics(reader.resolve(kin))
+    relative = element.find("relativeFromPosition")
+    if relative is not None:
+        relative = reader.resolve(relative)
+        if relative.get("joints"):
+            node.fields["from_q"] = _floats(relative.get("joints"))
+        if relative.get("pose"):
+            node.fields["from_pose"] = _floats(relative.get("pose"))
+        angles = relative.find("JointAngles")
+        if angles is not None:
+            node.fields["from_q"] = _floats(reader.resolve(angles).get("angles"))
+        offset = relative.find("TCPOffset")
+        if offset is not None:
+            node.fields["from_tcp_offset"] = _floats(reader.resolve(offset).get("pose"))
+        kin = relative.find("Kinematics")
+        if kin is not None:
+            node.fields["from_kinematics"] = _kinematics(reader.resolve(kin))
+    base = element.find("BaseToFeature")
+    if base is not None:
+        node.fields["base_to_feature"] = _floats(reader.resolve(base).get("pose"))
+    variable = element.find("variable")
+    if variable is not None:
+        node.fields["variable"] = reader.variable_name(variable)
+
+
+def _loop(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "Forever")
+    if element.get("count"):
+        node.fields["count"] = int(element.get("count"))
+    node.fields["variable"] = reader.variable_name(element.find("loopVariable"))
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
+def _if(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "If")
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
+def _wait(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "Sleep")
+    wait_time = element.find("waitTime")
+    if wait_time is not None and wait_time.text:
+        node.fields["seconds"] = float(wait_time.text)
+    pin = element.find("pin")
+    if pin is not None:
+        node.fields["pin"] = reader.resolve(pin).get("referencedName")
+    value = element.find("digitalValue")
+    if value is not None and value.text:
+        node.fields["digital"] = value.text.strip()
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
+def _set(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "NoAction")
+    pin = element.find("pin")
+    if pin is not None:
+        node.fields["pin"] = reader.resolve(pin).get("referencedName")
+    for key in ("digitalValue", "analogValue"):
+        value = element.find(key)
+        if value is not None and value.text:
+            node.fields[key] = value.text.strip()
+    tcp = element.find("tcp")
+    if tcp is not None:
+        node.fields["tcp"] = reader.resolve(tcp).get("referencedName")
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
+def _assignment(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    variable = element.find("variable")
+    if variable is not None:
+        target = reader.resolve(variable)
+        node.name = target.get("name") or target.get("featureName")
+        node.fields["persistent"] = target.get("prefersPersistentValue") == "true"
+    node.fields["source"] = element.get("valueSource", "Expression")
+    node.fields["message"] = element.get("message", "")
+    node.fields["value_type"] = element.get("valueType", "")
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
+def _script(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "Line")
+    node.fields["expression"] = reader.expression(element.find("expression"))
+    contents = element.find("cachedContents")
+    if contents is not None:
+        node.fields["contents"] = contents.text or ""
+    file = element.find("file")
+    if file is not None:
+        node.fields["file"] = (file.text or "").strip()
+
+
+def _popup(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "Message")
+    node.fields["message"] = element.get("message", "")
+    node.fields["halt"] = element.get("haltProgram") == "true"
+    node.fields["input"] = element.get("inputType", "Text")
+    node.fields["variable"] = reader.variable_name(element.find("variable"))
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
+def _comment(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["text"] = element.get("comment", "")
+
+
+def _direction(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    feature = element.find("feature")
+    if feature is not None:
+        node.fields["feature"] = reader.resolve(feature).get("referencedName")
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
+def _force(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["type"] = element.get("type", "Frame")
+    feature = element.find("feature")
+    if feature is not None:
+        node.fields["feature"] = reader.resolve(feature).get("referencedName")
+    for key in ("selection", "wrench", "limitsForce", "limitsMotion"):
+        child = element.find(key)
+        if child is not None:
+            node.fields[key] = _floats(reader.resolve(child).get("value"))
+
+
+def _timer(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["action"] = element.get("action", "Start")
+    node.name = reader.variable_name(element.find("variable"))
+
+
+def _subprogram(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    file = element.find("programFile")
+    node.fields["file"] = (file.text or "").strip() if file is not None else None
+
+
+def _call(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    sub = element.find("subprogram")
+    if sub is not None:
+        target = reader.resolve(sub)
+        node.name = target.get("name")
+        node.fields["subprogram"] = reader.node(target, None)
+
+
+_FIELDS = {
+    "Move": _move, "Waypoint": _waypoint, "Loop": _loop, "If": _if, "Wait": _wait,
+    "Set": _set, "Assignment": _assignment, "Script": _script, "Popup": _popup,
+    "Comment": _comment, "Timer": _timer, "Direction": _direction, "Force": _force,
+    "SubProgram": _subprogram, "CallSubProgram": _call,
+}
