@@ -371,3 +371,47 @@ def test_a_cell_is_checked_with_the_inferred_robot(ur10e_program, tmp_path, caps
     cell.write_text("[floor]\nheight = -0.5\n")
     assert main(["check", str(ur10e_program), "--cell", str(cell), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["robot"] == "ur10e"
+
+
+def _untaught_program(target: str) -> str:
+    # a PolyScope export ($ labels) whose moves are computed: no waypoint pairs to infer from
+    return ("def Untaught():\n"
+            '  $ 1 "Robot Program"\n'
+            "  movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])\n"
+            f'  $ 2 "MoveL"\n'
+            f"  movel(p{target}, a=1.2, v=0.25)\n"
+            "end\n")
+
+
+def _check_json(tmp_path, capsys, text: str, *flags: str) -> dict:
+    path = tmp_path / "untaught.script"
+    path.write_text(text)
+    main(["check", "--json", *flags, str(path)])
+    return json.loads(capsys.readouterr().out)
+
+
+def test_model_findings_on_an_unknown_robot_are_warnings_that_say_so(tmp_path, capsys):
+    # 1.1 m from the base: out of a UR5e's reach, inside a UR10e's
+    report = _check_json(tmp_path, capsys, _untaught_program("[-1.1, -0.1, 0.3, 0, 3.14, 0]"))
+    (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
+    assert finding["severity"] == "warning" and report["ok"]
+    assert "on the assumed ur5e" in finding["message"] and "--robot" in finding["hint"]
+    # given the robot, the same move is an error
+    report = _check_json(tmp_path, capsys, _untaught_program("[-1.1, -0.1, 0.3, 0, 3.14, 0]"),
+                         "--robot", "ur5e")
+    (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
+    assert finding["severity"] == "error" and not report["ok"]
+
+
+def test_a_target_no_ur_model_reaches_stays_an_error(tmp_path, capsys):
+    report = _check_json(tmp_path, capsys, _untaught_program("[-3.5, 0, 0.3, 0, 3.14, 0]"))
+    (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
+    assert finding["severity"] == "error" and "assumed" not in finding["message"]
+
+
+def test_a_hand_written_script_keeps_the_default_model_certain(tmp_path, capsys):
+    text = ("movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])\n"
+            "movel(p[-1.1, -0.1, 0.3, 0, 3.14, 0], a=1.2, v=0.25)\n")
+    report = _check_json(tmp_path, capsys, text)
+    (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
+    assert finding["severity"] == "error"

@@ -183,7 +183,7 @@ def _check_script(source, args: argparse.Namespace, options):
     from ..project.check import in_context
     from ..script.diagnostics import ScriptError
     from ..script.parser import parse
-    from .infer import apply, infer
+    from .infer import apply, infer, qualify
     from .run import check_text, check_tree
 
     try:
@@ -209,6 +209,7 @@ def _check_script(source, args: argparse.Namespace, options):
         file_options.cell = _load_cell(file_options.robot, args.cell)
     report = check_tree(module, source.name, file_options)
     report.inferred = inference
+    qualify(report, inference)
     if context is not None:
         report.context = context.note
     return report

@@ -19,9 +19,12 @@ values override (and are then not inferred).
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from ..script import nodes as n
 from .run import DEFAULT_START, CheckOptions
@@ -71,6 +74,7 @@ class Inference:
     gravity: tuple[float, float, float] | None = None
     installation: str | None = None
     notes: list[str] = field(default_factory=list)
+    polyscope: bool = False  # written by PolyScope (waypoint pairs or `$` labels): taught
 
     def robot_line(self) -> str:
         """One sentence about the robot model."""
@@ -456,9 +460,10 @@ def infer(module: n.Module, filename: str | None = None, *, robot: str | None = 
         if found.model is not None:
             result.robot = found.model
             result.robot_source = "inferred"
+    result.polyscope = bool(pairs) or any(isinstance(node, n.Marker) for node in n.walk(module))
     if start_joints is not None:
         result.start_joints, result.start_source = tuple(start_joints), "given"
-    elif not pairs and not any(isinstance(node, n.Marker) for node in n.walk(module)):
+    elif not result.polyscope:
         result.start_from = "not a PolyScope program"
     else:
         first = first_move_joints(module)
@@ -467,6 +472,44 @@ def infer(module: n.Module, filename: str | None = None, *, robot: str | None = 
             result.start_source = "inferred"
     result.notes = notes
     return result
+
+
+MODEL_DEPENDENT = frozenset({"URS301", "URS302", "URS303", "URS304", "URS305", "URS308"})
+"""Checks whose verdict depends on the arm's kinematics (reach, joint solutions, speeds,
+links), so on which UR model the program runs."""
+
+_POSITION = re.compile(r"at \[(-?[\d.]+), (-?[\d.]+), (-?[\d.]+)\] m")
+
+
+def qualify(report, inference: Inference) -> None:
+    """A PolyScope program was taught on a real arm; when neither ``--robot`` nor its
+    waypoints say which, findings that hold only for the assumed model (``MODEL_DEPENDENT``)
+    are not certain: they become warnings that say so. A target that no UR model reaches
+    (farther from the shoulder than the longest arm's reach plus the TCP) stays an error."""
+    if inference.robot_source != "default" or not inference.polyscope:
+        return
+    from ..kinematics import MODELS
+
+    tcp_length = float(np.linalg.norm(inference.tcp[:3])) if inference.tcp else 0.0
+    qualified = []
+    for finding in report.findings:
+        if finding.severity == "error" and finding.code in MODEL_DEPENDENT:
+            match = _POSITION.search(finding.message) if finding.code == "URS301" else None
+            if match is not None:
+                point = np.array([float(v) for v in match.groups()])
+                reachable = any(
+                    np.linalg.norm(point - (0.0, 0.0, spec.d1)) <= spec.reach + tcp_length
+                    for spec in MODELS.values())
+                if not reachable:
+                    qualified.append(finding)
+                    continue
+            finding = replace(
+                finding, severity="warning",
+                message=f"{finding.message} (on the assumed {inference.robot}: the robot this "
+                "program was taught on is not known)",
+                hint="give the robot with --robot MODEL to make this certain")
+        qualified.append(finding)
+    report.findings = qualified
 
 
 def apply(options: CheckOptions, inference: Inference, tcp_given: bool) -> CheckOptions:
