@@ -156,6 +156,9 @@ class _Stdin:
 
 
 def test_rules_lists_every_rule_and_explains_one(capsys):
+    from urdsl.lint.command import load_rules
+
+    RULES = load_rules()  # noqa: N806 - every stage's rules: lint, runtime and check
     assert main(["rules"]) == 0
     out = capsys.readouterr().out
     for code, rule in RULES.items():

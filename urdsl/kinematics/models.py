@@ -40,7 +40,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ModelSpec", "MODELS", "DH_ALPHA", "model_spec"]
+__all__ = ["ModelSpec", "MODELS", "DH_ALPHA", "model_spec", "JOINT_NAMES"]
+
+JOINT_NAMES = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
+"""The six joints of every UR arm, from the base out, as PolyScope names them (the URDF of
+the robot description calls them ``shoulder_pan_joint`` … ``wrist_3_joint``)."""
 
 #: The twist angles α_i [rad] shared by every UR arm.
 DH_ALPHA = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)

@@ -6,7 +6,9 @@ import argparse
 import math
 import sys
 
-from .findings import RULES
+from ..rules import RULES
+from . import checks  # noqa: F401 - registers the trace checks (their rules)
+from . import findings as _findings  # noqa: F401 - registers the rules of the run
 
 __all__ = ["add_commands", "cmd_check", "parse_vector"]
 
@@ -33,8 +35,11 @@ examples:
   urdsl check pick.script --tcp-speed-limit 0.25 --json > report.json
   urdsl check pick.script --plot pick.png
 
-rules:
-""" + "\n".join(f"  {code}  {severity:<8} {text}" for code, (severity, text) in RULES.items())
+rules ('urdsl rules CODE' explains one, 'urdsl rules URS3' all of the checker's):
+  URS2xx  error    runtime errors of the program (urdsl rules URS2)
+""" + "\n".join(f"  {rule.code}  {rule.severity:<8} {rule.summary}"
+                for rule in sorted(RULES.values(), key=lambda rule: rule.code)
+                if rule.stage == "check")
 
 
 def parse_vector(text: str, count: int, what: str, degrees: bool = False) -> tuple:
