@@ -82,7 +82,7 @@ def add_commands(commands) -> None:
 
 
 def cmd_compile(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError
 
     try:
         program = load_program(args.program)

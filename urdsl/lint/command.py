@@ -130,7 +130,7 @@ def _expand(names: list[str]) -> list[str]:
 def _expand_with_roots(names: list[str]) -> list[tuple[str, str | None]]:
     """Each file with the folder named on the command line it was found in (None for a
     file named itself): a folder named on the command line is one project."""
-    from ..cli import UsageError
+    from .._cli import UsageError
 
     files: list[tuple[str, str | None]] = []
     for name in names:
@@ -160,7 +160,7 @@ class _Projects:
 
     def context(self, file: str, root: str | None):
         """``(FileContext, new diagnostics of the project)`` for ``file``."""
-        from ..cli import UsageError
+        from .._cli import UsageError
         from ..project import Project, ProjectError
 
         key = root if root is not None else str(Path(file).resolve().parent)
@@ -180,7 +180,7 @@ class _Projects:
 
 
 def cmd_lint(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
     from . import report
     from .config import ConfigError, settings_for
     from .linter import lint_text, lint_tree
@@ -241,7 +241,7 @@ def load_rules() -> dict:
 
 
 def cmd_rules(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, UsageError
+    from .._cli import EXIT_OK, UsageError
 
     every = load_rules()
     chosen = sorted(every.values(), key=lambda rule: rule.code)

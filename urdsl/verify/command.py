@@ -125,13 +125,10 @@ def add_commands(commands) -> None:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
-    from ..kinematics import MODELS
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input, robot_model
     from .run import DEFAULT_START, CheckOptions
 
-    robot = (args.robot or "ur5e").lower()
-    if robot not in MODELS:
-        raise UsageError(f"unknown robot model {args.robot!r}; known: {', '.join(MODELS)}")
+    robot = robot_model(args.robot or "ur5e")
     if args.plot and len(args.files) > 1:
         raise UsageError("--plot takes one file at a time")
     options = CheckOptions(
@@ -183,7 +180,7 @@ def _check_script(source, args: argparse.Namespace, options):
     :mod:`urdsl.verify.infer`) where the command line leaves it open."""
     import os
 
-    from ..cli import UsageError
+    from .._cli import UsageError
     from ..project import ProjectError
     from ..project.check import in_context
     from ..script.diagnostics import ScriptError
@@ -221,7 +218,7 @@ def _check_script(source, args: argparse.Namespace, options):
 
 def _load_cell(robot: str, path: str):
     """The collision model of ``robot`` with the cell's obstacles, or a usage error."""
-    from ..cli import UsageError
+    from .._cli import UsageError
     from ..kinematics import KinematicsError, Robot
     from ..kinematics.collision import CollisionModel
 
@@ -234,7 +231,7 @@ def _load_cell(robot: str, path: str):
 
 
 def _check_program(name: str, options):
-    from ..cli import UsageError
+    from .._cli import UsageError
     from .run import check_file
 
     try:
