@@ -355,7 +355,7 @@ class MotionPlanner:
         :data:`STOP_MARGIN`; and whether the line was cut there. A line the arm can follow
         to its end is kept."""
         from .geometry import slerp_rotations
-        from .trace import _track
+        from .tracking import track
 
         length = _distance(pose, pose_from)
         if length < 1e-9:
@@ -371,7 +371,7 @@ class MotionPlanner:
             poses[:, :3, :3] = slerp_rotations(pose_from[:3, :3], pose[:3, :3], fractions)
             poses[:, :3, 3] = pose_from[:3, 3] + fractions[:, None] * (pose[:3, 3]
                                                                          - pose_from[:3, 3])
-            q = _track(model, poses, np.repeat(q_first[None], len(fractions), axis=0),
+            q = track(model, poses, np.repeat(q_first[None], len(fractions), axis=0),
                        np.repeat(q_first[None], len(fractions), axis=0),
                        np.zeros(len(fractions), dtype=np.int64), tcp)
             steps = np.abs(np.diff(np.vstack([q_first, q]), axis=0)).max(axis=1)

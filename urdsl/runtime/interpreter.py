@@ -38,6 +38,7 @@ from .unknown import (
     unknown_call,
 )
 from .values import (
+    LIST_LIMIT,
     ListValue,
     PoseValue,
     StructValue,
@@ -61,10 +62,6 @@ EVENT_LIMIT = 10_000
 """Events (and environment messages) an unpaced run keeps; later ones are counted, not kept
 (``RunResult.events_dropped``): a cell program's ``textmsg`` at every pass would otherwise
 fill the checker's memory. A paced run (the virtual controller) keeps all."""
-
-LIST_LIMIT = 1_000_000
-"""Values (list items, matrix cells, struct members, counted through nesting) one value may
-hold. The controller documents no maximum [U]; this bounds the checker's memory."""
 
 BREAK, CONTINUE, RETURN = 1, 2, 3
 
