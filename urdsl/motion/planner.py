@@ -23,7 +23,7 @@ stays continuous in position and speed. A blend therefore shortens the cycle by 
 model reproduces its topology (no stop, curve within the sphere) and its overlap rule, not
 its exact timing.
 
-Overlap rule (UR_FACTS.md §2): consecutive blend spheres must not overlap,
+Overlap rule (docs/controller-facts.md §4): consecutive blend spheres must not overlap,
 ``r_prev + r > |P - P_prev|``, where the start point and a stop point count as ``r = 0``.
 An offending move is skipped, with an "Overlapping Blends" warning, as the robot does.
 """

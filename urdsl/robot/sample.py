@@ -16,7 +16,7 @@ ROBOT_MODES = {
     -1: "NO_CONTROLLER", 0: "DISCONNECTED", 1: "CONFIRM_SAFETY", 2: "BOOTING", 3: "POWER_OFF",
     4: "POWER_ON", 5: "IDLE", 6: "BACKDRIVE", 7: "RUNNING", 8: "UPDATING_FIRMWARE",
 }
-"""Robot modes of CB3 and e-Series (UR_FACTS.md §4.4)."""
+"""Robot modes of CB3 and e-Series (docs/controller-facts.md §5)."""
 
 SAFETY_MODES = {
     1: "NORMAL", 2: "REDUCED", 3: "PROTECTIVE_STOP", 4: "RECOVERY", 5: "SAFEGUARD_STOP",
@@ -24,7 +24,7 @@ SAFETY_MODES = {
     10: "VALIDATE_JOINT_ID", 11: "UNDEFINED_SAFETY_MODE", 12: "AUTOMATIC_MODE_SAFEGUARD_STOP",
     13: "SYSTEM_THREE_POSITION_ENABLING_STOP",
 }
-"""Safety modes (UR_FACTS.md §4.4)."""
+"""Safety modes (docs/controller-facts.md §5)."""
 
 PROGRAM_STATES = {0: "STOPPING", 1: "STOPPED", 2: "PLAYING", 3: "PAUSING", 4: "PAUSED",
                   5: "RESUMING"}

@@ -310,7 +310,8 @@ def _to_num(rt, node, str):  # noqa: A002 - the catalog's parameter name
 
 # ---- strings ------------------------------------------------------------------------------
 
-_STRING_LIMIT = 1023  # str_cat/to_str results are limited to 1023 characters (URSCRIPT_LANGUAGE §2)
+# str_cat/to_str results are limited to 1023 characters (docs/controller-facts.md §8.1)
+_STRING_LIMIT = 1023
 
 
 def _limited(rt, node, text: str) -> str:

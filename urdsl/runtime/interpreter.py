@@ -7,7 +7,7 @@ the thread wants to go on. The scheduler always resumes the thread that is due f
 robin among equals), so robot time jumps from event to event instead of ticking every
 controller frame: checking a long program takes a fraction of the time the robot needs.
 
-Scoping follows the controller (../shared/reference/URSCRIPT_LANGUAGE.md §4): variables at
+Scoping follows the controller (docs/controller-facts.md §8.3): variables at
 the first level of the program are global, even when written ``local``; inside functions
 and threads a free name is the global if one exists, else a local; ``local`` forces a new
 local and ``global`` a global. Arguments and assignments copy values.

@@ -61,7 +61,8 @@ class BuiltinParam:
 
 @dataclass(frozen=True)
 class Builtin:
-    """One row of the catalog (see ``BUILTINS.md`` for the meaning of each field)."""
+    """One row of the catalog (``docs/controller-facts.md`` §9 gives the meaning of each
+    field)."""
 
     module: str
     name: str
