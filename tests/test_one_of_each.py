@@ -59,3 +59,49 @@ def test_one_list_of_joint_names():
 
     assert JOINT_NAMES == ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
     assert checks.JOINTS is JOINT_NAMES
+
+
+def test_thread_count_comes_from_the_machine_or_the_environment(capsys):
+    import os
+
+    from urdsl._threads import MAX_WORKERS, thread_count
+
+    cores = max(1, min(os.cpu_count() or 1, MAX_WORKERS))
+    assert thread_count({}) == cores
+    assert thread_count({"URDSL_THREADS": "3"}) == 3
+    assert thread_count({"URDSL_THREADS": " 1 "}) == 1
+    assert capsys.readouterr().err == ""
+    for bad in ("0", "-2", "two", "1.5"):
+        assert thread_count({"URDSL_THREADS": bad}) == cores
+        assert f"URDSL_THREADS={bad!r} is not a positive whole number" in capsys.readouterr().err
+
+
+def test_the_pool_uses_the_setting(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    code = ("from urdsl._threads import WORKERS, shared_pool; "
+            "print(WORKERS, shared_pool()._max_workers)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env={**os.environ, "URDSL_THREADS": "5"}).stdout
+    assert out.split() == ["5", "5"]
+
+
+def test_comments_cite_notes_that_live_in_the_repository():
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    facts = (root / "docs" / "controller-facts.md").read_text(encoding="utf-8")
+    sections = set(re.findall(r"^## (§\d+)", facts, flags=re.M))
+    items = {f"{section}.{number}" for section in sections for number in range(1, 10)}
+    later = ("urdsl/sim/", "urdsl/protocol/", "urdsl/robot/sender.py")  # the sim/protocol work
+    for path in sorted((root / "urdsl").rglob("*.py")):
+        name = path.relative_to(root).as_posix()
+        text = path.read_text(encoding="utf-8")
+        if not name.startswith(later):
+            assert not re.search(r"shared/reference|UR_FACTS|URSCRIPT_LANGUAGE|BUILTINS\.md",
+                                 text), name
+        for cited in re.findall(r"controller-facts\.md`{0,2},? (§[\d.]+\d)", text):
+            assert cited in sections or cited in items, f"{name} cites {cited}"
