@@ -1,7 +1,8 @@
 """Forward kinematics of the fourteen UR models against three independent references.
 
-* the DH test vectors of UR_FACTS.md §1.4 (40-digit arithmetic, 12 decimals) for the nine
-  models listed there, and the closed forms at q = 0 and q = upright for all fourteen;
+* DH test vectors computed from the nominal DH tables (docs/controller-facts.md §1) with
+  40-digit arithmetic, to 12 decimals, for the nine CB3/e-Series/UR20/UR30 models, and the
+  closed forms at q = 0 and q = upright for all fourteen;
 * the example-robot-data URDF chain ``base`` → ``tool0`` (UR3, UR5, UR10);
 * ur-analytic-ik's compiled forward kinematics (all fourteen models);
 
@@ -27,7 +28,7 @@ Q_NAMED = {
     "q_b": (1.0, -0.5, -1.0, 0.7, 2.0, -3.0),
 }
 
-# UR_FACTS.md §1.4: TCP positions [m] per model at q_zero, q_upright, q_a, q_b.
+# 40-digit DH test vectors: TCP positions [m] per model at q_zero, q_upright, q_a, q_b.
 POSITIONS = {
     "ur3": [(-0.4569, -0.19425, 0.06655), (0.0, -0.19425, 0.69415),
             (-0.374438261499, -0.156305705255, 0.278534021453),
@@ -58,7 +59,7 @@ POSITIONS = {
              (-0.320745527272, -0.752701947428, 1.033795268385)],
 }
 
-# UR_FACTS.md §1.4: rotation matrices (rows), the same for every model.
+# 40-digit DH test vectors: rotation matrices (rows), the same for every model.
 ROTATIONS = {
     "q_zero": [(1, 0, 0), (0, 0, -1), (0, 1, 0)],
     "q_upright": [(-1, 0, 0), (0, 0, -1), (0, -1, 0)],

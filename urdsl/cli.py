@@ -4,66 +4,33 @@ Each subcommand is a function ``cmd_<name>(args) -> int`` registered in :func:`b
 the return value is the exit status. Bad input (a file that is not URScript, a missing file)
 is reported as a message naming ``file:line:col``, never as a Python traceback.
 
+Helpers the command modules share (exit status, :class:`UsageError`, :func:`read_input`,
+``--robot`` names) live in :mod:`urdsl._cli`, below every command module; they import them
+from there, never from this module, which loads them.
+
 Exit status: 0 success, 1 the input has problems (syntax errors, files that ``fmt --check``
 would change), 2 usage or I/O errors.
 """
 
 from __future__ import annotations
 
+__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_PROBLEMS", "EXIT_USAGE", "UsageError",
+           "InputFile", "read_input", "robot_model"]
+
 import argparse
 import difflib
 import importlib
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 from . import __version__
+from ._cli import EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE, InputFile, UsageError, read_input, robot_model
+from ._cli import error as _error
 from ._deep import FOLLOWED_DEPTH, run_deep
 from .script.diagnostics import ScriptError
 from .script.nodes import dump_json, to_dict
 from .script.parser import parse
 from .script.printer import format as format_tree
-
-EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE = 0, 1, 2
-
-
-class UsageError(Exception):
-    """A problem with the command line or the files it names (exit status 2)."""
-
-
-@dataclass
-class InputFile:
-    """A file read for a command: its name for messages, its text and its encoding."""
-
-    name: str
-    text: str
-    encoding: str
-    path: str | None  # None for standard input
-
-
-def read_input(name: str) -> InputFile:
-    """Read ``name`` (``-`` is standard input). URScript files are UTF-8; files that are not
-    valid UTF-8 are read as Latin-1 (PolyScope's 8-bit text), and written back the same way."""
-    if name == "-":
-        data = sys.stdin.buffer.read()
-        path = None
-        label = "<stdin>"
-    else:
-        try:
-            with open(name, "rb") as handle:
-                data = handle.read()
-        except OSError as error:
-            raise UsageError(f"cannot read {name}: {error.strerror}") from None
-        path = label = name
-    try:
-        return InputFile(label, data.decode("utf-8"), "utf-8", path)
-    except UnicodeDecodeError:
-        return InputFile(label, data.decode("latin-1"), "latin-1", path)
-
-
-def _error(message: str) -> None:
-    print(f"urdsl: error: {message}", file=sys.stderr)
-
 
 # ---- parse ---------------------------------------------------------------------------------
 
@@ -209,7 +176,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 _COMMAND_MODULES: list[str] = [
     "urdsl.dsl.command",
-    "urdsl.kinematics.cli",
+    "urdsl.kinematics.command",
     "urdsl.verify.command",
     "urdsl.robot.command",
     "urdsl.sim.command",

@@ -88,7 +88,7 @@ def add_commands(commands) -> None:
 
 
 def cmd_compile(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError
 
     suffix = Path(args.program).suffix.lower()
     if suffix == ".urp":  # a PolyScope program: compiled as PolyScope does

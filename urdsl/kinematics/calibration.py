@@ -5,7 +5,7 @@ Every UR arm is calibrated at the factory; the controller's forward kinematics
 
     θ_i → θ_i + δθ_i,   a_i → a_i + δa_i,   d_i → d_i + δd_i,   α_i → α_i + δα_i
 
-so a nominal model differs from the real robot by up to a few mm (``UR_FACTS.md`` §1.2).
+so a nominal model differs from the real robot by up to a few mm (``docs/controller-facts.md`` §1).
 The corrections reach urdsl in two ways:
 
 * the primary interface's KINEMATICS_INFO package carries the *calibrated* DH values

@@ -15,22 +15,24 @@ ROS ``tool0``, Z out of the flange) in the controller's Base frame (ROS ``base``
 
 Sources
 -------
-* DH tables of UR3 … UR30 (CB3 and e-Series, UR20, UR30): ``UR_FACTS.md`` §1.2, i.e. UR's
-  article "DH Parameters for calculations of kinematics and dynamics", the ROS 2 description
-  ``config/<model>/default_kinematics.yaml`` and ``ur_kinematics/src/ur_kin.cpp``, which agree.
+* DH tables of UR3 … UR30 (CB3 and e-Series, UR20, UR30): ``docs/controller-facts.md`` §1,
+  i.e. UR's article "DH Parameters for calculations of kinematics and dynamics", the ROS 2
+  description ``config/<model>/default_kinematics.yaml`` and
+  ``ur_kinematics/src/ur_kin.cpp``, which agree.
 * UR7e, UR12e, UR15, UR18, UR8 Long: the DH table of the ``ur-analytic-ik`` package
   (``dh_parameters.hh``, citing the same UR article). UR7e is the UR5e arm and UR12e the UR10e
   arm under the names UR uses since 2025.
 * Joint position limits: the controller allows ±2π (±360°) on every joint; wrist 3 of the
-  UR3 and UR3e turns without limit (``UR_FACTS.md`` §1.5), stored as ±∞.
+  UR3 and UR3e turns without limit (``docs/controller-facts.md`` §2), stored as ±∞.
 * Joint speed limits: ROS 2 description ``config/<model>/joint_limits.yaml`` (which cite the
-  UR manuals): UR_FACTS.md §1.5 for the first nine models, the UR12e file (= UR10e values),
-  the UR18 file (180, 180, 240, 300, 300, 300 °/s). UR7e uses the UR5e values. UR15 and UR8
-  Long use the UR18 values: same joint sizes (identical d1, d4, d5, d6) — unconfirmed [U].
-* Reach and payload: UR product data sheets as quoted in ``UR_FACTS.md`` §1.6 (UR10e 12.5 kg on
-  newer units); UR7e, UR12e, UR15, UR18 and UR8 Long from one third-party table of UR's
-  current line-up [S] (which also rates newer UR20/UR30 units at 25/35 kg; the original
-  20/30 kg ratings are kept here).
+  UR manuals): ``docs/controller-facts.md`` §2 for the first nine models, the UR12e file
+  (= UR10e values), the UR18 file (180, 180, 240, 300, 300, 300 °/s). UR7e uses the UR5e
+  values. UR15 and UR8 Long use the UR18 values: same joint sizes (identical d1, d4, d5,
+  d6) — unconfirmed [U].
+* Reach and payload: UR product data sheets as quoted in ``docs/controller-facts.md`` §3
+  (UR10e 12.5 kg on newer units); UR7e, UR12e, UR15, UR18 and UR8 Long from one
+  third-party table of UR's current line-up [S] (which also rates newer UR20/UR30 units at
+  25/35 kg; the original 20/30 kg ratings are kept here).
 """
 
 from __future__ import annotations
@@ -40,7 +42,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ModelSpec", "MODELS", "DH_ALPHA", "model_spec"]
+__all__ = ["ModelSpec", "MODELS", "DH_ALPHA", "model_spec", "JOINT_NAMES"]
+
+JOINT_NAMES = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
+"""The six joints of every UR arm, from the base out, as PolyScope names them (the URDF of
+the robot description calls them ``shoulder_pan_joint`` … ``wrist_3_joint``)."""
 
 #: The twist angles α_i [rad] shared by every UR arm.
 DH_ALPHA = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
@@ -62,8 +68,8 @@ class ModelSpec:
     ``q_min``, ``q_max`` joint position limits in rad (±∞ for an unlimited joint);
     ``qd_max`` joint speed limits in rad/s; ``generation`` is ``"cb3"``, ``"e-series"`` or
     ``"ur-series"``; ``reach`` in m; ``payload`` in kg; ``robot_type`` the primary interface's
-    ``robotType`` code (UR_FACTS.md §1.6; UR7e and UR12e are assumed to report the UR5 and
-    UR10 codes of the arms they rename [U]).
+    ``robotType`` code (docs/controller-facts.md §3; UR7e and UR12e are assumed to report the
+    UR5 and UR10 codes of the arms they rename [U]).
     """
 
     name: str

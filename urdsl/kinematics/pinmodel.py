@@ -28,11 +28,11 @@ import pinocchio as pin
 
 from .errors import KinematicsError
 
-__all__ = ["JOINT_NAMES", "build_dh_model", "example_robot_data_dir", "urdf_path",
+__all__ = ["URDF_JOINT_NAMES", "build_dh_model", "example_robot_data_dir", "urdf_path",
            "load_urdf_model", "URDF_MODELS"]
 
-JOINT_NAMES = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
-               "wrist_2_joint", "wrist_3_joint")
+URDF_JOINT_NAMES = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
+                    "wrist_1_joint", "wrist_2_joint", "wrist_3_joint")
 LINK_NAMES = ("shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link",
               "wrist_2_link", "wrist_3_link")
 
@@ -61,7 +61,7 @@ def build_dh_model(name: str, theta_offset, a, d, alpha, q_min, q_max, qd_max) -
     placement = pin.SE3.Identity()
     parent_frame = 0
     for i in range(6):
-        joint = model.addJoint(parent, pin.JointModelRZ(), placement, JOINT_NAMES[i],
+        joint = model.addJoint(parent, pin.JointModelRZ(), placement, URDF_JOINT_NAMES[i],
                                np.array([1e3]), np.array([float(qd_max[i])]),
                                np.array([float(q_min[i])]), np.array([float(q_max[i])]))
         joint_frame = model.addJointFrame(joint, parent_frame)

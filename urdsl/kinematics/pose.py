@@ -9,7 +9,7 @@ axis × angle in rad) in the controller's Base frame. As a homogeneous matrix::
 Every function accepts one pose (shape (6,)) or a batch (shape (N, 6)), and broadcasts a
 single pose against a batch where that makes sense. Matrices have shape (4, 4) or (N, 4, 4).
 
-Conventions (``UR_FACTS.md`` §2 and the URScript manual):
+Conventions (``docs/controller-facts.md`` §4 and the URScript manual):
 
 * ``pose_trans(a, b) = T(a)·T(b)``: ``b`` expressed in the frame of ``a``.
 * ``pose_add(a, b)``: positions added, rotations multiplied ``R = R_a·R_b`` (not pose_trans).

@@ -9,8 +9,6 @@ import os
 import sys
 from pathlib import Path
 
-from .registry import RULES
-
 __all__ = ["add_commands", "cmd_lint", "cmd_rules", "cmd_lsp"]
 
 _SUFFIXES = (".script", ".urscript", ".urs")
@@ -97,13 +95,17 @@ def add_commands(commands) -> None:
     p.set_defaults(run=cmd_lint)
 
     p = commands.add_parser(
-        "rules", help="list the lint rules, or explain one",
-        description="Explain every lint rule (code, severity, what it checks and why, an "
-        "example and its fix), or only the one named.",
+        "rules", help="list urdsl's rule codes (lint, runtime, check), or explain one",
+        description="Explain every rule code urdsl reports (code, severity, what it checks "
+        "and why, an example and its fix): syntax errors URS001, lint rules URS1xx, runtime "
+        "errors URS2xx and the checker's findings URS3xx; or only the one named, or those "
+        "whose code starts with the prefix given.",
         epilog="examples:\n  urdsl rules | less\n  urdsl rules --short\n  urdsl rules URS108\n"
-        "  urdsl rules unused-variable\n  urdsl rules --json",
+        "  urdsl rules URS304\n  urdsl rules URS3 --short\n  urdsl rules unused-variable\n"
+        "  urdsl rules --json",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("code", nargs="?", metavar="CODE", help="a rule code or name")
+    p.add_argument("code", nargs="?", metavar="CODE",
+                   help="a rule code, a code prefix (URS3) or a rule name")
     p.add_argument("--json", action="store_true", help="print the rules as JSON")
     p.add_argument("--short", action="store_true",
                    help="one line per rule: code, severity, name, summary")
@@ -128,7 +130,7 @@ def _expand(names: list[str]) -> list[str]:
 def _expand_with_roots(names: list[str]) -> list[tuple[str, str | None]]:
     """Each file with the folder named on the command line it was found in (None for a
     file named itself): a folder named on the command line is one project."""
-    from ..cli import UsageError
+    from .._cli import UsageError
 
     files: list[tuple[str, str | None]] = []
     for name in names:
@@ -158,7 +160,7 @@ class _Projects:
 
     def context(self, file: str, root: str | None):
         """``(FileContext, new diagnostics of the project)`` for ``file``."""
-        from ..cli import UsageError
+        from .._cli import UsageError
         from ..project import Project, ProjectError
 
         key = root if root is not None else str(Path(file).resolve().parent)
@@ -178,7 +180,7 @@ class _Projects:
 
 
 def cmd_lint(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
     from . import report
     from .config import ConfigError, settings_for
     from .linter import lint_text, lint_tree
@@ -228,42 +230,44 @@ def cmd_lint(args: argparse.Namespace) -> int:
     return EXIT_PROBLEMS if any(d.severity == "error" for d in found) else EXIT_OK
 
 
-def cmd_rules(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, UsageError
-    from . import linter  # noqa: F401 - registers the rules
+def load_rules() -> dict:
+    """Every rule of every stage, by code: imports the modules that register them."""
+    from ..rules import RULES as every
+    from ..runtime import errors  # noqa: F401 - URS2xx
+    from ..verify import checks, findings  # noqa: F401 - URS3xx, URS210
+    from . import linter  # noqa: F401 - URS0xx, URS1xx
 
+    return every
+
+
+def cmd_rules(args: argparse.Namespace) -> int:
+    from .._cli import EXIT_OK, UsageError
+
+    every = load_rules()
+    chosen = sorted(every.values(), key=lambda rule: rule.code)
     if args.code:
-        by_name = {rule.name: rule for rule in RULES.values()}
-        rule = RULES.get(args.code.upper()) or by_name.get(args.code)
-        if rule is None:
+        by_name = {rule.name: rule for rule in every.values()}
+        rule = every.get(args.code.upper()) or by_name.get(args.code)
+        chosen = [rule] if rule is not None else [
+            r for r in chosen if r.code.startswith(args.code.upper())]
+        if not chosen or len(args.code) < 4:
             raise UsageError(f"unknown rule {args.code!r}; 'urdsl rules' lists them")
-        if args.json:
-            print(json.dumps(_rule_dict(rule), indent=2, ensure_ascii=False))
-        else:
-            print(rule.describe())
-        return EXIT_OK
+        if rule is not None:
+            if args.json:
+                print(json.dumps(rule.to_dict(), indent=2, ensure_ascii=False))
+            else:
+                print(rule.describe())
+            return EXIT_OK
     if args.json:
-        print(json.dumps([_rule_dict(r) for r in _sorted()], indent=2, ensure_ascii=False))
+        print(json.dumps([r.to_dict() for r in chosen], indent=2, ensure_ascii=False))
         return EXIT_OK
     if args.short:
-        for rule in _sorted():
+        for rule in chosen:
             print(f"{rule.code}  {rule.severity:<8} {rule.name:<26} {rule.summary}")
         print("\nRun 'urdsl rules CODE' for the explanation of a rule with an example.")
         return EXIT_OK
-    print("\n\n".join(rule.describe() for rule in _sorted()))
+    print("\n\n".join(rule.describe() for rule in chosen))
     return EXIT_OK
-
-
-def _sorted():
-    return sorted(RULES.values(), key=lambda rule: rule.code)
-
-
-def _rule_dict(rule) -> dict:
-    return {
-        "code": rule.code, "name": rule.name, "severity": rule.severity,
-        "summary": rule.summary, "explanation": " ".join(rule.explanation.split()),
-        "example": rule.example, "fixed": rule.fixed,
-    }
 
 
 def cmd_lsp(args: argparse.Namespace) -> int:

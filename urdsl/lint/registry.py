@@ -3,15 +3,16 @@
 A rule is a small function ``check(ctx) -> Iterator[Diagnostic]`` registered with
 :func:`rule`. Codes never change meaning once published (as in ruff): ``URS001`` is a syntax
 error (raised by the parser, see :mod:`urdsl.script.diagnostics`), ``URS1xx`` are lint rules,
-``URS2xx`` runtime errors of the interpreter and ``URS3xx`` findings of the verifier.
+``URS2xx`` runtime errors of the interpreter and ``URS3xx`` findings of the verifier; all
+of them are in the one registry :data:`urdsl.rules.RULES`, this module adds the lint rules.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from ..rules import Rule, register
 from ..script.diagnostics import Diagnostic
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -22,31 +23,14 @@ __all__ = ["Rule", "RULES", "rule", "SYNTAX_RULE", "DEPTH_RULE", "expand_codes"]
 Check = Callable[["LintContext"], Iterator[Diagnostic]]
 
 
-@dataclass(frozen=True)
-class Rule:
-    """One lint rule. ``example`` triggers it, ``fixed`` is the same code written right."""
-
-    code: str
-    name: str
-    severity: str
-    summary: str
-    explanation: str
-    example: str
-    fixed: str
-    check: Check | None = field(default=None, compare=False, repr=False)
-
-    def describe(self) -> str:
-        """The text of ``urdsl rules CODE``."""
-        lines = [f"{self.code} {self.name} ({self.severity})", "", self.summary, ""]
-        lines += [self.explanation.strip(), "", "Example:"]
-        lines += ["    " + line for line in self.example.strip().splitlines()]
-        lines += ["", "Write instead:"]
-        lines += ["    " + line for line in self.fixed.strip().splitlines()]
-        return "\n".join(lines)
-
-
 RULES: dict[str, Rule] = {}
-"""Every rule by code, in code order (filled as the rule modules are imported)."""
+"""The lint rules by code, in code order (filled as the rule modules are imported); every
+rule of every stage is in :data:`urdsl.rules.RULES`."""
+
+
+def _add(new: Rule) -> Rule:
+    RULES[new.code] = register(new)
+    return new
 
 
 SYNTAX_RULE = Rule(
@@ -61,9 +45,9 @@ expected. Habits from other languages are named with the URScript way in the hin
 No other rule runs on a file with a syntax error, and it is reported whatever --select and
 --ignore say.""",
     example="p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3])",
-    fixed="p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3]",
+    fixed="p1 = p[0.200, -0.300, 0.300, 0.5, 0.0, -0.3]", stage="parse",
 )
-RULES[SYNTAX_RULE.code] = SYNTAX_RULE
+_add(SYNTAX_RULE)
 
 DEPTH_RULE = Rule(
     code="URS100", name="too-deep-to-lint", severity="info",
@@ -75,7 +59,7 @@ that file, and this note says which; every other rule still runs.""",
     example="if a:\n  if a:\n    ... (2000 levels) ...\n  end\nend",
     fixed="split the deep nesting into functions",
 )
-RULES[DEPTH_RULE.code] = DEPTH_RULE
+_add(DEPTH_RULE)
 
 
 def rule(
@@ -84,13 +68,11 @@ def rule(
 ) -> Callable[[Check], Check]:
     """Register the decorated function as the check of rule ``code``."""
 
-    def register(check: Check) -> Check:
-        if code in RULES:  # pragma: no cover - programming error
-            raise ValueError(f"rule {code} registered twice")
-        RULES[code] = Rule(code, name, severity, summary, explanation, example, fixed, check)
+    def add(check: Check) -> Check:
+        _add(Rule(code, name, severity, summary, explanation, example, fixed, check))
         return check
 
-    return register
+    return add
 
 
 def expand_codes(selectors: list[str]) -> set[str]:

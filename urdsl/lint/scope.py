@@ -1,6 +1,6 @@
 """Who defines and who uses each name, with the controller's scoping rules.
 
-The URScript manual's rules (``URSCRIPT_LANGUAGE.md`` §4, "Scoping"):
+The URScript manual's rules (``docs/controller-facts.md`` §8.3, "Scoping"):
 
 * variables at the first level of the program (directly inside the outer ``def``, or the
   top-level statements of a snippet that PolyScope pastes there) are global, even when
@@ -27,7 +27,7 @@ BUILTIN_VARIABLES = frozenset((
     "pi",  # [U] listed with urmath in older manuals; ur_driver assigns it anyway
     "a_joint_default", "a_tool_default", "v_joint_default", "v_tool_default", "__package__",
 ))
-"""Names the controller defines as variables (``URSCRIPT_LANGUAGE.md`` §6, [U])."""
+"""Names the controller defines as variables (``docs/controller-facts.md`` §8.5, [U])."""
 
 Definition = n.FunctionDef | n.ThreadDef | n.SecDef
 

@@ -23,7 +23,7 @@ stays continuous in position and speed. A blend therefore shortens the cycle by 
 model reproduces its topology (no stop, curve within the sphere) and its overlap rule, not
 its exact timing.
 
-Overlap rule (UR_FACTS.md §2): consecutive blend spheres must not overlap,
+Overlap rule (docs/controller-facts.md §4): consecutive blend spheres must not overlap,
 ``r_prev + r > |P - P_prev|``, where the start point and a stop point count as ``r = 0``.
 An offending move is skipped, with an "Overlapping Blends" warning, as the robot does.
 """
@@ -355,7 +355,7 @@ class MotionPlanner:
         :data:`STOP_MARGIN`; and whether the line was cut there. A line the arm can follow
         to its end is kept."""
         from .geometry import slerp_rotations
-        from .trace import _track
+        from .tracking import track
 
         length = _distance(pose, pose_from)
         if length < 1e-9:
@@ -371,7 +371,7 @@ class MotionPlanner:
             poses[:, :3, :3] = slerp_rotations(pose_from[:3, :3], pose[:3, :3], fractions)
             poses[:, :3, 3] = pose_from[:3, 3] + fractions[:, None] * (pose[:3, 3]
                                                                          - pose_from[:3, 3])
-            q = _track(model, poses, np.repeat(q_first[None], len(fractions), axis=0),
+            q = track(model, poses, np.repeat(q_first[None], len(fractions), axis=0),
                        np.repeat(q_first[None], len(fractions), axis=0),
                        np.zeros(len(fractions), dtype=np.int64), tcp)
             steps = np.abs(np.diff(np.vstack([q_first, q]), axis=0)).max(axis=1)

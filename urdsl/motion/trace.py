@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._threads import shared_pool
+from .tracking import track
 
 __all__ = ["Trace", "sample", "joints_at", "tcp_groups"]
 
@@ -390,7 +391,7 @@ def tcp_groups(segments) -> tuple[np.ndarray, list]:
 def _cartesian(planner, paths, which, fraction, q_start, linear):
     """Joint displacements of samples on TCP paths (rows sorted by move, then along the
     path): poses along each path, then inverse kinematics that follows one solution
-    continuously along each move (:func:`_track`), one batch per TCP."""
+    continuously along each move (:func:`urdsl.motion.tracking.track`), one batch per TCP."""
     from ..kinematics.pose import rotvec_to_matrix
 
     poses = np.repeat(np.eye(4)[None], len(which), axis=0)
@@ -408,72 +409,9 @@ def _cartesian(planner, paths, which, fraction, q_start, linear):
     groups = paths.tcp_group[which]
     for group in np.unique(groups):
         rows = np.flatnonzero(groups == group)
-        solutions[rows] = _track(planner.kinematics, poses[rows], near[rows],
+        solutions[rows] = track(planner.kinematics, poses[rows], near[rows],
                                  q_start[which[rows]], which[rows], paths.tcps[group])
     return solutions - q_start[which]
-
-
-def _track(model, poses: np.ndarray, near: np.ndarray, first: np.ndarray,
-           owner: np.ndarray, tcp) -> np.ndarray:
-    """Joints (N, 6) for ``poses`` (N, 4, 4) along TCP paths, following one IK solution
-    continuously, as the controller does on a straight line: each sample takes the solution
-    closest to the sample before it on the same move (``owner``: the move of each row; rows
-    of a move in path order), the first sample of a move the one closest to where the move
-    starts (``first``, rad). A branch change then shows only where no continuous solution
-    exists — at a singularity or where the path leaves the workspace (URS302) — and not
-    near a singularity, where the solution closest to the straight joint-space line between
-    the move's ends (``near``, the first guess) may be another branch.
-
-    The sequential rule is solved in rounds over all rows at once. The first guess is kept
-    where it steps less than :data:`TRACK_STEP` from the row before; the other rows are
-    chosen from the row before them, and each further round chooses again the rows after a
-    row that changed (a toolpath needs no round at all). A row without a solution (NaN)
-    hands ``near`` on to the next.
-    """
-    count = len(poses)
-    if count == 0:
-        return np.empty((0, 6))
-    from ..kinematics.ik import choose_nearest
-
-    starts = np.ones(count, dtype=bool)
-    starts[1:] = owner[1:] != owner[:-1]
-    analytic = hasattr(model, "ik_all_many") and not getattr(model, "calibrated", False)
-    if analytic:
-        every, _ = model.ik_all_many(poses, tcp=tcp)
-
-        def choose(rows: np.ndarray, toward: np.ndarray) -> np.ndarray:
-            return choose_nearest(every[rows], toward, model.q_min, model.q_max)[0]
-    else:
-        def choose(rows: np.ndarray, toward: np.ndarray) -> np.ndarray:
-            return model.ik_many(poses[rows], toward, tcp=tcp)
-
-    current = choose(np.arange(count), near)
-    # rows that stay within TRACK_STEP of the row before are its continuation already
-    before = np.where(starts[:, None], first, np.roll(current, 1, axis=0))
-    step = np.abs(current - before).max(axis=1)
-    active = np.flatnonzero(~(step <= TRACK_STEP))  # NaN too: choose again
-    for _ in range(count):
-        if len(active) == 0:
-            break
-        previous = np.where(starts[active, None], first[active], current[active - 1])
-        lost = np.isnan(previous).any(axis=1)
-        previous[lost] = near[active[lost]]
-        chosen = choose(active, previous)
-        old = current[active]
-        same = ((chosen == old) | (np.isnan(chosen) & np.isnan(old))).all(axis=1)
-        current[active] = chosen
-        after = active[~same] + 1
-        after = after[after < count]
-        active = np.unique(after[~starts[after]])
-    return current
-
-
-TRACK_STEP = 0.25
-"""Largest joint step (rad) between consecutive path samples (knots, at most 32 ms apart)
-below which :func:`_track` keeps the first guess, the solution closest to the joint-space
-line: a joint moves at most 0.1 rad between knots at the fastest joint speed of a UR, and a
-change of branch moves one by about π (as :data:`urdsl.verify.checks.JUMP_MIN`). Rows
-stepping further are chosen again from the row before them, and so on along the move."""
 
 
 def _fill_gaps(values: np.ndarray, owner: np.ndarray) -> np.ndarray:

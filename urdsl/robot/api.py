@@ -19,6 +19,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..kinematics.models import model_spec
 from ..protocol.dashboard import DashboardReply
 from .connection import DEFAULT_PORTS
 from .dashboard import Dashboard, parse_command_words
@@ -35,14 +36,15 @@ class Robot:
 
     ``port_offset`` shifts every standard port (as ``urdsl sim --port-offset``); ``ports``
     overrides single ones by interface name (``{"rtde": 30004, "primary": 30001}``).
-    ``robot`` is the model the offline check of :meth:`send` uses; ``timeout`` (s) bounds
-    each connect and each wait for a reply or sample.
+    ``robot`` is the model the offline check of :meth:`send` uses (any name
+    :func:`urdsl.kinematics.model_spec` knows, e.g. ``"UR5e"``; KinematicsError for another);
+    ``timeout`` (s) bounds each connect and each wait for a reply or sample.
     """
 
     def __init__(self, host: str, *, robot: str = "ur5e", timeout: float = 5.0,
                  port_offset: int = 0, ports: dict[str, int] | None = None) -> None:
         self.host = host
-        self.robot = robot
+        self.robot = model_spec(robot).name
         self.timeout = timeout
         self.ports = {name: port + port_offset for name, port in DEFAULT_PORTS.items()}
         self.ports.update(ports or {})

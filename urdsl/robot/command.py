@@ -99,7 +99,7 @@ def cmd_record(args: argparse.Namespace) -> int:
     import signal
     import threading
 
-    from ..cli import UsageError
+    from .._cli import UsageError
     from .recorder import parse_fields, record
 
     try:
@@ -217,7 +217,7 @@ def _dashboard_description() -> str:
 
 
 def cmd_dashboard(args: argparse.Namespace) -> int:
-    from ..cli import UsageError
+    from .._cli import UsageError
     from .dashboard import Dashboard, parse_command_words, wait_for_mode
 
     try:
@@ -287,7 +287,7 @@ urdsl follows the program on 30001 either way (--monitor-port to change that).
 
 def _load_program(name: str, robot: str):
     """(tree, filename) of a .script file or a DSL .py program; problems as exceptions."""
-    from ..cli import UsageError, read_input
+    from .._cli import UsageError, read_input
     from ..script.parser import parse
 
     if name.endswith(".py"):
@@ -303,6 +303,7 @@ def _load_program(name: str, robot: str):
 
 
 def cmd_send(args: argparse.Namespace) -> int:
+    from .._cli import robot_model
     from ..dsl.command import ProgramFileError
     from ..dsl.errors import DslError
     from ..script.diagnostics import ScriptError
@@ -310,8 +311,7 @@ def cmd_send(args: argparse.Namespace) -> int:
     from .program import prepare_tree
     from .sender import default_checker, send_prepared
 
-    robot = args.robot.lower()
-    _check_robot(robot)
+    robot = robot_model(args.robot)
     try:
         tree, filename = _load_program(args.program, robot)
     except ScriptError as error:
@@ -355,14 +355,6 @@ def cmd_send(args: argparse.Namespace) -> int:
               "the 10 Hz robot state; on e-Series the robot must be in Remote Control)",
               file=sys.stderr)
     return 0 if result.ok else 1
-
-
-def _check_robot(robot: str) -> None:
-    from ..cli import UsageError
-    from ..kinematics import MODELS
-
-    if robot not in MODELS:
-        raise UsageError(f"unknown robot model {robot!r}; known: {', '.join(MODELS)}")
 
 
 # ---- state --------------------------------------------------------------------------------

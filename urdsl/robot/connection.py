@@ -34,7 +34,7 @@ DEFAULT_PORTS = {
     "dashboard": 29999, "primary": 30001, "secondary": 30002, "realtime": 30003,
     "rtde": 30004, "primary_ro": 30011, "secondary_ro": 30012, "realtime_ro": 30013,
 }
-"""The controller's standard ports (UR_FACTS.md §7)."""
+"""The controller's standard ports (docs/controller-facts.md §7)."""
 
 _NAMES = {
     29999: "dashboard", 30001: "primary", 30002: "secondary", 30003: "realtime",

@@ -36,7 +36,8 @@ __all__ = [
 ]
 
 VECTOR_SIZES = {"VECTOR6D": 6, "VECTOR3D": 3, "VECTOR6INT32": 6, "VECTOR6UINT32": 6}
-"""RTDE vector types and their lengths (UR_FACTS.md §5.2); every other type is a scalar."""
+"""RTDE vector types and their lengths (docs/controller-facts.md §6); every other type is a
+scalar."""
 
 FLUSH_INTERVAL = 0.5
 """Seconds between flushes of a recording: at most this much is lost if the machine dies.

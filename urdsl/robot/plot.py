@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..kinematics.models import JOINT_NAMES
 from .csvfile import Recording, read_recording
 
 __all__ = ["plot_recording", "PlotSummary", "DEFAULT_FIELDS", "MAX_POINTS"]
@@ -27,7 +28,6 @@ DEFAULT_FIELDS = ("actual_q", "actual_qd")
 """Plotted when no fields are asked for (falling back to target_q/target_qd, then to the
 first fields of the file)."""
 
-JOINT_NAMES = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
 _CARTESIAN = ("x", "y", "z", "rx", "ry", "rz")
 
 

@@ -18,6 +18,7 @@ from typing import Any
 from ..protocol import primary as p
 from ..protocol.errors import ProtocolError
 from .connection import Connection
+from .sample import RobotState
 
 __all__ = ["PrimaryStream", "PrimarySource", "state_from_packages"]
 
@@ -75,8 +76,6 @@ class PrimaryStream:
 
 def state_from_packages(stream: PrimaryStream, host: str, port: int, skipped: int):
     """A :class:`urdsl.robot.state.RobotState` of the newest sub-packages."""
-    from .state import RobotState
-
     mode = stream.get(p.RobotModeData)
     joints = stream.get(p.JointData)
     cartesian = stream.get(p.CartesianInfo)

@@ -1,8 +1,8 @@
 """The text that is sent to a controller, and the way back from its line numbers.
 
 The controller runs a script it receives on 30001/30002/30003 when the text starts with
-``def name():`` in column 0 and ends with ``end`` in column 0 (UR_FACTS.md §7: the script
-manual's "Connecting to URControl"); a new ``def`` replaces the running program. So:
+``def name():`` in column 0 and ends with ``end`` in column 0 (docs/controller-facts.md §7: the
+script manual's "Connecting to URControl"); a new ``def`` replaces the running program. So:
 
 * a program that is one ``def`` without parameters (PolyScope's exports, the DSL's
   ``Program``) or only ``sec`` programs is sent as the printer prints it;

@@ -13,6 +13,7 @@ from typing import Any
 from ..protocol import rtde as r
 from .connection import Connection
 from .rtde_session import RtdeSession
+from .sample import RobotState
 
 __all__ = ["RtdeStateSource", "STATE_FIELDS", "STATE_FREQUENCY"]
 
@@ -46,8 +47,6 @@ class RtdeStateSource:
         return samples[-1], len(samples) - 1
 
     def state(self, sample: r.DataPackage, skipped: int):
-        from .state import RobotState
-
         values = sample.values
         runtime = int(values["runtime_state"])  # type: ignore[call-overload]
         assert self.session is not None

@@ -21,7 +21,8 @@ from typing import Any
 from ..script.binder import Problem
 from ..script.builtins import Builtin, lookup, methods
 from ..script.nodes import Node
-from .interpreter import LIST_LIMIT
+from . import motion_builtins  # noqa: F401 - registers motion, robot state and pose maths
+from .registry import IMPLEMENTATIONS, implements
 from .unknown import (
     DEVICE_READS,
     DEVICE_REPLY_TIME,
@@ -30,6 +31,7 @@ from .unknown import (
     unknown_from,
 )
 from .values import (
+    LIST_LIMIT,
     ListValue,
     PoseValue,
     StructValue,
@@ -41,18 +43,6 @@ from .values import (
 )
 
 __all__ = ["BuiltinTable", "IMPLEMENTATIONS"]
-
-IMPLEMENTATIONS: dict[str, Callable[..., Any]] = {}
-
-
-def implements(*names: str):
-    def register(function: Callable[..., Any]) -> Callable[..., Any]:
-        for name in names:
-            IMPLEMENTATIONS[name] = function
-        return function
-
-    return register
-
 
 _NEUTRAL = {"Int": 0, "Float": 0.0, "Number": 0, "Bool": False, "String": "",
             "Array": None, "Pose": None, "None": None}
@@ -320,7 +310,8 @@ def _to_num(rt, node, str):  # noqa: A002 - the catalog's parameter name
 
 # ---- strings ------------------------------------------------------------------------------
 
-_STRING_LIMIT = 1023  # str_cat/to_str results are limited to 1023 characters (URSCRIPT_LANGUAGE §2)
+# str_cat/to_str results are limited to 1023 characters (docs/controller-facts.md §8.1)
+_STRING_LIMIT = 1023
 
 
 def _limited(rt, node, text: str) -> str:
@@ -678,6 +669,3 @@ def _rpc_factory(rt, node, type, url):  # noqa: A002
     rt.event("rpc", f"rpc_factory({type!r}, {url!r}): calls are recorded, not made", node.span)
     return _RemoteHandle(str(type), str(url))
 
-
-# Motion, robot state and pose maths register themselves from their own module.
-from . import motion_builtins  # noqa: E402,F401

@@ -7,7 +7,7 @@ the thread wants to go on. The scheduler always resumes the thread that is due f
 robin among equals), so robot time jumps from event to event instead of ticking every
 controller frame: checking a long program takes a fraction of the time the robot needs.
 
-Scoping follows the controller (../shared/reference/URSCRIPT_LANGUAGE.md §4): variables at
+Scoping follows the controller (docs/controller-facts.md §8.3): variables at
 the first level of the program are global, even when written ``local``; inside functions
 and threads a free name is the global if one exists, else a local; ``local`` forces a new
 local and ``global`` a global. Arguments and assignments copy values.
@@ -38,6 +38,7 @@ from .unknown import (
     unknown_call,
 )
 from .values import (
+    LIST_LIMIT,
     ListValue,
     PoseValue,
     StructValue,
@@ -61,10 +62,6 @@ EVENT_LIMIT = 10_000
 """Events (and environment messages) an unpaced run keeps; later ones are counted, not kept
 (``RunResult.events_dropped``): a cell program's ``textmsg`` at every pass would otherwise
 fill the checker's memory. A paced run (the virtual controller) keeps all."""
-
-LIST_LIMIT = 1_000_000
-"""Values (list items, matrix cells, struct members, counted through nesting) one value may
-hold. The controller documents no maximum [U]; this bounds the checker's memory."""
 
 BREAK, CONTINUE, RETURN = 1, 2, 3
 

@@ -18,8 +18,8 @@ import numpy as np
 
 from ..kinematics import KinematicsError
 from ..kinematics import pose as posemath
-from .builtins import implements
 from .errors import ScriptRuntimeError
+from .registry import implements
 from .values import ListValue, PoseValue, is_number, type_name
 
 __all__: list[str] = []

@@ -3,7 +3,7 @@
 Numbers follow the usual rules (an int and a float give a float); ``+`` also joins two
 strings (real programs do this though only ``str_cat`` is documented). Lists combine
 element-wise with an equal-length list or with a number; ``matrix * matrix`` and
-``matrix * list`` are matrix products (../shared/reference/URSCRIPT_LANGUAGE.md §4).
+``matrix * list`` are matrix products (docs/controller-facts.md §8.4).
 
 Each operation raises TypeError (or ValueError) for values it cannot combine (or a string
 longer than :data:`STRING_LIMIT` bytes) and
@@ -24,7 +24,7 @@ __all__ = ["binary", "STRING_LIMIT"]
 
 STRING_LIMIT = 1023
 """Bytes a string may hold: the controller's limit for ``str_cat``/``to_str`` results
-(URSCRIPT_LANGUAGE §2), applied to ``+`` of strings as well [U]."""
+(docs/controller-facts.md §8.1), applied to ``+`` of strings as well [U]."""
 
 
 def _is_matrix(value: Any) -> bool:

@@ -29,8 +29,12 @@ from typing import Any
 
 __all__ = [
     "PoseValue", "ListValue", "StructValue", "ThreadHandle", "copy_value", "type_name",
-    "format_value", "is_number", "Unknown", "has_unknown", "exceeds",
+    "format_value", "is_number", "Unknown", "has_unknown", "exceeds", "LIST_LIMIT",
 ]
+
+LIST_LIMIT = 1_000_000
+"""Values (list items, matrix cells, struct members, counted through nesting) one value may
+hold. The controller documents no maximum [U]; this bounds the checker's memory."""
 
 
 class PoseValue(tuple):

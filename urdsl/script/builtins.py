@@ -33,11 +33,11 @@ e-Series, 10.x and later PolyScope X.
 from __future__ import annotations
 
 import functools
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from importlib import resources
 
+from ..versions import ControllerVersion, parse_version
 from .binder import Binding, Problem, Signature, problems
 
 __all__ = ["BuiltinParam", "Builtin", "catalog", "lookup", "parse_version", "methods"]
@@ -45,20 +45,8 @@ __all__ = ["BuiltinParam", "Builtin", "catalog", "lookup", "parse_version", "met
 Version = tuple[int, int]
 
 
-def parse_version(text: str) -> Version:
-    """``"5.15"`` or ``"5.15.2"`` → ``(5, 15)``. Raises ValueError for anything else."""
-    match = re.fullmatch(r"\s*(\d+)(?:\.(\d+))?(?:\.\d+)*\s*", text)
-    if match is None:
-        raise ValueError(f"not a controller version: {text!r} (expected e.g. 5.15 or 3.14)")
-    return int(match.group(1)), int(match.group(2) or 0)
-
-
 def _series(version: Version) -> str:
-    if version[0] <= 4:
-        return "cb"
-    if version[0] < 10:
-        return "e"
-    return "x"
+    return ControllerVersion(*version).series
 
 
 @dataclass(frozen=True)
@@ -73,7 +61,8 @@ class BuiltinParam:
 
 @dataclass(frozen=True)
 class Builtin:
-    """One row of the catalog (see ``BUILTINS.md`` for the meaning of each field)."""
+    """One row of the catalog (``docs/controller-facts.md`` §9 gives the meaning of each
+    field)."""
 
     module: str
     name: str

@@ -488,7 +488,7 @@ BINARY_PRECEDENCE: dict[str, int] = {
 }
 """Binding strength of binary operators (higher binds tighter); all are left-associative.
 UR does not document precedence; this is the Python-like order the manual's examples imply
-(see ../shared/reference/URSCRIPT_LANGUAGE.md §3)."""
+(see docs/controller-facts.md §8.2)."""
 
 PREFIX_PRECEDENCE: dict[str, int] = {"not": 3, "!": 3, "-": 7, "+": 7}
 """Binding strength of prefix operators: ``not`` binds looser than comparisons."""

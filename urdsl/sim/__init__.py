@@ -3,7 +3,7 @@
 >>> from urdsl.sim import VirtualController
 >>> with VirtualController(robot="ur5e", speed=2.0) as sim, sim.serve(port_offset=100) as net:
 ...     sim.submit("def p():\\n  movej([0.5, -1.57, 1.57, -1.57, -1.57, 0])\\nend\\n")
-...     sim.wait_snapshot(lambda s: abs(s.q[0] - 0.5) < 1e-9, timeout=10)
+...     snapshot = sim.wait_snapshot(lambda s: abs(s.q[0] - 0.5) < 1e-9, timeout=10)
 
 ``urdsl sim`` runs the same from the command line (see :mod:`urdsl.sim.command`).
 """

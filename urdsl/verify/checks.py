@@ -2,23 +2,92 @@
 needs of the robot model or the cell) and returns findings, at most one per move and rule,
 placed at the statement that commanded the move, with its cause (the joint, the
 singularity, the colliding pair): the report keeps one finding per statement, rule and
-cause, however often a loop runs the statement (:meth:`urdsl.verify.report.Report.sort`)."""
+cause, however often a loop runs the statement (:meth:`urdsl.verify.report.Report.sort`).
+
+Each rule registers itself with :func:`trace_check`, as lint rules do with
+:func:`urdsl.lint.registry.rule`: its code, severity and explanation go into the one rule
+registry (:data:`urdsl.rules.RULES`, ``urdsl rules``), and :func:`urdsl.verify.run.check_tree`
+runs every registered check, in code order, over a :class:`TraceContext`. A new check is
+one decorated function ``check(ctx) -> list[Finding]`` (and its test).
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .._threads import shared_pool
+from ..kinematics.models import JOINT_NAMES
 from ..motion.planner import JOINT_SPACE
 from ..motion.trace import Trace
+from ..rules import Rule, register
 from .findings import Finding
 
-__all__ = ["joint_limits", "joint_speeds", "joint_accelerations", "blend_radii",
-           "path_continuity", "tcp_speed", "singularities", "collisions", "Continuity"]
+if TYPE_CHECKING:  # pragma: no cover
+    from .run import CheckOptions
 
-JOINTS = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
+__all__ = ["joint_limits", "joint_speeds", "joint_accelerations", "blend_radii",
+           "path_continuity", "tcp_speed", "singularities", "collisions", "Continuity",
+           "TraceContext", "TraceCheck", "trace_check", "trace_checks"]
+
+JOINTS = JOINT_NAMES
+
+
+@dataclass
+class TraceContext:
+    """What a trace check reads: the sampled ``trace``, the ``planner`` that made it (its
+    segments), the ``robot`` model, the user's ``options`` and ``excluded``: (N,) bool, the
+    samples around jumps and unreachable stretches that other checks leave out (set by the
+    URS302 check, which runs first)."""
+
+    trace: Trace
+    planner: Any
+    robot: Any
+    options: CheckOptions
+    excluded: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class TraceCheck:
+    """A registered check: its rule, the ``label`` that names it when it is skipped at the
+    wall-clock bound, and ``applies(options)``: whether the user's options ask for it."""
+
+    rule: Rule
+    label: str
+    applies: Callable[[CheckOptions], bool]
+
+    def run(self, ctx: TraceContext) -> list[Finding]:
+        assert self.rule.check is not None
+        return self.rule.check(ctx)
+
+
+_TRACE_CHECKS: dict[str, TraceCheck] = {}
+
+
+def trace_check(code: str, name: str, severity: str, label: str, summary: str,
+                explanation: str, example: str, fixed: str,
+                applies: Callable[[CheckOptions], bool] | None = None
+                ) -> Callable[[Callable[[TraceContext], list[Finding]]],
+                              Callable[[TraceContext], list[Finding]]]:
+    """Register the decorated ``check(ctx) -> list[Finding]`` as the check of rule
+    ``code`` (``urdsl check`` runs it over every trace for which ``applies(options)``)."""
+
+    def add(check: Callable[[TraceContext], list[Finding]]):
+        rule = register(Rule(code, name, severity, summary, explanation, example, fixed,
+                             check, stage="check"))
+        _TRACE_CHECKS[code] = TraceCheck(rule, label, applies or (lambda options: True))
+        return check
+
+    return add
+
+
+def trace_checks() -> list[TraceCheck]:
+    """The registered trace checks in code order (URS302 first: it finds the samples the
+    others leave out)."""
+    return [_TRACE_CHECKS[code] for code in sorted(_TRACE_CHECKS)]
 
 
 def _per_segment(trace: Trace, mask: np.ndarray):
@@ -324,3 +393,158 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
             _span(trace, segment), float(trace.times[sample]),
             "move around the obstacle with an extra waypoint", cause=what))
     return findings
+
+
+# ---- the registered checks, in code order ----------------------------------------------------
+
+_READY = "movej([0, -1.9, 1.9, -1.57, -1.57, 0])  # tool down, in front of the robot"
+_START = "0,-1.9,1.9,-1.57,-1.57,0"
+
+
+@trace_check(
+    "URS302", "path-leaves-workspace", "error", "path continuity",
+    summary="A movel/movep/movec path leaves the workspace or needs an IK branch flip.",
+    explanation="""
+Both ends of a straight-line (or circular) move are reachable, but a point between them is
+not, or the joints would have to jump to another inverse-kinematics solution on the way.
+The controller computes the path in Cartesian space and stops the program with a protective
+stop when it cannot follow it. urdsl samples the path at the controller rate and reports the
+move with the fraction of the way where it fails, or the joint that jumps. Samples around
+the failure are left out of the other checks.""",
+    example="movej(get_inverse_kin(p[0.35, -0.2, 0.3, 0, 3.1416, 0]))\n"
+            "movel(p[-0.35, 0.2, 0.3, 0, 3.1416, 0])  # through the base's axis",
+    fixed="movej(get_inverse_kin(p[0.35, -0.2, 0.3, 0, 3.1416, 0]))\n"
+          "movej(get_inverse_kin(p[-0.35, 0.2, 0.3, 0, 3.1416, 0]))",
+)
+def _continuity(ctx: TraceContext) -> list[Finding]:
+    result = path_continuity(ctx.trace, np.asarray(ctx.robot.qd_max))
+    ctx.excluded = result.samples
+    return result.findings
+
+
+@trace_check(
+    "URS303", "joint-position-limit", "error", "joint limits",
+    summary="A joint goes beyond its position limit.",
+    explanation="""
+Every UR joint turns at most ±360° (±2π rad) from zero (the UR3/UR3e wrist 3 without
+limit); a cell may set tighter limits in the safety configuration (urdsl check --q-min,
+--q-max). A movej target outside them, or a linear move whose inverse kinematics lead a
+joint there, stops the robot. The finding names the joint, the angle and the limit.""",
+    example=f"{_READY}\nmovej([0, -1.9, 1.9, -1.57, -1.57, 6.5])",
+    fixed=f"{_READY}\nmovej([0, -1.9, 1.9, -1.57, -1.57, 0.2168])  # 6.5 - 2*pi",
+)
+def _joint_limits(ctx: TraceContext) -> list[Finding]:
+    options, robot = ctx.options, ctx.robot
+    q_min = np.asarray(options.q_min if options.q_min is not None else robot.q_min)
+    q_max = np.asarray(options.q_max if options.q_max is not None else robot.q_max)
+    return joint_limits(ctx.trace, q_min, q_max)
+
+
+@trace_check(
+    "URS304", "joint-speed-limit", "error", "joint speeds",
+    summary="A joint turns faster than the robot model allows.",
+    explanation="""
+Each joint of a UR model has a top speed (e.g. 180 °/s for the base and shoulder of a UR5e,
+360 °/s for its wrists; see 'urdsl models'). urdsl samples the planned motion at the
+controller rate (2 ms e-Series, 8 ms CB3) and reports the first move in which a joint is
+faster than its limit, with the joint and its peak speed. A movej with a high v, or a linear
+move near a singularity, where the joints must turn fast for a slow TCP, causes it; the
+controller stops the robot there.""",
+    example=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], a=20, v=5)",
+    fixed=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], a=1.4, v=1.05)",
+)
+def _joint_speeds(ctx: TraceContext) -> list[Finding]:
+    return joint_speeds(ctx.trace, np.asarray(ctx.robot.qd_max), exclude=ctx.excluded)
+
+
+@trace_check(
+    "URS305", "joint-acceleration-limit", "warning", "joint accelerations",
+    summary="A joint accelerates harder than the limit given for the cell.",
+    explanation="""
+UR publishes no joint acceleration limits, so this check runs only when the user gives one
+(urdsl check --joint-acceleration-limit, rad/s², one value or six). It reports the first
+move in which a joint accelerates harder, with the joint and the acceleration.""",
+    example=f"# urdsl check --joint-acceleration-limit 5\n{_READY}\n"
+            "movej([1, -1.9, 1.9, -1.57, -1.57, 0], a=20, v=1)",
+    fixed=f"# urdsl check --joint-acceleration-limit 5\n{_READY}\n"
+          "movej([1, -1.9, 1.9, -1.57, -1.57, 0], a=4, v=1)",
+    applies=lambda options: options.joint_acceleration_limit is not None,
+)
+def _joint_accelerations(ctx: TraceContext) -> list[Finding]:
+    limits = np.broadcast_to(np.asarray(ctx.options.joint_acceleration_limit, float), (6,))
+    return joint_accelerations(ctx.trace, limits, exclude=ctx.excluded)
+
+
+@trace_check(
+    "URS306", "tcp-speed-limit", "error", "TCP speed",
+    summary="The TCP moves faster than the speed limit set for the cell.",
+    explanation="""
+A collaborative cell limits the TCP speed in its safety configuration (often 0.25 m/s
+where people work); the controller then slows or stops the robot. This check runs when the
+limit is given (urdsl check --tcp-speed-limit, m/s) and reports the first move over it,
+with its peak TCP speed.""",
+    example=f"# urdsl check --tcp-speed-limit 0.25 --start-joints {_START}\n"
+            "home = get_actual_tcp_pose()\nmovel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), v=0.5)",
+    fixed=f"# urdsl check --tcp-speed-limit 0.25 --start-joints {_START}\n"
+          "home = get_actual_tcp_pose()\nmovel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), v=0.2)",
+    applies=lambda options: options.tcp_speed_limit is not None,
+)
+def _tcp_speed(ctx: TraceContext) -> list[Finding]:
+    return tcp_speed(ctx.trace, ctx.robot, ctx.options.tcp_speed_limit)
+
+
+@trace_check(
+    "URS307", "near-singularity", "warning", "singularities",
+    summary="On a TCP path the arm passes close to a shoulder, elbow or wrist singularity.",
+    explanation="""
+Near a singularity a linear or circular move needs joint speeds that grow without bound:
+the wrist centre near the vertical axis through the base (shoulder), the arm stretched out
+or folded (elbow), wrist 2 near 0° or 180° so that the wrist 1 and wrist 3 axes line up
+(wrist). The controller slows down or stops with "joint speed limit" there. Joint moves
+(movej) pass singular poses harmlessly and are not reported. --singularity-scale widens or
+narrows the margins.""",
+    example="movej([0.3, -1.6, 1.6, -1.57, -0.25, 0])\nb = get_actual_tcp_pose()\n"
+            "movej([0.3, -1.6, 1.6, -1.57, 0.25, 0])\nmovel(b)  # wrist 2 passes 0",
+    fixed="movej([0.3, -1.6, 1.6, -1.57, -0.25, 0])\nb = get_actual_tcp_pose()\n"
+          "movej([0.3, -1.6, 1.6, -1.57, 0.25, 0])\nmovej(get_inverse_kin(b))",
+)
+def _singularities(ctx: TraceContext) -> list[Finding]:
+    return singularities(ctx.trace, ctx.robot, ctx.options.singularity_scale)
+
+
+@trace_check(
+    "URS308", "collision", "error", "collisions",
+    summary="The arm hits the cell (floor, boxes, cylinders, planes) or itself.",
+    explanation="""
+The arm's links (the meshes of the robot description, or capsules around its DH links) are
+swept along the planned motion against the obstacles of the cell file (urdsl check --cell
+cell.toml) and against each other. The finding names the colliding pair and the overlap.""",
+    example=f"# cell.toml: [floor] height = 0.0\n{_READY}\nhome = get_actual_tcp_pose()\n"
+            "movel(pose_add(home, p[0, 0, -1.0, 0, 0, 0]))",
+    fixed=f"# cell.toml: [floor] height = 0.0\n{_READY}\nhome = get_actual_tcp_pose()\n"
+          "movel(pose_add(home, p[0, 0, -0.2, 0, 0, 0]))",
+    applies=lambda options: options.cell is not None or options.self_collision,
+)
+def _collisions(ctx: TraceContext) -> list[Finding]:
+    options = ctx.options
+    return collisions(ctx.trace, ctx.robot, options.cell, options.collision_step,
+                      options.self_collision)
+
+
+@trace_check(
+    "URS310", "blend-radius-too-large", "warning", "blend radii",
+    summary="A blend radius is larger than half of a neighbouring segment.",
+    explanation="""
+A house rule, stricter than the controller's: when a blend radius is more than half of the
+segment before or after it, the blend of the next waypoint may cut it short, and the path
+differs from what the radius suggests. (When the blend spheres really overlap the
+controller skips the move: that is URS309.)""",
+    example=f"{_READY}\nhome = get_actual_tcp_pose()\n"
+            "movel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), r=0.03)\n"
+            "movel(pose_add(home, p[0.2, 0.05, 0, 0, 0, 0]), r=0.01)\nmovel(home)",
+    fixed=f"{_READY}\nhome = get_actual_tcp_pose()\n"
+          "movel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), r=0.02)\n"
+          "movel(pose_add(home, p[0.2, 0.05, 0, 0, 0, 0]), r=0.01)\nmovel(home)",
+)
+def _blend_radii(ctx: TraceContext) -> list[Finding]:
+    return blend_radii(ctx.planner.segments)

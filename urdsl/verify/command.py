@@ -6,7 +6,9 @@ import argparse
 import math
 import sys
 
-from .findings import RULES
+from ..rules import RULES
+from . import checks  # noqa: F401 - registers the trace checks (their rules)
+from . import findings as _findings  # noqa: F401 - registers the rules of the run
 
 __all__ = ["add_commands", "cmd_check", "parse_vector"]
 
@@ -33,8 +35,11 @@ examples:
   urdsl check pick.script --tcp-speed-limit 0.25 --json > report.json
   urdsl check pick.script --plot pick.png
 
-rules:
-""" + "\n".join(f"  {code}  {severity:<8} {text}" for code, (severity, text) in RULES.items())
+rules ('urdsl rules CODE' explains one, 'urdsl rules URS3' all of the checker's):
+  URS2xx  error    runtime errors of the program (urdsl rules URS2)
+""" + "\n".join(f"  {rule.code}  {rule.severity:<8} {rule.summary}"
+                for rule in sorted(RULES.values(), key=lambda rule: rule.code)
+                if rule.stage == "check")
 
 
 def parse_vector(text: str, count: int, what: str, degrees: bool = False) -> tuple:
@@ -120,13 +125,10 @@ def add_commands(commands) -> None:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
-    from ..kinematics import MODELS
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input, robot_model
     from .run import DEFAULT_START, CheckOptions
 
-    robot = (args.robot or "ur5e").lower()
-    if robot not in MODELS:
-        raise UsageError(f"unknown robot model {args.robot!r}; known: {', '.join(MODELS)}")
+    robot = robot_model(args.robot or "ur5e")
     if args.plot and len(args.files) > 1:
         raise UsageError("--plot takes one file at a time")
     options = CheckOptions(
@@ -178,7 +180,7 @@ def _check_script(source, args: argparse.Namespace, options):
     :mod:`urdsl.verify.infer`) where the command line leaves it open."""
     import os
 
-    from ..cli import UsageError
+    from .._cli import UsageError
     from ..project import ProjectError
     from ..project.check import in_context
     from ..script.diagnostics import ScriptError
@@ -217,7 +219,7 @@ def _check_script(source, args: argparse.Namespace, options):
 
 def _load_cell(robot: str, path: str):
     """The collision model of ``robot`` with the cell's obstacles, or a usage error."""
-    from ..cli import UsageError
+    from .._cli import UsageError
     from ..kinematics import KinematicsError, Robot
     from ..kinematics.collision import CollisionModel
 
@@ -230,7 +232,7 @@ def _load_cell(robot: str, path: str):
 
 
 def _check_program(name: str, options):
-    from ..cli import UsageError
+    from .._cli import UsageError
     from .run import check_file
 
     try:

@@ -1,29 +1,10 @@
 """Findings of the verifier: what would go wrong on the robot, and where in the program.
 
-Codes are stable (documented in ``urdsl check --help`` and the README):
-
-=======  ========  =============================================================
-code     severity  what
-=======  ========  =============================================================
-URS2xx   error     a runtime error stopped the program (see urdsl.runtime.errors)
-URS301   error     a target pose is out of reach (inverse kinematics fails)
-URS302   error     a movel/movec path leaves the workspace or needs an IK branch
-                   flip (a jump in joint space), even though both ends are reachable
-URS303   error     a joint position limit is exceeded
-URS304   error     a joint speed limit is exceeded
-URS305   warning   a joint acceleration limit is exceeded
-URS306   error     the TCP speed limit set for the cell is exceeded
-URS307   warning   the arm passes close to a singularity (shoulder, elbow, wrist)
-URS308   error     collision with the cell (floor, boxes, cylinders) or itself
-URS309   warning   Overlapping Blends: the robot skips the move
-URS310   warning   a blend radius larger than half of a neighbouring segment
-URS311   warning   the program ended while threads were still running
-URS312   info      the program was stopped at the time limit (it loops forever)
-URS313   warning   the check stopped early: the program waits for ever (a read with
-                   timeout 0 nothing answers) or the wall-clock bound was reached
-URS210   warning   what follows depends on a value from outside (a device's reply, an
-                   input, an operator's answer) that is unknown offline
-=======  ========  =============================================================
+Every code is a rule of the one registry (:data:`urdsl.rules.RULES`; ``urdsl rules`` explains
+each): URS2xx runtime errors (:mod:`urdsl.runtime.errors`), the trace checks URS302–URS308
+and URS310 (:mod:`urdsl.verify.checks`), and here the findings of the run itself: URS301
+(unreachable pose), URS309 (Overlapping Blends), URS311 (threads still running), URS312
+(time limit), URS313 (stopped early) and URS210 (depends on a value unknown offline).
 """
 
 from __future__ import annotations
@@ -31,33 +12,16 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field, replace
 
+from ..rules import RULES, Rule, register
 from ..script.diagnostics import Diagnostic
 from ..script.nodes import NO_SPAN, Span
 
-__all__ = ["Finding", "RULES"]
+__all__ = ["Finding"]
 
 _NUMBER = re.compile(r"(?<![\w.])(?<!wrist )[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
 """Numbers in a message (not inside names such as ``Waypoint_1``, nor a wrist's number)."""
 
 _REPEATED = re.compile(r" \(\d+ times(?:, first at t=[-\d.]+ s)?\)$")
-
-RULES: dict[str, tuple[str, str]] = {
-    "URS301": ("error", "unreachable pose"),
-    "URS302": ("error", "path leaves the workspace or flips IK branch"),
-    "URS303": ("error", "joint position limit"),
-    "URS304": ("error", "joint speed limit"),
-    "URS305": ("warning", "joint acceleration limit"),
-    "URS306": ("error", "TCP speed limit"),
-    "URS307": ("warning", "near a singularity"),
-    "URS308": ("error", "collision"),
-    "URS309": ("warning", "overlapping blends (move skipped)"),
-    "URS310": ("warning", "blend radius larger than half a segment"),
-    "URS311": ("warning", "threads still running at program end"),
-    "URS312": ("info", "stopped at the time limit"),
-    "URS313": ("warning", "check stopped early (waits for ever, wall-clock bound)"),
-    "URS210": ("warning", "depends on a device value unknown offline"),
-}
-
 
 @dataclass(frozen=True)
 class Finding:
@@ -81,7 +45,7 @@ class Finding:
     @classmethod
     def of(cls, code: str, message: str, span: Span = NO_SPAN, time: float | None = None,
            hint: str | None = None, cause: str | None = None) -> Finding:
-        return cls(code, RULES[code][0], message, span, time, hint, cause)
+        return cls(code, RULES[code].severity, message, span, time, hint, cause)
 
     def identity(self) -> tuple:
         """What makes two findings the same problem: rule, statement and cause — not the
@@ -110,3 +74,75 @@ class Finding:
         result["time"] = None if self.time is None else round(self.time, 6)
         result["count"] = self.count
         return result
+
+
+# ---- the rules of the run itself ----------------------------------------------------------------
+
+_READY = "movej([0, -1.9, 1.9, -1.57, -1.57, 0])"
+
+
+def _rule(code: str, name: str, severity: str, summary: str, explanation: str, example: str,
+          fixed: str) -> None:
+    register(Rule(code, name, severity, summary, explanation, example, fixed, stage="check"))
+
+
+_rule("URS210", "unknown-dependency", "warning",
+      "What follows depends on a value from outside that is unknown offline.",
+      """
+A device's reply (a socket, an XML-RPC call, a gripper), an input or register, an operator's
+answer: offline these values are unknown. The check goes on where it can (both ways of an
+if, a move to an unknown pose is noted and not checked) and says once, at the statement,
+what depends on such a value; the rest of the program is still checked.""",
+      'rq = rpc_factory("xmlrpc", "http://127.0.0.1:4242/RPC2")\n'
+      "if not rq.activated():\n  halt\nend",
+      "# a program that does not depend on the reply: nothing to note\n"
+      'rq = rpc_factory("xmlrpc", "http://127.0.0.1:4242/RPC2")')
+_rule("URS301", "unreachable-pose", "error",
+      "A target pose is out of reach: inverse kinematics find no solution.",
+      """
+The robot cannot put its TCP (with the active TCP offset) at the pose: it is further than
+the arm reaches, too close to the base, or the orientation is impossible there. The
+controller stops the program at the move; nothing after it runs.""",
+      f"{_READY}\nmovel(p[1.5, 0.2, 0.3, 0, 3.1416, 0])",
+      f"{_READY}\nmovel(p[0.5, 0.2, 0.3, 0, 3.1416, 0])")
+_rule("URS309", "overlapping-blends", "warning",
+      "Overlapping Blends: the blend spheres of two waypoints overlap and the robot skips "
+      "the move.",
+      """
+A blend radius may be at most as large as the distance to the neighbouring waypoints minus
+their own radii; when two blend spheres overlap, the controller skips the move in between
+and shows "Overlapping Blends" (PolyScope warns, the program goes on). urdsl reports the move
+that is skipped.""",
+      f"{_READY}\nhome = get_actual_tcp_pose()\n"
+      "movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]), r=0.05)\n"
+      "movel(pose_add(home, p[0.1, 0.06, 0, 0, 0, 0]), r=0.05)\nmovel(home)",
+      f"{_READY}\nhome = get_actual_tcp_pose()\n"
+      "movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]), r=0.02)\n"
+      "movel(pose_add(home, p[0.1, 0.06, 0, 0, 0, 0]), r=0.02)\nmovel(home)")
+_rule("URS311", "threads-still-running", "warning",
+      "The program ended while threads were still running.",
+      """
+When the main program ends the controller stops every thread it started, in whatever state
+it is (a gripper half closed, an output still on). Join the threads, or kill them at a
+moment of your choosing, before the end.""",
+      f"thread beat():\n  while True:\n    sleep(0.5)\n  end\nend\n{_READY}\nt = run beat()",
+      f"thread beat():\n  while True:\n    sleep(0.5)\n  end\nend\n{_READY}\nt = run beat()\n"
+      "sleep(1)\nkill t")
+_rule("URS312", "time-limit", "info",
+      "The program was stopped at the time limit (it loops forever).",
+      """
+Cell programs often loop forever. urdsl runs a program for at most --max-time seconds of
+robot time (3600 by default), checks what ran until then and says that it stopped it.""",
+      "# urdsl check --max-time 20\nwhile True:\n  sleep(1)\nend",
+      "# urdsl check --max-time 20\ni = 0\nwhile i < 10:\n  sleep(1)\n  i = i + 1\nend")
+_rule("URS313", "check-stopped-early", "warning",
+      "The check stopped early: the program waits for ever, or the wall-clock bound was "
+      "reached.",
+      """
+A read with timeout 0 that nothing answers offline (a socket nobody opened, a register no
+one writes) waits for ever; the check stops that thread there and says so. Every check also
+ends within its wall-clock bound (urdsl check --timeout, 60 s by default): the run stops
+where it got to, and the checks left undone are named.""",
+      'while True:\n  socket_read_byte_list(1, "g", 0)\nend',
+      'socket_open("127.0.0.1", 30000, "g")\nwhile True:\n  socket_read_byte_list(1, "g", 2)\n'
+      "end")

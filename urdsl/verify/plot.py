@@ -7,12 +7,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..kinematics.models import JOINT_NAMES
+
 __all__ = ["plot_report"]
 
 MAX_POINTS = 5000
 """Samples drawn per curve: more than a screen shows; a long program is thinned evenly."""
 
-JOINT_NAMES = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
 
 
 def plot_report(report, path: str | Path, robot=None) -> None:

@@ -7,7 +7,7 @@ The steps, each reported as findings at the statement that caused them:
    :class:`urdsl.motion.MotionPlanner` as its robot, in robot time — runtime errors (URS2xx,
    an unreachable target as URS301) stop it as they would stop the controller;
 3. sample the planned trajectory at the controller rate (:func:`urdsl.motion.trace.sample`);
-4. run the checks of :mod:`urdsl.verify.checks` over the samples.
+4. run every check registered in :mod:`urdsl.verify.checks` over the samples.
 
 Reads from outside the controller (devices, inputs, operator answers) are unknown values
 (:mod:`urdsl.runtime.unknown`): what depends on them is a URS210 warning, not an error.
@@ -229,33 +229,14 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
     findings: list[Finding] = []
     if len(trace.times) == 0 or not planner.segments:
         return findings
-    jumps = checks.path_continuity(trace, robot.qd_max)
-    findings += jumps.findings
-    q_min = np.asarray(options.q_min if options.q_min is not None else robot.q_min)
-    q_max = np.asarray(options.q_max if options.q_max is not None else robot.q_max)
-    steps = [
-        ("joint limits", lambda: checks.joint_limits(trace, q_min, q_max)),
-        ("joint speeds", lambda: checks.joint_speeds(trace, np.asarray(robot.qd_max),
-                                                     exclude=jumps.samples)),
-    ]
-    if options.joint_acceleration_limit is not None:
-        limits = np.broadcast_to(np.asarray(options.joint_acceleration_limit, float), (6,))
-        steps.append(("joint accelerations", lambda: checks.joint_accelerations(
-            trace, limits, exclude=jumps.samples)))
-    steps.append(("blend radii", lambda: checks.blend_radii(planner.segments)))
-    if options.tcp_speed_limit is not None:
-        steps.append(("TCP speed", lambda: checks.tcp_speed(trace, robot,
-                                                            options.tcp_speed_limit)))
-    steps.append(("singularities", lambda: checks.singularities(trace, robot,
-                                                                options.singularity_scale)))
-    steps.append(("collisions", lambda: checks.collisions(
-        trace, robot, options.cell, options.collision_step, options.self_collision)))
-    for index, (_name, run) in enumerate(steps):
+    ctx = checks.TraceContext(trace, planner, robot, options)
+    steps = [check for check in checks.trace_checks() if check.applies(options)]
+    for index, check in enumerate(steps):
         if deadline is not None and time.monotonic() > deadline:
-            skipped = ", ".join(n for n, _ in steps[index:])
+            skipped = ", ".join(step.label for step in steps[index:])
             findings.append(Finding.of(
                 "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s; "
                 f"not checked: {skipped}", span, None, "use --timeout to allow more time"))
             break
-        findings += run()
+        findings += check.run(ctx)
     return findings

@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 
-from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError
 from .calibration import Calibration
 from .errors import KinematicsError
 from .models import MODELS, model_spec
