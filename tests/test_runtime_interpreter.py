@@ -224,3 +224,24 @@ def test_pace_sees_robot_time_advance_and_can_stop_the_program():
     assert result.stopped and result.error is None
     assert seen == [0.5, 1.0, 1.5, 2.0]
     assert result.globals["i"] == 4 and result.time == 1.5
+
+
+def test_old_combined_io_builtins_reach_the_tool_io():
+    # get_digital_in/get_digital_out/set_digital_out take 0..9 (8 and 9 are the tool's),
+    # get_analog_in 0..3 (2 and 3 are the tool's), on CB3 and e-Series alike
+    from urdsl import parse
+    from urdsl.runtime import Environment, Interpreter
+
+    environment = Environment()
+    result = Interpreter(parse(
+        "set_digital_out(9, True)\n"
+        "a = get_digital_out(9)\n"
+        "b = get_tool_digital_out(1)\n"
+        "c = get_digital_in(8)\n"
+        "d = get_analog_in(3)\n", "io.script"), environment=environment).run()
+    assert result.error is None
+    assert result.globals["a"] is True and result.globals["b"] is True
+    assert environment.tool_digital_out == [False, True]
+    result = Interpreter(parse("e = get_digital_in(10)\n", "io.script"),
+                         environment=Environment()).run()
+    assert result.error is not None and "0..9; 8..9 are the tool's" in result.error.message

@@ -514,6 +514,28 @@ def _getter(attribute: str, what: str, name: str | None = None):
     return apply
 
 
+def _with_tool(name: str, standard: str, tool: str, what: str, setter: bool = False):
+    """The old combined builtins (``get_digital_in``, ``set_digital_out``,
+    ``get_digital_out``: 0..9; ``get_analog_in``: 0..3): the standard bank first, then the
+    tool's (digital 8 and 9 are tool 0 and 1; analog 2 and 3 are tool 0 and 1), as the script
+    manual documents them on CB3 and e-Series."""
+    function = IMPLEMENTATIONS[name]
+    on_tool = (_setter(tool, what) if setter
+               else _getter(tool, what, name if name in DEVICE_READS else None))
+
+    def apply(rt, node, n, *rest, **kw):
+        size = len(getattr(rt.env, standard))
+        last = size + len(getattr(rt.env, tool)) - 1
+        if type(n) is int and size <= n <= last:
+            return on_tool(rt, node, n - size, *rest, **kw)
+        if type(n) is int and n > last:
+            raise rt.error("index", f"{what} {n} does not exist (0..{last}; {size}.."
+                           f"{last} are the tool's)", node)
+        return function(rt, node, n, *rest, **kw)
+
+    return apply
+
+
 for _names, _attribute, _what in [
     (("set_standard_digital_out", "set_digital_out"), "standard_digital_out", "digital output"),
     (("set_configurable_digital_out",), "configurable_digital_out", "configurable output"),
@@ -552,6 +574,15 @@ def _register_writer(attribute: str, convert):
 
     return apply
 
+
+for _name, _standard, _tool, _what in [
+    ("set_digital_out", "standard_digital_out", "tool_digital_out", "digital output"),
+    ("get_digital_out", "standard_digital_out", "tool_digital_out", "digital output"),
+    ("get_digital_in", "standard_digital_in", "tool_digital_in", "digital input"),
+    ("get_analog_in", "standard_analog_in", "tool_analog_in", "analog input"),
+]:
+    IMPLEMENTATIONS[_name] = _with_tool(_name, _standard, _tool, _what,
+                                        setter=_name.startswith("set_"))
 
 IMPLEMENTATIONS["write_output_integer_register"] = _register_writer("output_int_registers", int)
 IMPLEMENTATIONS["write_output_float_register"] = _register_writer("output_float_registers",
