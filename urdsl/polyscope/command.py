@@ -53,7 +53,7 @@ def load(path: str | Path) -> tuple[Program, Compiled]:
 
 def compile_urp(path: str, output: str | None) -> int:
     """``urdsl compile X.urp [-o X.script]``: the exit status."""
-    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError
 
     if not Path(path).is_file():
         raise UsageError(f"cannot read {path}: No such file")
@@ -132,7 +132,7 @@ def add_commands(commands) -> None:
 
 
 def cmd_show(args: argparse.Namespace) -> int:
-    from ..cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError
 
     if Path(args.program).suffix.lower() != ".urp":
         raise UsageError(f"cannot show {args.program}: urdsl show takes a PolyScope program "
