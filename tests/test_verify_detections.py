@@ -511,3 +511,22 @@ def test_a_waypoint_out_of_reach_is_reported_even_when_a_condition_may_stop_the_
         """)
     (finding,) = only(report, "URS301")
     assert finding.span.line == 5
+
+
+def test_where_a_direction_move_stops_is_unknown_until_a_move_to_a_known_target():
+    # after "until tool contact" the arm is wherever the part was: a move relative to that
+    # is not checked against the end of reach (a warning says why); a taught move makes the
+    # position known again
+    text = textwrap.dedent(DIRECTION).lstrip("\n") + textwrap.dedent(f"""\
+        movel(pose_trans(get_actual_tcp_pose(), p[0.355, 0, 0, 0, 0, 0]), a=1.2, v=0.1)
+        {READY}
+        movel(pose_trans(get_actual_tcp_pose(), p[0, 0, -2.0, 0, 0, 0]), a=1.2, v=0.1)
+        """)
+    report = check(text)
+    relative = 1 + next(i for i, line in enumerate(text.splitlines()) if "0.355" in line)
+    assert "URS301" in report.codes()  # the last move, from a known pose, is out of reach
+    (unreachable,) = only(report, "URS301")
+    assert unreachable.span.line == relative + 2
+    (warning,) = [f for f in report.findings
+                  if f.code == "URS210" and f.span.line == relative]
+    assert "after the move at line 15" in warning.message

@@ -177,6 +177,9 @@ class MotionPlanner:
         # spans of the movel/movep calls that a condition may stop before their target
         # (PolyScope's Direction node: :func:`urdsl.motion.direction.stoppable_moves`)
         self.stoppable: frozenset = frozenset()
+        # the span of the last move, if it was such a move cut where the arm could follow it:
+        # where the arm really stops depends on its condition (contact, an input)
+        self.stopped_at: Span | None = None
         self._tcp: np.ndarray | None = None
         self._pending: Segment | None = None  # the last move, if it may still blend
         self._q_end = self.q_start.copy()  # joints at the end of the last resolved move
@@ -336,7 +339,10 @@ class MotionPlanner:
         if a_rot is None:
             a_rot = ROTATION_PER_METRE * a
         profile = line_profile(pose_from, pose, v, a, t, v_rot, a_rot)
-        return self._add_cartesian(kind, profile, pose_from, pose, r, span, params, now)
+        end = self._add_cartesian(kind, profile, pose_from, pose, r, span, params, now)
+        if params.get("until"):
+            self.stopped_at = span  # where the arm ends depends on the condition
+        return end
 
     def _far(self, pose: np.ndarray) -> bool:
         """Whether a target (4x4) lies further from the base than :data:`FAR_TARGET` times
@@ -508,6 +514,7 @@ class MotionPlanner:
     # ---- planning --------------------------------------------------------------------------
 
     def _add(self, segment: Segment, now: float) -> float:
+        self.stopped_at = None  # a move to a known target: the arm's position is known again
         previous = self._pending
         radius = segment.radius
         previous_radius = previous.radius if previous is not None else 0.0

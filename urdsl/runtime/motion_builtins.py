@@ -20,7 +20,7 @@ from ..kinematics import KinematicsError
 from ..kinematics import pose as posemath
 from .errors import ScriptRuntimeError
 from .registry import implements
-from .values import ListValue, PoseValue, is_number, type_name
+from .values import ListValue, PoseValue, Unknown, is_number, type_name
 
 __all__: list[str] = []
 
@@ -215,14 +215,27 @@ def _stop(rt, node, a, aRot="a"):  # noqa: N803
 # ---- robot state -----------------------------------------------------------------------------
 
 
+def _stopped_by_condition(rt, arm) -> Unknown | None:
+    """After a move that a condition stops (PolyScope's Direction node: until tool contact,
+    an input), where the arm is depends on that condition: unknown offline, until a move to a
+    known target."""
+    span = getattr(arm, "stopped_at", None)
+    if span is None or not rt.unknown:
+        return None
+    return Unknown(f"the arm's position after the move at line {span.line}, which a "
+                   "condition stops", span)
+
+
 @implements("get_actual_joint_positions", "get_target_joint_positions")
 def _joints(rt, node):
-    return _vector(_arm(rt, node).joints_at(rt.time))
+    arm = _arm(rt, node)
+    return _stopped_by_condition(rt, arm) or _vector(arm.joints_at(rt.time))
 
 
 @implements("get_actual_tcp_pose", "get_target_tcp_pose")
 def _tcp_pose(rt, node):
-    return _to_pose(_arm(rt, node).tcp_at(rt.time))
+    arm = _arm(rt, node)
+    return _stopped_by_condition(rt, arm) or _to_pose(arm.tcp_at(rt.time))
 
 
 @implements("get_actual_joint_speeds", "get_target_joint_speeds")
