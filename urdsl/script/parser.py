@@ -14,10 +14,12 @@ written in, so nothing written is lost.
 
 from __future__ import annotations
 
+import bisect
 import functools
 import itertools
 import math
 import re
+from collections.abc import Generator
 from dataclasses import replace
 from importlib import resources
 from typing import Any
@@ -556,35 +558,74 @@ class Parser:
 
 def _place_comments(module: Module, comments: list[Token], source: Source) -> Module:
     """Put comments that stood inside a statement in front of that statement, in the
-    innermost block that holds it."""
-    pending = sorted(comments, key=lambda token: token[2])
+    innermost block that holds it.
 
-    def place(items: tuple) -> tuple:
+    Blocks nest as deep as the program does, so the walk keeps its own stack (generators
+    driven by :func:`_trampoline`) instead of recursing; each comment is found by bisection
+    and taken once, so many comments in a large file cost no more than a few in a small one.
+    """
+    pending = sorted(comments, key=lambda token: token[2])
+    offsets = [token[2] for token in pending]
+    count = len(pending)
+    # after[i]: a comment index >= i that may still be pending; count when none is
+    # (a "next pending" chain with path compression, so taken comments are skipped at once)
+    after = list(range(count + 1))
+
+    def first_pending(index: int) -> int:
+        root = index
+        while after[root] != root:
+            root = after[root]
+        while after[index] != root:
+            after[index], index = root, after[index]
+        return root
+
+    def has_pending(start: int, end: int) -> bool:
+        index = first_pending(bisect.bisect_left(offsets, start))
+        return index < count and offsets[index] < end
+
+    def place(items: tuple) -> Generator[Any, Any, tuple]:
         result: list = []
         for item in items:
             start, end = item.span.start, item.span.end
-            if any(start <= c[2] < end for c in pending):
-                item = descend(item)
-                for token in [c for c in pending if start <= c[2] < end]:
-                    _, (text, _trailing), c_start, c_end = token
+            if has_pending(start, end):
+                item = yield descend(item)
+                index = first_pending(bisect.bisect_left(offsets, start))
+                while index < count and offsets[index] < end:
+                    _, (text, _trailing), c_start, c_end = pending[index]
                     result.append(Comment(text, False, Span(source, c_start, c_end)))
-                    pending.remove(token)
+                    after[index] = index + 1
+                    index = first_pending(index + 1)
             result.append(item)
         return tuple(result)
 
-    def descend(item: Node) -> Node:
+    def descend(item: Node) -> Generator[Any, Any, Node]:
         if isinstance(item, (FunctionDef, ThreadDef, SecDef, While, Elif)):
-            return replace(item, body=place(item.body))
+            return replace(item, body=(yield place(item.body)))
         if isinstance(item, If):
-            return replace(
-                item,
-                body=place(item.body),
-                elifs=tuple(descend(branch) for branch in item.elifs),
-                orelse=None if item.orelse is None else place(item.orelse),
-            )
+            body = yield place(item.body)
+            elifs = []
+            for branch in item.elifs:
+                elifs.append((yield descend(branch)))
+            orelse = None if item.orelse is None else (yield place(item.orelse))
+            return replace(item, body=body, elifs=tuple(elifs), orelse=orelse)
         return item
 
-    return Module(place(module.body), module.span)
+    return Module(_trampoline(place(module.body)), module.span)
+
+
+def _trampoline(work: Generator[Any, Any, Any]) -> Any:
+    """Run a generator that yields the sub-generators whose results it needs (sent back to
+    it), with an explicit stack instead of Python recursion; return its result."""
+    stack = [work]
+    value: Any = None
+    while stack:
+        try:
+            stack.append(stack[-1].send(value))
+            value = None
+        except StopIteration as done:
+            stack.pop()
+            value = done.value
+    return value
 
 
 @functools.cache
