@@ -85,7 +85,7 @@ def _flip_char(rng: random.Random, text: str) -> str:
 
 
 def _flip_byte(rng: random.Random, text: str) -> str:
-    data = bytearray(text.encode("utf-8"))
+    data = bytearray(text.encode("utf-8", errors="surrogateescape"))
     if not data:
         return text
     at = rng.randrange(len(data))
