@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.urdsl-installed
 TSTAMP := $(VENV)/.urdsl-test-installed
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench clean fuzz
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -27,6 +27,12 @@ demo: $(STAMP)
 test: $(TSTAMP)
 	$(PY) -m ruff check urdsl tests bench programs grammar
 	$(PY) -m pytest -q
+
+# Longer fuzzing (issue 14): URDSL_FUZZ_SECONDS per target (default 300), a fresh seed unless
+# URDSL_FUZZ_SEED is given; a failure prints the seed and case that rebuild its input.
+fuzz: $(TSTAMP)
+	URDSL_FUZZ_SECONDS=$${URDSL_FUZZ_SECONDS:-300} URDSL_FUZZ_SEED=$${URDSL_FUZZ_SEED:-$$(date +%s)} \
+	  $(PY) -m pytest -q -s -p no:cacheprovider tests/test_fuzz_script.py tests/test_fuzz_check.py
 
 bench: $(TSTAMP)
 	$(PY) bench/parse_bench.py
