@@ -291,3 +291,30 @@ def test_deep_runs_recurse_from_their_first_instruction():
 
     for _ in range(20):
         assert run_deep(recurse, 5_000) == 5_000
+
+
+# ---- what this fuzzer found in the parser, as regression tests -------------------------------
+
+
+def test_comment_after_a_lone_cr_stays_on_its_own_line():
+    tree = urdsl.parse("x = 1\r# note\ry = 2 # tail\r")
+    assert urdsl.format(tree) == "x = 1\n# note\ny = 2  # tail\n"
+    assert urdsl.parse(urdsl.format(tree)) == tree
+
+
+@pytest.mark.parametrize("depth", [3, 2_000])
+def test_comment_inside_an_expression_deep_in_blocks(depth):
+    # set-aside comments were placed by recursion: RecursionError past ~500 levels
+    text = "while True:\n" * depth + "x = (1 # why\n)\n" + "end\n" * depth
+    printed = urdsl.format(urdsl.parse(text))
+    lines = printed.splitlines()
+    assert lines[depth] == "  " * depth + "# why"
+    assert lines[depth + 1] == "  " * depth + "x = (1)"
+    assert printed.count("end") == depth
+
+
+def test_many_comments_inside_expressions_each_placed_once():
+    text = "".join(f"x{i} = f(1, # c{i}\n  2)\n" for i in range(3_000))
+    lines = urdsl.format(urdsl.parse(text)).splitlines()
+    assert lines[:4] == ["# c0", "x0 = f(1, 2)", "# c1", "x1 = f(1, 2)"]
+    assert len(lines) == 6_000
