@@ -45,6 +45,10 @@ def _number(rng: random.Random, low: float, high: float) -> str:
     return repr(round(value, rng.choice((0, 1, 3, 6)))) if rng.random() < 0.9 else "0"
 
 
+def _positive(rng: random.Random, low: float, high: float) -> str:
+    return repr(round(rng.uniform(low, high), rng.choice((1, 3, 6))) or low)
+
+
 class Program:
     """Writes one random program; ``text()`` is its URScript."""
 
@@ -100,7 +104,7 @@ class Program:
             return f"pow({self.number(depth + 1)}, {rng.randrange(-3, 4)})"
         if kind == 10 and self.functions:
             return f"{rng.choice(self.functions)}({self.number(depth + 1)})"
-        return f"q[{rng.randrange(0, 7)}]"
+        return f"q[{rng.choice((0, 1, 2, 3, 4, 5, 6))}]"
 
     def condition(self) -> str:
         rng = self.rng
@@ -128,7 +132,7 @@ class Program:
     def statement(self, depth: int, pad: str) -> list[str]:
         rng = self.rng
         kind = rng.randrange(20 if depth < 3 else 11)
-        speed = f"a={_number(rng, 0.1, 3)}, v={_number(rng, 0.05, 2)}"
+        speed = f"a={_positive(rng, 0.1, 3)}, v={_positive(rng, 0.05, 2)}"
         if kind == 0:
             timing = rng.choice(("", f", t={_number(rng, 0.1, 5)}", f", r={_number(rng, 0, 0.05)}"))
             return [f"{pad}movej({self.joints()}, {speed}{timing})"]
@@ -146,7 +150,7 @@ class Program:
             items = ", ".join(self.number(2) for _ in range(rng.randrange(1, 6)))
             return [f"{pad}l = [{items}]"]
         if kind == 7:
-            return [f"{pad}l[{rng.randrange(-1, 6)}] = {self.number(2)}"]
+            return [f"{pad}l[{rng.choice((0, 0, 1, 2, 3, -1))}] = {self.number(2)}"]
         if kind == 8:
             return [f"{pad}set_digital_out({rng.randrange(8)}, {rng.choice(('True', 'False'))})"]
         if kind == 9:
@@ -182,12 +186,33 @@ class Program:
             return [f"{pad}q = get_inverse_kin({self.pose()})"]
         if kind == 18:
             return [f"{pad}{rng.choice(('stopj', 'stopl'))}({_number(rng, 0.5, 5)})"]
+        if rng.random() < 0.3:
+            return [pad + line for line in self.hostile().split("\n")]
         return [f"{pad}f = {self.number()}"]
+
+    def hostile(self) -> str:
+        """A statement of the kinds issue 14 found to hang the checker or eat its memory."""
+        rng = self.rng
+        choices = [
+            "while True:\n  sleep(0)\nend",
+            'socket_read_byte_list(1, "g", 0)',
+            f"movej(q, t={rng.choice(('1e4', '1e6', '1e300'))})",
+            f"movej(q, a={rng.choice(('1e-300', '1e300'))}, v={rng.choice(('1e-300', '1e300'))})",
+            "g = [1]\nwhile True:\n  g = [g, g]\nend",
+            's = "ab"\nwhile True:\n  s = str_cat(s, s)\nend',
+            "rec(0)",
+            f"l = make_list({rng.choice(('10', '1e9', '-1', '0.5'))}, 0)",
+        ]
+        if self.threads:
+            worker = rng.choice(self.threads)
+            choices.append(f"while True:\n  h = run {worker}()\n  sync()\nend")
+        return rng.choice(choices)
 
     def text(self) -> str:
         rng = self.rng
         head = ["global n = 0", "global f = 0.0", "global l = [0, 0, 0]",
                 "global q = [0, -1.57, 1.57, -1.57, -1.57, 0]"]
+        head += ["def rec(x):", "  return rec(x + 1)", "end"]
         for index in range(rng.randrange(0, 3)):
             name = f"fn{index}"
             body = self.block(2, rng.randrange(1, 3), "  ")
