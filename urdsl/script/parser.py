@@ -528,24 +528,27 @@ class Parser:
         return state
 
     def _accepts(self, stack: list[int], kind: str) -> bool:
-        """Whether ``kind`` can be shifted after the reductions it would trigger (simulated on
-        a copy of the state stack, with no tree building)."""
+        """Whether ``kind`` can be shifted after the reductions it would trigger (simulated
+        with no tree building, and without copying ``stack``: a comment deep in nested blocks
+        costs what one at the top does)."""
         actions = self.actions
         gotos = self.gotos
-        states = list(stack)
+        kept = len(stack)  # stack[:kept] is still below the simulated states
+        pushed: list[int] = []  # the simulated states above stack[:kept]
         while True:
-            action = actions[states[-1]].get(kind)
+            action = actions[pushed[-1] if pushed else stack[kept - 1]].get(kind)
             if action is None:
                 return False
             if type(action) is int:
                 return True
-            if type(action) is str:
-                states[-1:] = [gotos[states[-2]][action]]
-                continue
-            size, _, rule = action
-            if size:
-                del states[-size:]
-            states.append(gotos[states[-1]][rule])
+            if type(action) is str:  # `?rule` passing its child up: replace the top state
+                size, rule = 1, action
+            else:
+                size, _, rule = action
+            from_pushed = min(size, len(pushed))
+            del pushed[len(pushed) - from_pushed:]
+            kept -= size - from_pushed
+            pushed.append(gotos[pushed[-1] if pushed else stack[kept - 1]][rule])
 
     def _syntax_error(self, source: Source, stack: list[int], token: Token) -> ScriptSyntaxError:
         from .errors import explain
