@@ -318,3 +318,18 @@ def test_many_comments_inside_expressions_each_placed_once():
     lines = urdsl.format(urdsl.parse(text)).splitlines()
     assert lines[:4] == ["# c0", "x0 = f(1, 2)", "# c1", "x1 = f(1, 2)"]
     assert len(lines) == 6_000
+
+
+@pytest.mark.parametrize("digits", [310, 401, 5_000])
+def test_integer_beyond_float_range_is_a_syntax_error(digits):
+    # found by this fuzzer: lint (and check) raised OverflowError on a 400-digit int, and
+    # int() refuses 4,300 digits (ValueError from parse)
+    text = f"movej([1{'0' * (digits - 1)}, 0, 0, 0, 0, 0])\n"
+    with pytest.raises(urdsl.ScriptSyntaxError) as caught:
+        urdsl.parse(text, filename="big.script")
+    diagnostic = caught.value.diagnostic
+    assert (diagnostic.line, diagnostic.column) == (1, 8)
+    assert f"100000000000... ({digits} characters) is larger" in diagnostic.message
+    assert [d.code for d in lint_text(text, "big.script")] == ["URS001"]
+    largest = str(int(1.7976931348623157e308))
+    assert urdsl.format(urdsl.parse(f"x = {largest}\n")) == f"x = {largest}\n"

@@ -19,6 +19,7 @@ import functools
 import itertools
 import math
 import re
+import sys
 from collections.abc import Generator
 from dataclasses import replace
 from importlib import resources
@@ -82,6 +83,9 @@ def grammar_text() -> str:
     """The text of ``grammar/urscript.lark`` (shipped as package data ``urdsl.grammar``)."""
     return resources.files("urdsl.grammar").joinpath("urscript.lark").read_text("utf-8")
 
+
+_FLOAT_MAX = int(sys.float_info.max)
+"""The largest float as an int: int literals above it have no float value."""
 
 # Prefix operators that bind looser than comparisons (see _Builder.resolve).
 _LOOSE_PREFIX = frozenset(("not", "!"))
@@ -365,9 +369,18 @@ class _Builder:
 
     def number(self, s: list) -> Number:
         _, text, start, end = s[0]
-        value: int | float = int(text) if text.isdigit() else float(text)
+        value: int | float
+        if text.isdigit():
+            # an int must fit a float too (the tools compute with it as one); past 400
+            # digits int() is slow, and refuses 4,300
+            value = int(text) if len(text.lstrip("0")) <= 400 else math.inf
+            if value != math.inf and value > _FLOAT_MAX:
+                value = math.inf
+        else:
+            value = float(text)
         if value == math.inf:
-            self.error(start, end, f"{text} is larger than the largest number a controller "
+            shown = text if len(text) <= 30 else f"{text[:12]}... ({len(text)} characters)"
+            self.error(start, end, f"{shown} is larger than the largest number a controller "
                        "float holds (about 1.8e308)", "write a smaller number")
         return Number(value, _span((self.src, start, end)))
 
