@@ -25,6 +25,7 @@ import os
 import random
 import re
 import time
+import traceback
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -199,14 +200,14 @@ def mutant(target: str, case: int) -> str:
     return text
 
 
-def cases(target: str) -> Iterator[int]:
-    """Case numbers for ``target``: until the time budget is spent (at least MIN_CASES)."""
+def cases(target: str, minimum: int = MIN_CASES) -> Iterator[int]:
+    """Case numbers for ``target``: until the time budget is spent (at least ``minimum``)."""
     if ONLY_CASE is not None:
         yield int(ONLY_CASE)
         return
     stop = time.monotonic() + SECONDS
     case = 0
-    while case < MIN_CASES or time.monotonic() < stop:
+    while case < minimum or time.monotonic() < stop:
         yield case
         case += 1
     print(f"\nfuzz {target}: {case} cases, seed {SEED}, {SECONDS:g} s")
@@ -216,11 +217,40 @@ class Failure(AssertionError):
     pass
 
 
-def _fail(tmp_path: Path, target: str, case: int, text: str, problem: str) -> Failure:
-    path = tmp_path / f"{target}-{case}.script"
-    path.write_text(text, encoding="utf-8", errors="surrogateescape", newline="")
-    return Failure(f"{problem}\nreproduce: URDSL_FUZZ_SEED={SEED} URDSL_FUZZ_CASE={case} "
-                   f"(target {target}); input saved as {path}")
+class Findings:
+    """The distinct failures of one target: a failure is told apart by its exception type
+    and the line that raised it; the fuzzer goes on after one (a long run reports them all)
+    and stops after :data:`LIMIT`."""
+
+    LIMIT = 10
+
+    def __init__(self, target: str, tmp_path: Path) -> None:
+        self.target = target
+        self.tmp_path = tmp_path
+        self.found: dict[tuple[str, str], str] = {}
+
+    @property
+    def full(self) -> bool:
+        return len(self.found) >= self.LIMIT
+
+    def add(self, case: int, text: str, error: BaseException) -> None:
+        origin = traceback.extract_tb(error.__traceback__)[-1]
+        where = f"{Path(origin.filename).name}:{origin.lineno}"
+        key = (type(error).__name__, where if not isinstance(error, AssertionError)
+               else f"{where} {str(error)[:40]}")
+        if key in self.found:
+            return
+        path = self.tmp_path / f"{self.target}-{case}.script"
+        path.write_text(text, encoding="utf-8", errors="surrogateescape", newline="")
+        self.found[key] = (
+            f"{type(error).__name__} at {where}: {str(error)[:300]}\n  reproduce: "
+            f"URDSL_FUZZ_SEED={SEED} URDSL_FUZZ_CASE={case} (target {self.target}); "
+            f"input saved as {path}")
+
+    def check(self) -> None:
+        if self.found:
+            raise Failure(f"{len(self.found)} distinct failure(s):\n"
+                          + "\n".join(self.found.values()))
 
 
 def _same_tree(a: urdsl.script.Module, b: urdsl.script.Module) -> bool:
@@ -243,7 +273,10 @@ def _check_diagnostic(diagnostic: Diagnostic, text: str, filename: str) -> None:
 
 def test_parse_and_fmt_of_mutated_programs(tmp_path):
     parsed = 0
+    findings = Findings("fmt", tmp_path)
     for case in cases("fmt"):
+        if findings.full:
+            break
         text = mutant("fmt", case)
         try:
             try:
@@ -257,12 +290,16 @@ def test_parse_and_fmt_of_mutated_programs(tmp_path):
             assert _same_tree(tree, again), "fmt output parses to another tree"
             assert urdsl.format(again) == printed, "fmt is not idempotent"
         except Exception as error:  # noqa: BLE001 - any escape is the finding
-            raise _fail(tmp_path, "fmt", case, text, f"{type(error).__name__}: {error}") from error
+            findings.add(case, text, error)
+    findings.check()
     assert parsed or ONLY_CASE is not None, "no mutant parsed: the mutations are too coarse"
 
 
 def test_lint_of_mutated_programs(tmp_path):
+    findings = Findings("lint", tmp_path)
     for case in cases("lint"):
+        if findings.full:
+            break
         text = mutant("lint", case)
         try:
             found = lint_text(text, "fuzz.script")
@@ -270,7 +307,8 @@ def test_lint_of_mutated_programs(tmp_path):
             for diagnostic in found:
                 _check_diagnostic(diagnostic, text, "fuzz.script")
         except Exception as error:  # noqa: BLE001 - any escape is the finding
-            raise _fail(tmp_path, "lint", case, text, f"{type(error).__name__}: {error}") from error
+            findings.add(case, text, error)
+    findings.check()
 
 
 @pytest.mark.parametrize("name", ["flip", "splice", "deep", "number", "space"])
