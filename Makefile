@@ -28,11 +28,12 @@ test: $(TSTAMP)
 	$(PY) -m ruff check urdsl tests bench programs grammar
 	$(PY) -m pytest -q
 
-# longer fuzzing: FUZZ_SECONDS per target (default 60), FUZZ_SEED to vary the inputs
-FUZZ_SECONDS ?= 60
-FUZZ_SEED ?= 14
+# Longer fuzzing (issue 14): every tests/test_fuzz_*.py target runs URDSL_FUZZ_SECONDS
+# (default 120) with a fresh seed unless URDSL_FUZZ_SEED is given; a failure prints the seed
+# and case that rebuild its input.
 fuzz: $(TSTAMP)
-	URDSL_FUZZ_SECONDS=$(FUZZ_SECONDS) URDSL_FUZZ_SEED=$(FUZZ_SEED) $(PY) -m pytest -q -s tests/test_fuzz_*.py
+	URDSL_FUZZ_SECONDS=$${URDSL_FUZZ_SECONDS:-120} URDSL_FUZZ_SEED=$${URDSL_FUZZ_SEED:-$$(date +%s)} \
+	  $(PY) -m pytest -q -s -p no:cacheprovider tests/test_fuzz_protocol.py tests/test_fuzz_script.py tests/test_fuzz_check.py
 
 bench: $(TSTAMP)
 	$(PY) bench/parse_bench.py

@@ -51,14 +51,15 @@ def run_deep(function: Callable[..., T], *args, **kwargs) -> T:
     with _lock:  # the recursion limit is the process's: one deep run at a time
         previous_size = threading.stack_size()
         previous_limit = sys.getrecursionlimit()
-        threading.stack_size(STACK_BYTES)
-        try:
-            worker = threading.Thread(target=work, name="urdsl-deep", daemon=True)
-            worker.start()
-        finally:
-            threading.stack_size(previous_size)
+        # raised before the worker starts: it may run (and recurse) at once
         sys.setrecursionlimit(max(previous_limit, RECURSION_LIMIT))
         try:
+            threading.stack_size(STACK_BYTES)
+            try:
+                worker = threading.Thread(target=work, name="urdsl-deep", daemon=True)
+                worker.start()
+            finally:
+                threading.stack_size(previous_size)
             while worker.is_alive():
                 worker.join(0.1)  # in slices, so that Ctrl-C reaches this thread
         finally:

@@ -119,7 +119,8 @@ class Lexer:
                 last_end = end
                 yield (keywords.get(value, "NAME"), value, start, end)
             elif kind == "COMMENT":
-                trailing = last_end >= 0 and "\n" not in text[last_end:start]
+                # trailing: on the line of the last token (a lone CR ends a line too)
+                trailing = last_end >= 0 and _line_breaks(text, last_end, start) == 0
                 yield ("COMMENT", (text[start + 1:end].rstrip(), trailing), start, end)
             elif kind == "MARKER":
                 last_end = end

@@ -14,10 +14,13 @@ written in, so nothing written is lost.
 
 from __future__ import annotations
 
+import bisect
 import functools
 import itertools
 import math
 import re
+import sys
+from collections.abc import Generator
 from dataclasses import replace
 from importlib import resources
 from typing import Any
@@ -80,6 +83,9 @@ def grammar_text() -> str:
     """The text of ``grammar/urscript.lark`` (shipped as package data ``urdsl.grammar``)."""
     return resources.files("urdsl.grammar").joinpath("urscript.lark").read_text("utf-8")
 
+
+_FLOAT_MAX = int(sys.float_info.max)
+"""The largest float as an int: int literals above it have no float value."""
 
 # Prefix operators that bind looser than comparisons (see _Builder.resolve).
 _LOOSE_PREFIX = frozenset(("not", "!"))
@@ -363,9 +369,18 @@ class _Builder:
 
     def number(self, s: list) -> Number:
         _, text, start, end = s[0]
-        value: int | float = int(text) if text.isdigit() else float(text)
+        value: int | float
+        if text.isdigit():
+            # an int must fit a float too (the tools compute with it as one); past 400
+            # digits int() is slow, and refuses 4,300
+            value = int(text) if len(text.lstrip("0")) <= 400 else math.inf
+            if value != math.inf and value > _FLOAT_MAX:
+                value = math.inf
+        else:
+            value = float(text)
         if value == math.inf:
-            self.error(start, end, f"{text} is larger than the largest number a controller "
+            shown = text if len(text) <= 30 else f"{text[:12]}... ({len(text)} characters)"
+            self.error(start, end, f"{shown} is larger than the largest number a controller "
                        "float holds (about 1.8e308)", "write a smaller number")
         return Number(value, _span((self.src, start, end)))
 
@@ -526,24 +541,27 @@ class Parser:
         return state
 
     def _accepts(self, stack: list[int], kind: str) -> bool:
-        """Whether ``kind`` can be shifted after the reductions it would trigger (simulated on
-        a copy of the state stack, with no tree building)."""
+        """Whether ``kind`` can be shifted after the reductions it would trigger (simulated
+        with no tree building, and without copying ``stack``: a comment deep in nested blocks
+        costs what one at the top does)."""
         actions = self.actions
         gotos = self.gotos
-        states = list(stack)
+        kept = len(stack)  # stack[:kept] is still below the simulated states
+        pushed: list[int] = []  # the simulated states above stack[:kept]
         while True:
-            action = actions[states[-1]].get(kind)
+            action = actions[pushed[-1] if pushed else stack[kept - 1]].get(kind)
             if action is None:
                 return False
             if type(action) is int:
                 return True
-            if type(action) is str:
-                states[-1:] = [gotos[states[-2]][action]]
-                continue
-            size, _, rule = action
-            if size:
-                del states[-size:]
-            states.append(gotos[states[-1]][rule])
+            if type(action) is str:  # `?rule` passing its child up: replace the top state
+                size, rule = 1, action
+            else:
+                size, _, rule = action
+            from_pushed = min(size, len(pushed))
+            del pushed[len(pushed) - from_pushed:]
+            kept -= size - from_pushed
+            pushed.append(gotos[pushed[-1] if pushed else stack[kept - 1]][rule])
 
     def _syntax_error(self, source: Source, stack: list[int], token: Token) -> ScriptSyntaxError:
         from .errors import explain
@@ -556,35 +574,74 @@ class Parser:
 
 def _place_comments(module: Module, comments: list[Token], source: Source) -> Module:
     """Put comments that stood inside a statement in front of that statement, in the
-    innermost block that holds it."""
-    pending = sorted(comments, key=lambda token: token[2])
+    innermost block that holds it.
 
-    def place(items: tuple) -> tuple:
+    Blocks nest as deep as the program does, so the walk keeps its own stack (generators
+    driven by :func:`_trampoline`) instead of recursing; each comment is found by bisection
+    and taken once, so many comments in a large file cost no more than a few in a small one.
+    """
+    pending = sorted(comments, key=lambda token: token[2])
+    offsets = [token[2] for token in pending]
+    count = len(pending)
+    # after[i]: a comment index >= i that may still be pending; count when none is
+    # (a "next pending" chain with path compression, so taken comments are skipped at once)
+    after = list(range(count + 1))
+
+    def first_pending(index: int) -> int:
+        root = index
+        while after[root] != root:
+            root = after[root]
+        while after[index] != root:
+            after[index], index = root, after[index]
+        return root
+
+    def has_pending(start: int, end: int) -> bool:
+        index = first_pending(bisect.bisect_left(offsets, start))
+        return index < count and offsets[index] < end
+
+    def place(items: tuple) -> Generator[Any, Any, tuple]:
         result: list = []
         for item in items:
             start, end = item.span.start, item.span.end
-            if any(start <= c[2] < end for c in pending):
-                item = descend(item)
-                for token in [c for c in pending if start <= c[2] < end]:
-                    _, (text, _trailing), c_start, c_end = token
+            if has_pending(start, end):
+                item = yield descend(item)
+                index = first_pending(bisect.bisect_left(offsets, start))
+                while index < count and offsets[index] < end:
+                    _, (text, _trailing), c_start, c_end = pending[index]
                     result.append(Comment(text, False, Span(source, c_start, c_end)))
-                    pending.remove(token)
+                    after[index] = index + 1
+                    index = first_pending(index + 1)
             result.append(item)
         return tuple(result)
 
-    def descend(item: Node) -> Node:
+    def descend(item: Node) -> Generator[Any, Any, Node]:
         if isinstance(item, (FunctionDef, ThreadDef, SecDef, While, Elif)):
-            return replace(item, body=place(item.body))
+            return replace(item, body=(yield place(item.body)))
         if isinstance(item, If):
-            return replace(
-                item,
-                body=place(item.body),
-                elifs=tuple(descend(branch) for branch in item.elifs),
-                orelse=None if item.orelse is None else place(item.orelse),
-            )
+            body = yield place(item.body)
+            elifs = []
+            for branch in item.elifs:
+                elifs.append((yield descend(branch)))
+            orelse = None if item.orelse is None else (yield place(item.orelse))
+            return replace(item, body=body, elifs=tuple(elifs), orelse=orelse)
         return item
 
-    return Module(place(module.body), module.span)
+    return Module(_trampoline(place(module.body)), module.span)
+
+
+def _trampoline(work: Generator[Any, Any, Any]) -> Any:
+    """Run a generator that yields the sub-generators whose results it needs (sent back to
+    it), with an explicit stack instead of Python recursion; return its result."""
+    stack = [work]
+    value: Any = None
+    while stack:
+        try:
+            stack.append(stack[-1].send(value))
+            value = None
+        except StopIteration as done:
+            stack.pop()
+            value = done.value
+    return value
 
 
 @functools.cache
