@@ -197,8 +197,7 @@ class Program:
             "g = [1]\nwhile True:\n  g = [g, g]\nend",
             's = "ab"\nwhile True:\n  s = str_cat(s, s)\nend',
             "rec(0)",
-            # make_list(0.5, 0) is left out: it raises TypeError in the runtime (reported)
-            f"l = make_list({rng.choice(('10', '1e9', '-1'))}, 0)",
+            f"l = make_list({rng.choice(('10', '1e9', '-1', '0.5'))}, 0)",
         ]
         if self.threads:
             worker = rng.choice(self.threads)

@@ -162,3 +162,20 @@ def test_a_message_at_every_pass_does_not_fill_memory():
     assert len(report.events) == EVENT_LIMIT + 1  # 15,000 passes; the rest are counted
     assert report.events[-1].message.startswith("5,0")
     assert len(report.trace.times) <= 1  # the arm never moved: nothing to sample
+
+
+def test_absurd_move_parameters_raise_no_numpy_warning(recwarn):
+    from urdsl.verify.run import CheckOptions, check_text
+
+    report = check_text("q = [0.5, -1.5, 1.5, -1.5, -1.5, 0]\nmovej(q, a=1e300, v=1e-300)\n",
+                        "absurd.script", options=CheckOptions(max_time=10.0))
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+    assert "5.000e+299" in report.render_text()
+
+
+def test_make_list_needs_whole_lengths():
+    from urdsl.verify.run import check_text
+
+    report = check_text("l = make_list(0.5, 0)\n", "ml.script")
+    assert [f.code for f in report.findings] == ["URS203"]
+    assert "whole number" in report.findings[0].message

@@ -113,10 +113,13 @@ def positions(t, distance, accel, peak, t_acc, t_flat) -> np.ndarray:
     to [0, duration]. A profile of zero distance stays at 0."""
     duration = 2.0 * t_acc + t_flat
     t = np.clip(t, 0.0, duration)
-    rising = 0.5 * accel * t * t
-    cruising = 0.5 * accel * t_acc * t_acc + peak * (t - t_acc)
-    rest = duration - t
-    falling = distance - 0.5 * accel * rest * rest
+    # each branch is computed everywhere and picked by np.where: with absurd parameters
+    # (a=1e300) the branches not taken may overflow, which is no error of the one taken
+    with np.errstate(over="ignore", invalid="ignore"):
+        rising = 0.5 * accel * t * t
+        cruising = 0.5 * accel * t_acc * t_acc + peak * (t - t_acc)
+        rest = duration - t
+        falling = distance - 0.5 * accel * rest * rest
     result = np.where(t < t_acc, rising, np.where(t < t_acc + t_flat, cruising, falling))
     return np.where(distance == 0.0, 0.0, result)
 

@@ -385,6 +385,12 @@ def _size(rt, node, v):
 @implements("make_list")
 def _make_list(rt, node, length, initial_value, capacity=None):
     capacity = length if capacity is None else capacity
+    for name, value in (("length", length), ("capacity", capacity)):
+        whole = type(value) is int or (type(value) is float and value.is_integer())
+        if not whole or value < 0:
+            raise rt.error("type", f"make_list: the {name} must be a whole number >= 0, got "
+                           f"{value!r}", node)
+    length, capacity = int(length), int(capacity)
     if capacity < length:
         raise rt.error("index", "make_list: capacity is smaller than length", node)
     if not is_number(capacity) or capacity > LIST_LIMIT:

@@ -117,7 +117,7 @@ class Report:
             lines.append(f"moves ({len(self.moves)}):")
             for move in self.moves[:max_moves]:
                 lines.append(f"  line {move.span.line:>4}  {move.kind:<6} "
-                             f"start {move.start:8.3f} s  duration {move.duration:7.3f} s")
+                             f"start {move.start:8.3f} s  duration {_seconds(move.duration):>7} s")
             if len(self.moves) > max_moves:
                 lines.append(f"  ... {len(self.moves) - max_moves} more")
         if self.context:
@@ -150,7 +150,7 @@ class Report:
                 table.add_column(column, justify="right" if column != "move" else "left")
             for move in self.moves[:max_moves]:
                 table.add_row(str(move.span.line), move.kind, f"{move.start:.3f}",
-                              f"{move.duration:.3f}")
+                              _seconds(move.duration))
             if len(self.moves) > max_moves:
                 table.add_row("…", f"{len(self.moves) - max_moves} more", "", "")
             console.print(table)
@@ -167,3 +167,9 @@ class Report:
         from .plot import plot_report
 
         plot_report(self, path, robot_model)
+
+
+def _seconds(value: float) -> str:
+    """A time in s for the move table: milliseconds, or a power of ten for absurd lengths
+    (``movej(q, t=1e300)``)."""
+    return f"{value:.3f}" if abs(value) < 1e9 else f"{value:.3e}"
