@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import time
 
 from ..rules import RULES
 from . import checks  # noqa: F401 - registers the trace checks (their rules)
@@ -188,6 +189,7 @@ def _check_script(source, args: argparse.Namespace, options):
     from .infer import apply, infer, qualify
     from .run import check_text, check_tree
 
+    started = time.monotonic()  # the wall-clock bound covers the parse and inference too
     try:
         module = parse(source.text, source.name)
     except ScriptError:
@@ -209,7 +211,7 @@ def _check_script(source, args: argparse.Namespace, options):
     file_options = apply(options, inference, tcp_given=args.tcp is not None)
     if args.cell and file_options.robot != options.robot:
         file_options.cell = _load_cell(file_options.robot, args.cell)
-    report = check_tree(module, source.name, file_options)
+    report = check_tree(module, source.name, file_options, started=started)
     report.inferred = inference
     qualify(report, inference)
     if context is not None:
