@@ -116,6 +116,9 @@ def add_commands(commands) -> None:
     p.add_argument("--no-project", action="store_true",
                    help="check the file alone, not in the context of its project (host "
                    "program, sibling script files, installation variables)")
+    p.add_argument("--nominal", action="store_true",
+                   help="a PolyScope program (.urp): check on the model's nominal kinematics, "
+                   "not the arm's calibration stored in the program")
     p.set_defaults(run=cmd_check)
 
 
@@ -151,6 +154,11 @@ def cmd_check(args: argparse.Namespace) -> int:
                 report = _check_program(name, options)
             except (DslError, ProgramFileError) as error:
                 print(str(error), file=sys.stderr)
+                failed = True
+                continue
+        elif name.lower().endswith(".urp"):
+            report = _check_urp(name, args, options)
+            if report is None:
                 failed = True
                 continue
         else:
@@ -211,6 +219,28 @@ def _check_script(source, args: argparse.Namespace, options):
     report.inferred = inference
     if context is not None:
         report.context = context.note
+    return report
+
+
+def _check_urp(name: str, args: argparse.Namespace, options):
+    """A PolyScope program: compiled, then checked (see :mod:`urdsl.polyscope.check`);
+    None (the message printed) when it cannot be compiled."""
+    from pathlib import Path
+
+    from ..cli import UsageError
+    from ..polyscope.check import check_urp
+    from ..polyscope.compile import CompileError
+    from ..polyscope.urp import UrpError
+
+    if not Path(name).is_file():
+        raise UsageError(f"cannot read {name}: No such file")
+    try:
+        report = check_urp(name, options, robot_given=bool(args.robot),
+                           start_joints=args.start_joints or args.start_joints_deg,
+                           tcp=args.tcp, nominal=args.nominal, cell_path=args.cell)
+    except (UrpError, CompileError) as error:
+        print(str(error), file=sys.stderr)
+        return None
     return report
 
 
