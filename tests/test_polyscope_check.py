@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import gzip
 import json
+import math
 import shutil
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import pytest
 from urdsl.cli import main
 from urdsl.polyscope.check import calibration_of, generate
 from urdsl.polyscope.urp import read_urp
+from urdsl.runtime.unknown import DEVICE_REPLY_TIME
 
 DATA = Path(__file__).parent / "data" / "polyscope"
 
@@ -74,7 +76,8 @@ def test_urcap_nodes_are_an_info_finding_and_a_device(tmp_path, capsys):
     assert "Robot Program > Grip" in urcap["message"]
     depends = next(f for f in report["findings"] if f["code"] == "URS210")
     assert "URCap" in depends["message"] and "Robot Program > If" in depends["message"]
-    assert report["cycle_time"] == pytest.approx(0.5, abs=0.01)  # the branch of a working one
+    # the URCap node answers as a device does, then the branch of a working one runs
+    assert report["cycle_time"] == pytest.approx(DEVICE_REPLY_TIME + 0.5, abs=0.01)
 
 
 def test_lint_names_the_node(cell, capsys):
@@ -119,3 +122,84 @@ def test_the_arm_calibration_moves_the_check(tmp_path, capsys):
     assert "very arm" in json.loads(capsys.readouterr().out)["context"]
     main(["check", str(program), "--json", "--nominal"])
     assert "--nominal" in json.loads(capsys.readouterr().out)["context"]
+
+
+def _safety(tcp_speed: float = 1.5, shoulder_max: float = 0.0524, plane: str = "") -> str:
+    """A ``<SafetySettings>`` block as PolyScope writes it (INI text)."""
+    return f"""<SafetySettings>
+[SafetyLimits BoundaryPlane0]
+name = Ceiling
+displacement = 0.0
+mode = {'BOTH' if plane else 'DISABLED'}
+planeNormal = {plane or '[0.0, 0.0, 0.0]'}
+distanceToOrigin = 0.3
+elbowRestricted = true
+
+[SafetyLimits BoundaryPlane1]
+name = Wall
+mode = TRIGGER
+planeNormal = [1.0, 0.0, 0.0]
+distanceToOrigin = 0.1
+
+[SafetySetup]
+withPositionLimits = [true, true, true, true, true, false]
+
+[SafetyLimits Normal Values]
+maxTcpSpeed = {tcp_speed}
+maxForce = 150.0
+
+[SafetyLimits Normal Joints]
+maxJointSpeed = [3.14, 3.14, 3.14, 6.28, 6.28, 6.28]
+minJointPosition = [6.2308, 6.2308, 6.2308, 6.2308, 6.2308, 0.0]
+maxJointPosition = [0.0524, {shoulder_max}, 0.0524, 0.0524, 0.0524, 0.0]
+minJointRevolutions = [-2, -2, -2, -2, -2, -2147483648]
+maxJointRevolutions = [1, {1 if shoulder_max == 0.0524 else -1}, 1, 1, 1, 2147483647]
+</SafetySettings>"""
+
+
+def _with_safety(cell: Path, block: str) -> None:
+    installation = cell.with_suffix(".installation")
+    text = installation.read_text(encoding="utf-8")
+    installation.write_text(text.replace("</Installation>", block + "\n</Installation>"),
+                            encoding="utf-8")
+
+
+def test_safety_limits_are_read_from_the_installation():
+    from urdsl.polyscope.installation import parse_safety
+
+    safety = parse_safety(_safety(0.25).split(">", 1)[1].rsplit("<", 1)[0])
+    assert safety.tcp_speed == 0.25 and safety.force == 150.0
+    assert safety.q_max[0] == pytest.approx(2 * math.pi + 0.0524)  # angle + whole turns
+    assert safety.q_min[0] == pytest.approx(-4 * math.pi + 6.2308)
+    assert safety.q_min[5] is None and safety.q_max[5] is None  # not limited
+    assert safety.joint_speed[3] == 6.28
+    assert [p.name for p in safety.planes] == ["Wall"] and safety.planes[0].mode == "TRIGGER"
+
+
+def test_installation_tcp_speed_limit_reaches_the_check(cell, capsys):
+    _with_safety(cell, _safety(tcp_speed=0.05))
+    main(["check", str(cell), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert "TCP speed limit 0.05 m/s" in report["context"]
+    speed = [f for f in report["findings"] if f["code"] == "URS306"]
+    assert speed and "node Robot Program > MoveJ > Waypoint_" in speed[0]["message"]
+    main(["check", str(cell), "--json", "--tcp-speed-limit", "50"])  # the flag wins
+    assert "URS306" not in [f["code"] for f in json.loads(capsys.readouterr().out)["findings"]]
+
+
+def test_installation_joint_limits_reach_the_check(cell, capsys):
+    _with_safety(cell, _safety(shoulder_max=6.1))  # shoulder at most −2π + 6.1 = −0.18 rad
+    main(["check", str(cell), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert "joint position limits" in report["context"]
+    assert any(f["code"] == "URS303" and "shoulder" in f["message"]
+               for f in report["findings"])
+
+
+def test_installation_safety_planes_are_cell_planes(cell, capsys):
+    _with_safety(cell, _safety(plane="[0.0, 0.0, -1.0]"))  # stay below z = 0.3 m
+    main(["check", str(cell), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert "1 safety plane(s) as cell planes (Ceiling)" in report["context"]  # not the trigger
+    assert any(f["code"] == "URS308" and "Ceiling" in f["message"]
+               for f in report["findings"])

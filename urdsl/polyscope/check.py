@@ -25,6 +25,7 @@ from pathlib import Path
 from ..script import nodes as n
 from ..script.diagnostics import Diagnostic
 from .compile import Compiled
+from .installation import Installation
 from .urp import Node, Program
 
 __all__ = ["Generated", "generate", "URCAP_CODE", "node_findings"]
@@ -48,6 +49,7 @@ class Generated:
     text: str
     filename: str
     owners: list[Node | None]
+    installation: Installation | None = None
 
     def node_at(self, line: int) -> Node | None:
         """The node that generated script line ``line`` (1-based)."""
@@ -72,9 +74,9 @@ def generate(path: str | Path) -> Generated:
     the nearest marker above it whose block it is in (raises
     :class:`~urdsl.polyscope.urp.UrpError` or :class:`~urdsl.polyscope.compile.CompileError`,
     messages naming the file and node)."""
-    from .command import load
+    from .command import load_all
 
-    program, compiled = load(path)
+    program, installation, compiled = load_all(path)
     text = compiled.text
     waypoints = {node.name: node for root in program.top for node in root.walk()
                  if node.kind == "Waypoint" and node.name}
@@ -96,7 +98,15 @@ def generate(path: str | Path) -> Generated:
             owners.append(waypoints[named.group(1)])
         else:
             owners.append(open_nodes[-1][1] if open_nodes else None)
-    return Generated(str(path), program, compiled, text, f"{path} (compiled)", owners)
+    lines = text.splitlines()
+    for index in range(len(lines) - 1):  # the loop around the Robot Program is the program's
+        marker = _MARKER.match(lines[index + 1])
+        if owners[index] is None and marker and lines[index].strip().startswith("while"):
+            node = compiled.numbers.get(int(marker.group(1)))
+            if node is not None and node.kind == "MainProgram":
+                owners[index] = node
+    return Generated(str(path), program, compiled, text, f"{path} (compiled)", owners,
+                     installation)
 
 
 def _located(generated: Generated, line: int, message: str) -> str:
@@ -124,14 +134,14 @@ def urcap_diagnostics(generated: Generated) -> list[Diagnostic]:
     for number, node in generated.urcap_nodes():
         line = next((i for i, text in enumerate(lines, 1)
                      if _MARKER.match(text) and _MARKER.match(text).group(1) == str(number)),
-                    0)
+                    1)  # a URCap node without a marker of its own: on the program's line
         urcap = node.attrs.get("strategyURCapName", "?")
         message = (f"URCap node {node.title} of {urcap}: only the URCap can generate its "
                    "code; urdsl checks the program without it and treats what it does as a "
                    "device (its results are unknown)")
         out.append(Diagnostic(generated.filename, line, 1, "info", URCAP_CODE,
-                              _located(generated, line, message),
-                              source_line=lines[line - 1] if line else None))
+                              f"{message} [{generated.where(node)}]",
+                              source_line=lines[line - 1] if lines else None))
     return out
 
 
@@ -154,44 +164,84 @@ def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
     return {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
 
 
+def with_urcap_time(module: n.Module, numbers: set[int]) -> n.Module:
+    """``module`` with each URCap node (marker number in ``numbers``) taking a device's
+    reply time (:data:`urdsl.runtime.unknown.DEVICE_REPLY_TIME`, as ``sleep``, placed on the
+    node's marker): what the URCap's code does takes robot time, never none, so a loop of
+    URCap nodes is not taken for a busy loop."""
+    from ..runtime.unknown import DEVICE_REPLY_TIME
+
+    def block(items: tuple) -> tuple:
+        out = []
+        for item in items:
+            out.append(visit(item))
+            if isinstance(item, n.Marker) and item.number in numbers:
+                out.append(n.ExprStmt(n.Call(n.Name("sleep", span=item.span),
+                                             (n.Number(DEVICE_REPLY_TIME, span=item.span),),
+                                             span=item.span), span=item.span))
+        return tuple(out)
+
+    def visit(node):
+        if not dataclasses.is_dataclass(node) or isinstance(node, n.Expr):
+            return node
+        changes = {}
+        for f in dataclasses.fields(node):
+            value = getattr(node, f.name)
+            if isinstance(value, tuple) and value and all(
+                    isinstance(v, (n.Stmt, n.Comment, n.Blank, n.Marker, n.Elif))
+                    for v in value):
+                changes[f.name] = tuple(visit(v) for v in value) if all(
+                    isinstance(v, n.Elif) for v in value) else block(value)
+        return dataclasses.replace(node, **changes) if changes else node
+
+    return visit(module) if numbers else module
+
+
 def calibration_of(program: Program, robot: str | None = None):
     """The program's ``<kinematics>`` as a :class:`~urdsl.kinematics.Calibration` of the
-    model whose nominal DH table it corrects (``robot`` when given), with that model's name;
-    ``(None, None)`` when the program has none or it matches no model (``robot``) within
-    :data:`_DH_MATCH` m."""
+    model whose arm it describes (``robot`` when given), with that model's name;
+    ``(None, None)`` when the program has none or it matches no model (``robot``).
+
+    Factory calibrations are "linearized": the lengths along parallel axes trade off (a
+    UR3e's stores d = 1.79, 30.86, −32.52 m where the nominal table has 0, 0, 0.131 m), so
+    the table is compared by what it does: a model matches when the flange positions of the
+    calibrated and nominal tables differ by at most :data:`_FK_MATCH` m at every one of a
+    fixed set of joint positions (two models differ by centimetres to decimetres)."""
     import numpy as np
 
-    from ..kinematics import MODELS, Calibration
+    from ..kinematics import MODELS, Calibration, KinematicsError, Robot
     from ..kinematics.models import model_spec
 
     block = program.kinematics
-    if block is None or len(block.a) != 6 or len(block.d) != 6 or len(block.alpha) != 6 \
-            or len(block.delta_theta) != 6:
+    if block is None or any(len(v) != 6 for v in (block.a, block.d, block.alpha,
+                                                   block.delta_theta)):
         return None, None
-    candidates = [robot] if robot else list(MODELS)
+    samples = np.random.default_rng(13).uniform(-np.pi, np.pi, (24, 6))
     best = None
-    for name in candidates:
+    for name in [robot] if robot else list(MODELS):
         spec = model_spec(name)
-        da = np.asarray(block.a) - spec.dh_a
-        dd = np.asarray(block.d) - spec.dh_d
-        dalpha = np.asarray(block.alpha) - spec.dh_alpha
-        error = float(max(np.max(np.abs(da)), np.max(np.abs(dd))))
-        if error <= _DH_MATCH and float(np.max(np.abs(dalpha))) <= _ALPHA_MATCH and (
-                best is None or error < best[0]):
-            best = (error, spec.name, Calibration(np.asarray(block.delta_theta), da, dd,
-                                                  dalpha, model=spec.name))
+        calibration = Calibration(np.asarray(block.delta_theta),
+                                  np.asarray(block.a) - spec.dh_a,
+                                  np.asarray(block.d) - spec.dh_d,
+                                  np.asarray(block.alpha) - spec.dh_alpha, model=spec.name)
+        try:
+            nominal = Robot.model(spec.name).fk_many(samples)
+            calibrated = Robot.model(spec.name, calibration=calibration).fk_many(samples)
+        except (KinematicsError, ValueError, FloatingPointError):
+            continue
+        error = float(np.max(np.linalg.norm(nominal[:, :3, 3] - calibrated[:, :3, 3],
+                                            axis=1)))
+        if error <= _FK_MATCH and (best is None or error < best[0]):
+            best = (error, spec.name, calibration)
     if best is None:
         return None, None
     return best[2], best[1]
 
 
-_DH_MATCH = 0.005
-"""Largest difference [m] of a calibrated DH length from a model's nominal one for the
-calibration to be taken as that model's (factory corrections are well under a millimetre;
-two models differ by centimetres)."""
-
-_ALPHA_MATCH = 0.01
-"""Largest difference [rad] of a calibrated DH twist from the nominal one."""
+_FK_MATCH = 0.01
+"""Largest flange position difference [m] between a program's calibrated kinematics and a
+model's nominal ones for the calibration to be that model's (factory corrections move the
+flange by a few millimetres at most)."""
 
 
 def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=None,
@@ -225,6 +275,11 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
                              + "; nominal kinematics used")
     inference = infer(module, path, robot=options.robot if robot_given else calibrated_model,
                       start_joints=start_joints, tcp=tcp, default_robot=options.robot)
+    if calibrated_model is not None and not robot_given:
+        model = calibrated_model
+        inference.robot_source = "program"  # the arm the program's <kinematics> describe
+        inference.robot_line = lambda: (  # type: ignore[method-assign]
+            f"robot {model} from the program's <kinematics> (the arm's calibration)")
     file_options = apply(options, inference, tcp_given=tcp is not None)
     if cell_path and file_options.robot != options.robot:
         from ..verify.command import _load_cell
@@ -234,11 +289,15 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         file_options.calibration = calibration
         notes.append(f"on this very arm: the {calibration.model} calibration of the program's "
                      "<kinematics>")
+    if generated.installation is not None and generated.installation.safety is not None:
+        notes.extend(installation_defaults(file_options, generated.installation,
+                                           cell_given=bool(cell_path)))
     file_options.unknown_globals = urcap_values(generated, module)
     if file_options.unknown_globals:
         notes.append("unknown values from URCap nodes: "
                      + ", ".join(sorted(file_options.unknown_globals)))
-    report = check_tree(module, generated.filename, file_options)
+    urcaps = {number for number, _node in generated.urcap_nodes()}
+    report = check_tree(with_urcap_time(module, urcaps), generated.filename, file_options)
     report.inferred = inference
     report.findings = node_findings(generated, [
         f for f in report.findings if not _polyscope_threads_only(f)])
@@ -252,6 +311,52 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     report.context = "; ".join(notes)
     report.generated = generated  # type: ignore[attr-defined]
     return report
+
+
+def installation_defaults(options, installation: Installation, cell_given: bool) -> list[str]:
+    """Set the installation's normal-mode safety limits on ``options`` (a
+    :class:`~urdsl.verify.run.CheckOptions` for its robot) where the command line left them
+    open: joint position limits (a joint the installation does not limit keeps the model's),
+    joint speed limits, the TCP speed limit, and the safety planes that restrict normal mode
+    (``NORMAL``, ``BOTH``) as planes of the cell (unless ``--cell`` was given). Returns what
+    was taken, for the report."""
+    import numpy as np
+
+    from ..kinematics import Robot
+    from ..kinematics.collision import CollisionModel
+
+    safety = installation.safety
+    if safety is None:
+        return []
+    robot = Robot.model(options.robot, calibration=options.calibration)
+    taken: list[str] = []
+    if options.q_min is None and options.q_max is None and safety.q_min and safety.q_max:
+        low = tuple(float(robot.q_min[j]) if v is None else max(v, float(robot.q_min[j]))
+                    for j, v in enumerate(safety.q_min))
+        high = tuple(float(robot.q_max[j]) if v is None else min(v, float(robot.q_max[j]))
+                     for j, v in enumerate(safety.q_max))
+        if low != tuple(float(v) for v in robot.q_min) or \
+                high != tuple(float(v) for v in robot.q_max):
+            options.q_min, options.q_max = low, high
+            taken.append("joint position limits")
+    if safety.joint_speed and bool(np.any(np.asarray(safety.joint_speed) < robot.qd_max)):
+        options.joint_speed_limit = tuple(safety.joint_speed)
+        taken.append("joint speed limits")
+    if options.tcp_speed_limit is None and safety.tcp_speed is not None:
+        options.tcp_speed_limit = safety.tcp_speed
+        taken.append(f"TCP speed limit {safety.tcp_speed:g} m/s")
+    planes = [p for p in safety.planes if p.mode in ("NORMAL", "BOTH")]
+    if planes and not cell_given:
+        cell = options.cell if isinstance(options.cell, CollisionModel) else \
+            CollisionModel(robot)
+        for plane in planes:
+            cell.add_plane(plane.normal, -plane.distance, plane.name)
+        options.cell = cell
+        taken.append(f"{len(planes)} safety plane(s) as cell planes ("
+                     + ", ".join(p.name for p in planes) + ")")
+    if not taken:
+        return []
+    return [f"from {Path(installation.path).name}: " + ", ".join(taken)]
 
 
 _THREADS_LEFT = re.compile(r"thread\(s\) (.+?) still ran")

@@ -88,6 +88,9 @@ class CheckOptions:
     calibration: Any = None
     """A :class:`urdsl.kinematics.Calibration` of the very arm (a PolyScope program's
     ``<kinematics>``), or None for the model's nominal kinematics."""
+    joint_speed_limit: tuple[float, ...] | None = None
+    """Joint speed limits [rad/s] set for the cell (a PolyScope installation's), below the
+    model's."""
     unknown_globals: dict[str, str] = field(default_factory=dict)
     """Globals the program reads that something outside it defines (a URCap node's code):
     name → where the value comes from; each holds an unknown value."""
@@ -243,10 +246,12 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
     findings += jumps.findings
     q_min = np.asarray(options.q_min if options.q_min is not None else robot.q_min)
     q_max = np.asarray(options.q_max if options.q_max is not None else robot.q_max)
+    qd_max = np.asarray(robot.qd_max, dtype=float)
+    if options.joint_speed_limit is not None:
+        qd_max = np.minimum(qd_max, np.asarray(options.joint_speed_limit, dtype=float))
     steps = [
         ("joint limits", lambda: checks.joint_limits(trace, q_min, q_max)),
-        ("joint speeds", lambda: checks.joint_speeds(trace, np.asarray(robot.qd_max),
-                                                     exclude=jumps.samples)),
+        ("joint speeds", lambda: checks.joint_speeds(trace, qd_max, exclude=jumps.samples)),
     ]
     if options.joint_acceleration_limit is not None:
         limits = np.broadcast_to(np.asarray(options.joint_acceleration_limit, float), (6,))
