@@ -378,3 +378,37 @@ def _offset(text: str, line: int) -> int:
     for _ in range(line - 1):
         offset = text.index("\n", offset) + 1
     return offset
+
+
+def send_check(path: str, robot: str, check: bool):
+    """``urdsl send X.urp``: ``(tree, filename, report)`` of the compiled program, the report
+    of :func:`check_urp` (None when ``check`` is false); None when the program cannot be
+    compiled (the message printed). ``robot`` is the command line's model; the default
+    (ur5e) gives way to the arm the program's ``<kinematics>`` describe."""
+    import sys
+    from pathlib import Path
+
+    from ..cli import UsageError
+    from ..script.diagnostics import ScriptError
+    from ..script.parser import parse
+    from ..verify.run import CheckOptions
+    from .compile import CompileError
+    from .urp import UrpError
+
+    if not Path(path).is_file():
+        raise UsageError(f"cannot read {path}: No such file")
+    try:
+        generated = generate(path)
+        tree = parse(generated.text, generated.filename)
+    except (UrpError, CompileError) as error:
+        print(str(error), file=sys.stderr)
+        return None
+    except ScriptError as error:
+        print(error.diagnostic.render(), file=sys.stderr)
+        return None
+    report = None
+    if check:
+        report = check_urp(path, CheckOptions(robot=robot), robot_given=robot != "ur5e")
+        if report.context:
+            print(report.context, file=sys.stderr)
+    return tree, generated.filename, report
