@@ -203,3 +203,13 @@ def test_installation_safety_planes_are_cell_planes(cell, capsys):
     assert "1 safety plane(s) as cell planes (Ceiling)" in report["context"]  # not the trigger
     assert any(f["code"] == "URS308" and "Ceiling" in f["message"]
                for f in report["findings"])
+
+
+def test_the_demo_program_is_checked_by_node(capsys):
+    program = Path(__file__).parents[1] / "programs" / "polyscope" / "pick.urp"
+    assert main(["check", str(program), "--json"]) == 1  # the installation's speed limit
+    report = json.loads(capsys.readouterr().out)
+    speed = [f["message"] for f in report["findings"] if f["code"] == "URS306"]
+    assert any("node Robot Program > Loop > MoveL > LiftPick" in m for m in speed)
+    assert "TCP speed limit 0.25 m/s" in report["context"]
+    assert len(report["moves"]) == 13 and report["cycle_time"] > 10
