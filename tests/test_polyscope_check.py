@@ -213,3 +213,16 @@ def test_the_demo_program_is_checked_by_node(capsys):
     assert any("node Robot Program > Loop > MoveL > LiftPick" in m for m in speed)
     assert "TCP speed limit 0.25 m/s" in report["context"]
     assert len(report["moves"]) == 13 and report["cycle_time"] > 10
+
+
+def test_a_missing_installation_is_named(tmp_path, capsys):
+    program = tmp_path / "alone.urp"
+    program.write_text(_program('<Wait type="Sleep"><waitTime>0.1</waitTime></Wait>'))
+    assert main(["check", str(program), "--json"]) == 0
+    assert "no installation default.installation beside the program" in json.loads(
+        capsys.readouterr().out)["context"]
+    program.write_text(_program('<Set type="DigitalOutput"><pin referencedName="gripper"/>'
+                                '<digitalValue>1</digitalValue></Set>'))
+    assert main(["check", str(program)]) == 1
+    err = capsys.readouterr().err
+    assert f"{program}: error: node Robot Program > Set" in err and "Traceback" not in err

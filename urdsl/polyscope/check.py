@@ -262,6 +262,10 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     except ScriptError:
         return check_text(generated.text, generated.filename, options=options)
     notes = [f"compiled from {path} (PolyScope {generated.program.saved_in or '?'})"]
+    if generated.installation is None:
+        named = generated.program.installation
+        notes.append(f"no installation {named + '.installation ' if named else ''}beside the "
+                     "program: compiled and checked without its preamble and limits")
     calibration, calibrated_model = (None, None)
     if generated.program.kinematics is not None:
         if nominal:
