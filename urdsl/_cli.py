@@ -20,7 +20,7 @@ from .kinematics.models import model_spec
 from .versions import ControllerVersion
 
 __all__ = ["EXIT_OK", "EXIT_PROBLEMS", "EXIT_USAGE", "UsageError", "InputFile", "read_input",
-           "error", "robot_model", "controller_version"]
+           "load_cell", "error", "robot_model", "controller_version"]
 
 EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE = 0, 1, 2
 
@@ -82,3 +82,17 @@ def controller_version(text: str) -> ControllerVersion:
         return ControllerVersion.parse(text)
     except ValueError as failure:
         raise UsageError(str(failure)) from None
+
+
+def load_cell(robot: str, path: str):
+    """The collision model of ``robot`` with the obstacles of the cell file ``path`` (see
+    :mod:`urdsl.kinematics.collision`), or a :class:`UsageError` naming what is wrong."""
+    from .kinematics import KinematicsError, Robot
+    from .kinematics.collision import CollisionModel
+
+    model = CollisionModel(Robot.model(robot))
+    try:
+        model.load_cell(path)
+    except KinematicsError as error:
+        raise UsageError(f"bad cell description: {error}") from None
+    return model

@@ -4,12 +4,14 @@ Read a URScript program and show its canonical form; show how urdsl reports the 
 of the course's slides (file:line:col, the line, a caret, a hint); compile a Python DSL
 program; check the course's program offline on a simulated UR5e — first as the slides order
 it (a straight line out of a singular pose, which the robot cannot do), then corrected —
-and write its report and plot; finally the whole story against the built-in virtual
+and write its report and plot; check a PolyScope program (``programs/polyscope/pick.urp``:
+its tree, findings by node, cycle time); finally the whole story against the built-in virtual
 controller: check, send, record RTDE while the program runs, plot (all on 127.0.0.1).
 """
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -46,6 +48,7 @@ def main() -> int:
             console.print()
     compile_program(console)
     check_programs(console)
+    check_polyscope(console)
     story = run_story(console)
     console.rule("[bold]done")
     console.print("next: urdsl compile --help, urdsl check --help, urdsl sim --help")
@@ -62,6 +65,27 @@ def compile_program(console: Console) -> None:
     head = "\n".join(text.splitlines()[:14]) + "\n  ..."
     console.print(Panel(Syntax(head, "python", theme="ansi_dark"),
                         title=f"urdsl compile {program.relative_to(PROGRAMS.parent)}"))
+
+
+def check_polyscope(console: Console) -> None:
+    """A PolyScope program (``.urp`` with its ``.installation``): its tree as PolyScope shows
+    it, then ``urdsl check`` on the arm of its ``<kinematics>`` with the installation's
+    safety limits, each finding naming its node, and the cycle time."""
+    from .polyscope.check import check_urp
+    from .polyscope.command import load, tree_lines
+    from .verify.run import CheckOptions
+
+    program = PROGRAMS / "polyscope" / "pick.urp"
+    shown = program.relative_to(PROGRAMS.parent)
+    console.rule("[bold]PolyScope programs: check the program the operator edits")
+    console.print(f"[bold]$ urdsl show {shown}[/bold]")
+    tree, compiled = load(program)
+    console.print("\n".join(tree_lines(tree, compiled)), markup=False, highlight=False)
+    console.print()
+    console.print(f"[bold]$ urdsl check {shown}[/bold]")
+    report = check_urp(os.path.relpath(program), CheckOptions(), robot_given=False)
+    report.print_rich(console, max_moves=7)
+    console.print()
 
 
 def run_story(console: Console) -> bool:

@@ -196,6 +196,9 @@ def cmd_lint(args: argparse.Namespace) -> int:
     found = []
     ran: set[str] = set()
     for name, root in pairs:
+        if name.lower().endswith(".urp"):
+            found.extend(_lint_urp(name, select, ignore, args))
+            continue
         source = read_input(name)
         label = args.stdin_filename if name == "-" and args.stdin_filename else source.name
         where = source.path if source.path is not None else args.stdin_filename
@@ -228,6 +231,37 @@ def cmd_lint(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(report.render_text(found, len(files)))
     return EXIT_PROBLEMS if any(d.severity == "error" for d in found) else EXIT_OK
+
+
+def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
+    """A PolyScope program: compiled, its script linted, each finding naming its node (see
+    :mod:`urdsl.polyscope.check`); a program that cannot be compiled is one URS001 error."""
+    from .._cli import UsageError
+    from ..polyscope.check import generate, node_findings, urcap_diagnostics
+    from ..polyscope.compile import CompileError
+    from ..polyscope.urp import UrpError
+    from ..script.diagnostics import Diagnostic
+    from .config import ConfigError, settings_for
+    from .linter import lint_text
+
+    if not os.path.isfile(name):
+        raise UsageError(f"cannot read {name}: No such file")
+    try:
+        settings = settings_for(name, select=select, ignore=ignore, robot=args.robot,
+                                version=args.target_version, use_config=not args.no_config)
+    except ConfigError as error:
+        raise UsageError(str(error)) from None
+    try:
+        generated = generate(name)
+    except (UrpError, CompileError) as error:
+        text = str(error)
+        message = text.split(": error: ", 1)[1] if ": error: " in text else text
+        return [Diagnostic(name, 1, 1, "error", "URS001", message)]
+    found = node_findings(generated, lint_text(generated.text, generated.filename, settings))
+    wanted = not select or any("URS214".startswith(code) for code in select)
+    if wanted and not any("URS214".startswith(code) for code in ignore):
+        found.extend(urcap_diagnostics(generated))
+    return sorted(found, key=lambda d: (d.line, d.column))
 
 
 def load_rules() -> dict:

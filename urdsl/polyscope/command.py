@@ -11,7 +11,7 @@ from .compile import Compiled, CompileError, compile_program, parse_variables
 from .installation import Installation, InstallationError, find_installation, read_installation
 from .urp import Node, Program, UrpError, read_urp
 
-__all__ = ["add_commands", "compile_urp", "load"]
+__all__ = ["add_commands", "compile_urp", "load", "load_all"]
 
 
 def _installation_for(program: Program, path: str | Path) -> Installation | None:
@@ -39,6 +39,12 @@ def load(path: str | Path) -> tuple[Program, Compiled]:
     """Read and compile the ``.urp`` at ``path`` with its installation and the
     installation's variables. Raises :class:`UrpError` or :class:`CompileError` (messages
     name the file and node)."""
+    program, _installation, compiled = load_all(path)
+    return program, compiled
+
+
+def load_all(path: str | Path) -> tuple[Program, Installation | None, Compiled]:
+    """:func:`load`, also giving the installation read (None when there is none)."""
     program = read_urp(path)
     installation = _installation_for(program, path)
     variables: list[tuple[str, str]] = []
@@ -48,7 +54,7 @@ def load(path: str | Path) -> tuple[Program, Compiled]:
             variables = parse_variables(file.read_bytes())
         except OSError:
             variables = []
-    return program, compile_program(program, installation, variables)
+    return program, installation, compile_program(program, installation, variables)
 
 
 def compile_urp(path: str, output: str | None) -> int:

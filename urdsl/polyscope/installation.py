@@ -31,6 +31,7 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 __all__ = ["Installation", "InstallationError", "Tcp", "Payload", "read_installation",
+           "Safety", "SafetyPlane", "parse_safety",
            "parse_installation", "find_installation", "GRAVITY"]
 
 GRAVITY = 9.82
@@ -69,6 +70,106 @@ class Payload:
 
 
 @dataclass(frozen=True)
+class SafetyPlane:
+    """A safety plane: the TCP (and the elbow, when ``elbow``) must stay where
+    ``normal·x + distance ≥ 0`` (x in the base frame, m). ``mode`` as written: ``NORMAL``,
+    ``REDUCED``, ``BOTH`` or ``TRIGGER`` (switches to reduced mode, restricts nothing).
+    The side is inferred [U]: with it, the robot's base is on the allowed side of every plane
+    of the real installations looked at."""
+
+    name: str
+    normal: tuple[float, float, float]
+    distance: float
+    mode: str
+    elbow: bool = False
+
+
+@dataclass(frozen=True)
+class Safety:
+    """Normal-mode safety limits: ``tcp_speed`` m/s, ``force`` N, ``power`` W,
+    ``momentum`` kg·m/s, ``joint_speed`` rad/s per joint, ``q_min``/``q_max`` rad per joint
+    (``None`` for a joint without position limits: PolyScope stores each limit as an angle
+    in [0, 2π) and a number of whole revolutions), and the enabled planes."""
+
+    tcp_speed: float | None = None
+    force: float | None = None
+    power: float | None = None
+    momentum: float | None = None
+    joint_speed: tuple[float, ...] | None = None
+    q_min: tuple[float | None, ...] | None = None
+    q_max: tuple[float | None, ...] | None = None
+    planes: tuple[SafetyPlane, ...] = ()
+
+
+def parse_safety(text: str) -> Safety | None:
+    """The ``<SafetySettings>`` text (INI sections such as ``[SafetyLimits Normal
+    Values]``) as :class:`Safety`; None when it holds no limits. Values that do not read
+    as numbers are left out."""
+    sections: dict[str, dict[str, str]] = {}
+    current: dict[str, str] | None = None
+    for raw in text.splitlines():
+        line = raw.strip()
+        if line.startswith("[") and line.endswith("]"):
+            current = sections.setdefault(line[1:-1].strip(), {})
+        elif current is not None and "=" in line:
+            key, value = line.split("=", 1)
+            current[key.strip()] = value.strip()
+    if not sections:
+        return None
+
+    def number(section: str, key: str) -> float | None:
+        try:
+            value = float(sections.get(section, {})[key])
+        except (KeyError, ValueError):
+            return None
+        return value if math.isfinite(value) else None
+
+    def vector(section: str, key: str) -> tuple[float, ...] | None:
+        text = sections.get(section, {}).get(key)
+        if text is None:
+            return None
+        try:
+            values = tuple(float(v) for v in text.strip("[]").split(","))
+        except ValueError:
+            return None
+        return values if all(math.isfinite(v) for v in values) else None
+
+    joints = "SafetyLimits Normal Joints"
+    q_min = q_max = None
+    low, high = vector(joints, "minJointPosition"), vector(joints, "maxJointPosition")
+    low_turns = vector(joints, "minJointRevolutions")
+    high_turns = vector(joints, "maxJointRevolutions")
+    limited = (sections.get("SafetySetup", {}).get("withPositionLimits", "").strip("[]")
+               .replace(" ", "").split(","))
+    if low and high and low_turns and high_turns and all(
+            len(v) == 6 for v in (low, high, low_turns, high_turns)):
+        def bound(angle: float, turns: float, joint: int) -> float | None:
+            if abs(turns) > 1000 or (len(limited) == 6 and limited[joint] == "false"):
+                return None
+            return turns * 2 * math.pi + angle
+
+        q_min = tuple(bound(low[j], low_turns[j], j) for j in range(6))
+        q_max = tuple(bound(high[j], high_turns[j], j) for j in range(6))
+    planes = []
+    for name, section in sections.items():
+        if not name.startswith("SafetyLimits BoundaryPlane"):
+            continue
+        mode = section.get("mode", "DISABLED")
+        normal = vector(name, "planeNormal")
+        distance = number(name, "distanceToOrigin")
+        if mode == "DISABLED" or normal is None or len(normal) != 3 or distance is None \
+                or math.hypot(*normal) < 1e-9:
+            continue
+        planes.append(SafetyPlane(section.get("name", name), normal, distance, mode,
+                                  section.get("elbowRestricted") == "true"))
+    speeds = vector(joints, "maxJointSpeed")
+    values = "SafetyLimits Normal Values"
+    return Safety(number(values, "maxTcpSpeed"), number(values, "maxForce"),
+                  number(values, "maxPower"), number(values, "maxMomentum"),
+                  speeds if speeds and len(speeds) == 6 else None, q_min, q_max, tuple(planes))
+
+
+@dataclass(frozen=True)
 class Installation:
     """What urdsl reads from an installation so far.
 
@@ -94,6 +195,9 @@ class Installation:
     io_names: tuple[tuple[str, str], ...] = ()
     """The I/O names the user gave: (name, pin) pairs, pin as PolyScope refers to it
     (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``)."""
+    safety: Safety | None = None
+    """The safety configuration's normal-mode limits and planes (3.x and 5.x), when the
+    file has them."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -209,7 +313,12 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
                         mounting, version, _settings(root), _features(root, path),
-                        _io_names(root))
+                        _io_names(root), _safety(root))
+
+
+def _safety(root: ElementTree.Element) -> Safety | None:
+    element = root.find("SafetySettings")
+    return parse_safety(element.text or "") if element is not None else None
 
 
 _IO_BANKS = {

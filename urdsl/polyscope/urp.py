@@ -111,6 +111,9 @@ class Node:
     element: ElementTree.Element | None = field(default=None, repr=False)
     parent: Node | None = field(default=None, repr=False)
     suppressed: bool = False
+    position: tuple[int, int] | None = None
+    """(line, column), 1-based, of the node's element in the program's XML (decompressed),
+    when known."""
 
     @property
     def path(self) -> str:
@@ -213,7 +216,31 @@ def parse_urp(data: bytes, path: str = "<urp>") -> Program:
     if root.tag != "URProgram":
         raise UrpError(f"{path}: error: not a PolyScope program (root element <{root.tag}>, "
                        "expected <URProgram>)")
-    return _Reader(root, path).program()
+    reader = _Reader(root, path)
+    reader.positions = _positions(xml, root)
+    return reader.program()
+
+
+def _positions(xml: bytes, root: ElementTree.Element) -> dict[ElementTree.Element, tuple[int, int]]:
+    """Element → (line, column) of its start tag, 1-based: expat reports the start tags in
+    document order, the order ``root.iter()`` walks the tree."""
+    from xml.parsers import expat
+
+    starts: list[tuple[int, int]] = []
+    parser = expat.ParserCreate()
+
+    def start(_name, _attrs) -> None:
+        starts.append((parser.CurrentLineNumber, parser.CurrentColumnNumber + 1))
+
+    parser.StartElementHandler = start
+    try:
+        parser.Parse(xml, True)
+    except expat.ExpatError:
+        return {}
+    elements = list(root.iter())
+    if len(elements) != len(starts):
+        return {}
+    return dict(zip(elements, starts, strict=True))
 
 
 _INDEX = re.compile(r"^(.+)\[(\d+)\]$")
@@ -226,6 +253,7 @@ class _Reader:
         self.parents: dict[ElementTree.Element, ElementTree.Element] = {
             child: parent for parent in root.iter() for child in parent}
         self.nodes: dict[ElementTree.Element, Node] = {}
+        self.positions: dict[ElementTree.Element, tuple[int, int]] = {}
 
     # -- references
     def resolve(self, element: ElementTree.Element) -> ElementTree.Element:
@@ -320,7 +348,7 @@ class _Reader:
         elif kind == "subprogram":
             kind = "SubProgram"
         node = Node(kind, dict(element.attrib), name=element.get("name"), element=element,
-                    parent=parent, suppressed=suppressed)
+                    parent=parent, suppressed=suppressed, position=self.positions.get(element))
         self.nodes[element] = node
         try:
             _FIELDS.get(kind, _no_fields)(self, node, element)

@@ -312,17 +312,26 @@ def cmd_send(args: argparse.Namespace) -> int:
     from .sender import default_checker, send_prepared
 
     robot = robot_model(args.robot)
-    try:
-        tree, filename = _load_program(args.program, robot)
-    except ScriptError as error:
-        print(error.diagnostic.render(), file=sys.stderr)
-        return 1
-    except (DslError, ProgramFileError) as error:
-        print(str(error), file=sys.stderr)
-        return 1
+    if args.program.lower().endswith(".urp"):
+        from ..polyscope.check import send_check
+
+        loaded = send_check(args.program, robot, args.check)
+        if loaded is None:
+            return 1
+        tree, filename, report = loaded
+        robot = report.robot if report is not None else robot
+    else:
+        try:
+            tree, filename = _load_program(args.program, robot)
+        except ScriptError as error:
+            print(error.diagnostic.render(), file=sys.stderr)
+            return 1
+        except (DslError, ProgramFileError) as error:
+            print(str(error), file=sys.stderr)
+            return 1
+        report = default_checker(tree, filename, robot) if args.check else None
     prepared = prepare_tree(tree, filename)
-    if args.check:
-        report = default_checker(tree, filename, robot)
+    if report is not None:
         if report.has_errors:
             sys.stderr.write(report.render_text(moves=False))
             print(str(CheckFailedError(report, filename)), file=sys.stderr)
@@ -526,7 +535,9 @@ def add_commands(commands) -> None:
                             "how it ends", description=_SEND_DESCRIPTION, epilog=_SEND_EPILOG,
                             formatter_class=_FORMATTER)
     p.add_argument("program", metavar="FILE|PROGRAM.py",
-                   help="a URScript file ('-' reads stdin) or a Python DSL program")
+                   help="a URScript file ('-' reads stdin), a Python DSL program or a "
+                   "PolyScope program (.urp, compiled and checked as urdsl compile and "
+                   "urdsl check do)")
     _host(p)
     p.add_argument("--port", type=int, default=30002, metavar="PORT",
                    help="where to send: 30001, 30002 (default) or 30003")

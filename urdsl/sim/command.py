@@ -70,7 +70,9 @@ def add_commands(commands) -> None:
     p.add_argument("--port-offset", type=int, default=0, metavar="N",
                    help="add N to every port (default: 0, the controller's own ports)")
     p.add_argument("--programs", default=None, metavar="DIR",
-                   help="folder the dashboard's 'load <file>' reads URScript programs from")
+                   help="folder the dashboard's 'load <file>' reads programs from: URScript "
+                   "files, and PolyScope programs (.urp, compiled with their installation "
+                   "as urdsl compile does)")
     p.add_argument("--powered-off", action="store_true",
                    help="start powered off, as a real controller boots: use the dashboard's "
                    "'power on' and 'brake release' before sending programs")

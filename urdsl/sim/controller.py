@@ -414,12 +414,19 @@ class VirtualController:
 
     def load_program(self, name: str) -> str:
         """Load a program file from ``programs_dir`` (dashboard ``load``); returns its
-        path relative to the folder. Raises FileNotFoundError or SimError (not URScript)."""
+        path relative to the folder. A PolyScope program (``.urp``) is compiled with its
+        installation (``urdsl compile``). Raises FileNotFoundError or SimError (not
+        URScript, or a ``.urp`` that cannot be compiled)."""
         from ..script.parser import parse
 
         path = self.program_path(name)
         if path is None:
             raise FileNotFoundError(name)
+        if path.suffix.lower() == ".urp":  # a PolyScope program: compiled as PolyScope does
+            text = _compiled_urp(path)
+            with self._lock:
+                self._loaded = (name.strip(), text)
+            return name.strip()
         try:
             raw = path.read_bytes()
         except OSError as error:
@@ -1070,3 +1077,19 @@ def _no_span():
     from ..script.nodes import NO_SPAN
 
     return NO_SPAN
+
+
+def _compiled_urp(path: Path) -> str:
+    """The URScript a PolyScope program compiles to; SimError naming the file and node when
+    it cannot be read or compiled."""
+    from ..polyscope.command import load
+    from ..polyscope.compile import CompileError
+    from ..polyscope.urp import UrpError
+
+    try:
+        _program, compiled = load(path)
+        return compiled.text
+    except (UrpError, CompileError) as error:
+        raise SimError(str(error)) from None
+    except RecursionError:
+        raise SimError(f"{path.name}: the program nests too deeply") from None

@@ -2,8 +2,9 @@
 
 One line in, one line out, with the replies of UR_FACTS.md §6. The virtual controller is
 always in remote control. ``load`` reads URScript files (``.script``, ``.urscript``,
-``.txt``) from the controller's programs folder; PolyScope ``.urp`` files cannot be run by
-urdsl and answer ``Error while loading program``.
+``.txt``) and PolyScope programs (``.urp``, compiled with their installation as ``urdsl
+compile`` does) from the controller's programs folder; a file that cannot be read or
+compiled answers ``Error while loading program``.
 """
 
 from __future__ import annotations
@@ -65,9 +66,6 @@ class DashboardSession:
     # ---- commands --------------------------------------------------------------------------
 
     def _load(self, name: str) -> str:
-        if name.lower().endswith(".urp"):  # PolyScope programs: urdsl cannot run them
-            return (f"File not found: {name}" if not self._exists(name)
-                    else f"Error while loading program: {name}")
         try:
             loaded = self.sim.load_program(name)
         except FileNotFoundError:
@@ -75,11 +73,6 @@ class DashboardSession:
         except SimError:
             return f"Error while loading program: {name}"
         return f"Loading program: {loaded}"
-
-    def _exists(self, name: str) -> bool:
-        # only files inside the programs folder count: a file elsewhere answers as a
-        # missing one, so the dashboard is no oracle for the controller's file system
-        return self.sim.program_path(name) is not None
 
     def _play(self) -> str:
         return "Starting program" if self.sim.play() else "Failed to execute: play"

@@ -454,7 +454,11 @@ controller stops the robot there.""",
     fixed=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], a=1.4, v=1.05)",
 )
 def _joint_speeds(ctx: TraceContext) -> list[Finding]:
-    return joint_speeds(ctx.trace, np.asarray(ctx.robot.qd_max), exclude=ctx.excluded)
+    qd_max = np.asarray(ctx.robot.qd_max, dtype=float)
+    limit = getattr(ctx.options, "joint_speed_limit", None)
+    if limit is not None:  # the installation's safety limits, lower than the arm's
+        qd_max = np.minimum(qd_max, np.asarray(limit, dtype=float))
+    return joint_speeds(ctx.trace, qd_max, exclude=ctx.excluded)
 
 
 @trace_check(

@@ -73,7 +73,8 @@ def add_commands(commands) -> None:
         description=_DESCRIPTION, epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("files", nargs="+", metavar="FILE",
-                   help="a URScript file (.script) or a DSL program (.py)")
+                   help="a URScript file (.script), a DSL program (.py) or a PolyScope "
+                   "program (.urp: compiled, checked on its arm with its installation)")
     p.add_argument("--robot", metavar="MODEL",
                    help="robot model: ur3, ur5, ur10, ur3e, ur5e, ur10e, ur16e, ur20, ur30, "
                    "ur7e, ur12e, ur15, ur18, ur8long (default: the model whose kinematics "
@@ -122,11 +123,14 @@ def add_commands(commands) -> None:
     p.add_argument("--no-project", action="store_true",
                    help="check the file alone, not in the context of its project (host "
                    "program, sibling script files, installation variables)")
+    p.add_argument("--nominal", action="store_true",
+                   help="a PolyScope program (.urp): check on the model's nominal kinematics, "
+                   "not the arm's calibration stored in the program")
     p.set_defaults(run=cmd_check)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input, robot_model
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, load_cell, read_input, robot_model
     from .run import DEFAULT_START, CheckOptions
 
     robot = robot_model(args.robot or "ur5e")
@@ -142,7 +146,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         timeout=args.timeout,
         self_collision=not args.no_self_collision)
     if args.cell:
-        options.cell = _load_cell(robot, args.cell)
+        options.cell = load_cell(robot, args.cell)
     from ..dsl.command import ProgramFileError
     from ..dsl.errors import DslError
 
@@ -154,6 +158,11 @@ def cmd_check(args: argparse.Namespace) -> int:
                 report = _check_program(name, options)
             except (DslError, ProgramFileError) as error:
                 print(str(error), file=sys.stderr)
+                failed = True
+                continue
+        elif name.lower().endswith(".urp"):
+            report = _check_urp(name, args, options)
+            if report is None:
                 failed = True
                 continue
         else:
@@ -181,7 +190,7 @@ def _check_script(source, args: argparse.Namespace, options):
     :mod:`urdsl.verify.infer`) where the command line leaves it open."""
     import os
 
-    from .._cli import UsageError
+    from .._cli import UsageError, load_cell
     from ..project import ProjectError
     from ..project.check import in_context
     from ..script.diagnostics import ScriptError
@@ -210,7 +219,7 @@ def _check_script(source, args: argparse.Namespace, options):
                       default_robot=options.robot)
     file_options = apply(options, inference, tcp_given=args.tcp is not None)
     if args.cell and file_options.robot != options.robot:
-        file_options.cell = _load_cell(file_options.robot, args.cell)
+        file_options.cell = load_cell(file_options.robot, args.cell)
     report = check_tree(module, source.name, file_options, started=started)
     report.inferred = inference
     qualify(report, inference)
@@ -219,18 +228,26 @@ def _check_script(source, args: argparse.Namespace, options):
     return report
 
 
-def _load_cell(robot: str, path: str):
-    """The collision model of ``robot`` with the cell's obstacles, or a usage error."""
-    from .._cli import UsageError
-    from ..kinematics import KinematicsError, Robot
-    from ..kinematics.collision import CollisionModel
+def _check_urp(name: str, args: argparse.Namespace, options):
+    """A PolyScope program: compiled, then checked (see :mod:`urdsl.polyscope.check`);
+    None (the message printed) when it cannot be compiled."""
+    from pathlib import Path
 
-    model = CollisionModel(Robot.model(robot))
+    from .._cli import UsageError
+    from ..polyscope.check import check_urp
+    from ..polyscope.compile import CompileError
+    from ..polyscope.urp import UrpError
+
+    if not Path(name).is_file():
+        raise UsageError(f"cannot read {name}: No such file")
     try:
-        model.load_cell(path)
-    except KinematicsError as error:
-        raise UsageError(f"bad cell description: {error}") from None
-    return model
+        report = check_urp(name, options, robot_given=bool(args.robot),
+                           start_joints=args.start_joints or args.start_joints_deg,
+                           tcp=args.tcp, nominal=args.nominal, cell_path=args.cell)
+    except (UrpError, CompileError) as error:
+        print(str(error), file=sys.stderr)
+        return None
+    return report
 
 
 def _check_program(name: str, options):

@@ -20,6 +20,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -28,6 +29,7 @@ from ..motion.direction import stoppable_moves
 from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
 from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
+from ..runtime.values import Unknown
 from ..script.diagnostics import ScriptSyntaxError
 from ..script.nodes import NO_SPAN
 from ..script.parser import parse
@@ -83,6 +85,15 @@ class CheckOptions:
     self_collision: bool = True
     timeout: float | None = DEFAULT_TIMEOUT
     environment: Environment | None = field(default=None, repr=False)
+    calibration: Any = None
+    """A :class:`urdsl.kinematics.Calibration` of the very arm (a PolyScope program's
+    ``<kinematics>``), or None for the model's nominal kinematics."""
+    joint_speed_limit: tuple[float, ...] | None = None
+    """Joint speed limits [rad/s] set for the cell (a PolyScope installation's), below the
+    model's."""
+    unknown_globals: dict[str, str] = field(default_factory=dict)
+    """Globals the program reads that something outside it defines (a URCap node's code):
+    name → where the value comes from; each holds an unknown value."""
 
 
 def check_text(text: str, filename: str = "<script>", *, robot: str = "ur5e",
@@ -113,10 +124,10 @@ def check_file(path: str | Path, options: CheckOptions | None = None) -> Report:
     return check_text(path.read_text(encoding="utf-8"), str(path), options=options)
 
 
-def _robot_model(name: str):
+def _robot_model(name: str, calibration=None):
     from ..kinematics import Robot
 
-    return Robot.model(name)
+    return Robot.model(name, calibration=calibration)
 
 
 def check_tree(module, filename: str, options: CheckOptions,
@@ -129,7 +140,7 @@ def check_tree(module, filename: str, options: CheckOptions,
 
 
 def _check_tree(module, filename: str, options: CheckOptions, started: float) -> Report:
-    robot = _robot_model(options.robot)
+    robot = _robot_model(options.robot, options.calibration)
     cb3 = getattr(robot.spec, "generation", "") == "cb3"
     step = 0.008 if cb3 else 0.002
     planner = MotionPlanner(robot, options.start_joints, step_time=step, lazy_ik=True)
@@ -142,6 +153,8 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     if environment is None:
         environment = Environment(devices="unknown")
     interpreter = Interpreter(module, robot=planner, environment=environment, config=config)
+    for name, source in options.unknown_globals.items():
+        interpreter.globals.setdefault(name, Unknown(source))
     result = interpreter.run()
 
     report = Report(filename, options.robot)

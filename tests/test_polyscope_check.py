@@ -1,0 +1,228 @@
+"""``urdsl check X.urp`` and ``urdsl lint X.urp``: the compiled program checked and linted,
+findings naming the program node (path and XML position), URCap nodes as devices, the arm's
+calibration from ``<kinematics>``, errors without tracebacks."""
+
+from __future__ import annotations
+
+import gzip
+import json
+import math
+import shutil
+from pathlib import Path
+
+import pytest
+
+from urdsl.cli import main
+from urdsl.polyscope.check import calibration_of, generate
+from urdsl.polyscope.urp import read_urp
+from urdsl.runtime.unknown import DEVICE_REPLY_TIME
+
+DATA = Path(__file__).parent / "data" / "polyscope"
+
+
+def _program(children: str, kinematics: str = "") -> str:
+    return (f'<URProgram name="t" installation="default" createdIn="5.11.1" '
+            f'lastSavedIn="5.11.1">{kinematics}<children><MainProgram runOnlyOnce="true">'
+            f'<children>{children}</children></MainProgram></children></URProgram>')
+
+
+def _chars(text: str) -> str:
+    return "".join(f'<ExpressionChar character="{c}"/>' for c in text)
+
+
+URCAP = ('<Contributed strategyClass="com.example.Grip" strategyProgramNodeType="Grip" '
+         'strategyURCapDeveloper="Example Inc." strategyURCapName="Example_Gripper"/>\n')
+
+
+@pytest.fixture
+def cell(tmp_path):
+    for name in ("cell.urp", "cell.installation"):
+        shutil.copy(DATA / name, tmp_path / name)
+    return tmp_path / "cell.urp"
+
+
+def test_nodes_know_their_place_in_the_xml():
+    program = read_urp(DATA / "cell.urp")
+    lines = (DATA / "cell.urp").read_text(encoding="utf-8").splitlines()
+    for node in program.main.walk():
+        line, column = node.position
+        assert lines[line - 1][column - 1:].startswith(f"<{node.element.tag}")
+
+
+def test_check_names_the_node_beside_the_generated_line(cell, capsys):
+    assert main(["check", str(cell), "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert report["file"] == f"{cell} (compiled)"
+    error = next(f for f in report["findings"] if f["severity"] == "error")
+    assert "node Robot Program > MoveL > Variable" in error["message"]
+    assert f"{cell}:53:13" in error["message"]  # the Waypoint element in the XML
+    generated = generate(cell)
+    assert generated.text.splitlines()[error["line"] - 1].strip().startswith("movel(count")
+    assert report["cycle_time"] > 0
+
+
+def test_urcap_nodes_are_an_info_finding_and_a_device(tmp_path, capsys):
+    program = tmp_path / "urcap.urp"
+    program.write_text(_program(URCAP + '<If type="If" checkContinuously="false"><expression>'
+                                + _chars("grip_ok") + '</expression><children><Wait '
+                                'type="Sleep"><waitTime>0.5</waitTime></Wait></children></If>'))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    codes = [f["code"] for f in report["findings"]]
+    assert "URS214" in codes and "URS311" not in codes  # PolyScope's step counter is fine
+    assert not any(c.startswith("URS2") and c not in ("URS210", "URS214") for c in codes)
+    urcap = next(f for f in report["findings"] if f["code"] == "URS214")
+    assert "only the URCap can generate" in urcap["message"]
+    assert "Robot Program > Grip" in urcap["message"]
+    depends = next(f for f in report["findings"] if f["code"] == "URS210")
+    assert "URCap" in depends["message"] and "Robot Program > If" in depends["message"]
+    # the URCap node answers as a device does, then the branch of a working one runs
+    assert report["cycle_time"] == pytest.approx(DEVICE_REPLY_TIME + 0.5, abs=0.01)
+
+
+def test_lint_names_the_node(cell, capsys):
+    main(["lint", str(cell), "--format", "json"])
+    found = json.loads(capsys.readouterr().out)
+    assert any(d["code"] == "URS214" and "BeforeStart > Grip" in d["message"] for d in found)
+    assert all(d["file"] == f"{cell} (compiled)" for d in found)
+    assert any("node Robot Program > MoveL" in d["message"] for d in found)
+
+
+@pytest.mark.parametrize("data", [b"garbage", gzip.compress(b"<URProgram><children>")[:-6],
+                                  b"<URProgram name='x'><children></children></URProgram>"])
+def test_a_broken_program_is_one_message(tmp_path, capsys, data):
+    program = tmp_path / "broken.urp"
+    program.write_bytes(data)
+    assert main(["check", str(program)]) == 1
+    err = capsys.readouterr().err
+    assert str(program) in err and "Traceback" not in err
+    assert main(["lint", str(program)]) == 1
+    assert str(program) in capsys.readouterr().out
+
+
+def test_calibration_from_kinematics_of_the_matching_model():
+    program = read_urp(DATA / "cell.urp")
+    calibration, model = calibration_of(program)
+    assert model == "ur5e" and calibration.is_zero
+    assert calibration_of(program, "ur10e") == (None, None)
+
+
+def test_the_arm_calibration_moves_the_check(tmp_path, capsys):
+    kinematics = ('<kinematics><deltaTheta value="0, 0, 0, 0, 0, 0"/>'
+                  '<a value="0.0, -0.4265, -0.3922, 0.0, 0.0, 0.0"/>'
+                  '<d value="0.1625, 0.0, 0.0, 0.1333, 0.0997, 0.0996"/>'
+                  '<alpha value="1.5707963267948966, 0, 0, 1.5707963267948966, '
+                  '-1.5707963267948966, 0"/></kinematics>')
+    program = tmp_path / "arm.urp"
+    program.write_text(_program('<Wait type="Sleep"><waitTime>0.1</waitTime></Wait>',
+                                kinematics))
+    calibration, model = calibration_of(read_urp(program))
+    assert model == "ur5e" and calibration.delta_a[1] == pytest.approx(-0.0015)
+    main(["check", str(program), "--json"])
+    assert "very arm" in json.loads(capsys.readouterr().out)["context"]
+    main(["check", str(program), "--json", "--nominal"])
+    assert "--nominal" in json.loads(capsys.readouterr().out)["context"]
+
+
+def _safety(tcp_speed: float = 1.5, shoulder_max: float = 0.0524, plane: str = "") -> str:
+    """A ``<SafetySettings>`` block as PolyScope writes it (INI text)."""
+    return f"""<SafetySettings>
+[SafetyLimits BoundaryPlane0]
+name = Ceiling
+displacement = 0.0
+mode = {'BOTH' if plane else 'DISABLED'}
+planeNormal = {plane or '[0.0, 0.0, 0.0]'}
+distanceToOrigin = 0.3
+elbowRestricted = true
+
+[SafetyLimits BoundaryPlane1]
+name = Wall
+mode = TRIGGER
+planeNormal = [1.0, 0.0, 0.0]
+distanceToOrigin = 0.1
+
+[SafetySetup]
+withPositionLimits = [true, true, true, true, true, false]
+
+[SafetyLimits Normal Values]
+maxTcpSpeed = {tcp_speed}
+maxForce = 150.0
+
+[SafetyLimits Normal Joints]
+maxJointSpeed = [3.14, 3.14, 3.14, 6.28, 6.28, 6.28]
+minJointPosition = [6.2308, 6.2308, 6.2308, 6.2308, 6.2308, 0.0]
+maxJointPosition = [0.0524, {shoulder_max}, 0.0524, 0.0524, 0.0524, 0.0]
+minJointRevolutions = [-2, -2, -2, -2, -2, -2147483648]
+maxJointRevolutions = [1, {1 if shoulder_max == 0.0524 else -1}, 1, 1, 1, 2147483647]
+</SafetySettings>"""
+
+
+def _with_safety(cell: Path, block: str) -> None:
+    installation = cell.with_suffix(".installation")
+    text = installation.read_text(encoding="utf-8")
+    installation.write_text(text.replace("</Installation>", block + "\n</Installation>"),
+                            encoding="utf-8")
+
+
+def test_safety_limits_are_read_from_the_installation():
+    from urdsl.polyscope.installation import parse_safety
+
+    safety = parse_safety(_safety(0.25).split(">", 1)[1].rsplit("<", 1)[0])
+    assert safety.tcp_speed == 0.25 and safety.force == 150.0
+    assert safety.q_max[0] == pytest.approx(2 * math.pi + 0.0524)  # angle + whole turns
+    assert safety.q_min[0] == pytest.approx(-4 * math.pi + 6.2308)
+    assert safety.q_min[5] is None and safety.q_max[5] is None  # not limited
+    assert safety.joint_speed[3] == 6.28
+    assert [p.name for p in safety.planes] == ["Wall"] and safety.planes[0].mode == "TRIGGER"
+
+
+def test_installation_tcp_speed_limit_reaches_the_check(cell, capsys):
+    _with_safety(cell, _safety(tcp_speed=0.05))
+    main(["check", str(cell), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert "TCP speed limit 0.05 m/s" in report["context"]
+    speed = [f for f in report["findings"] if f["code"] == "URS306"]
+    assert speed and "node Robot Program > MoveJ > Waypoint_" in speed[0]["message"]
+    main(["check", str(cell), "--json", "--tcp-speed-limit", "50"])  # the flag wins
+    assert "URS306" not in [f["code"] for f in json.loads(capsys.readouterr().out)["findings"]]
+
+
+def test_installation_joint_limits_reach_the_check(cell, capsys):
+    _with_safety(cell, _safety(shoulder_max=6.1))  # shoulder at most −2π + 6.1 = −0.18 rad
+    main(["check", str(cell), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert "joint position limits" in report["context"]
+    assert any(f["code"] == "URS303" and "shoulder" in f["message"]
+               for f in report["findings"])
+
+
+def test_installation_safety_planes_are_cell_planes(cell, capsys):
+    _with_safety(cell, _safety(plane="[0.0, 0.0, -1.0]"))  # stay below z = 0.3 m
+    main(["check", str(cell), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert "1 safety plane(s) as cell planes (Ceiling)" in report["context"]  # not the trigger
+    assert any(f["code"] == "URS308" and "Ceiling" in f["message"]
+               for f in report["findings"])
+
+
+def test_the_demo_program_is_checked_by_node(capsys):
+    program = Path(__file__).parents[1] / "programs" / "polyscope" / "pick.urp"
+    assert main(["check", str(program), "--json"]) == 1  # the installation's speed limit
+    report = json.loads(capsys.readouterr().out)
+    speed = [f["message"] for f in report["findings"] if f["code"] == "URS306"]
+    assert any("node Robot Program > Loop > MoveL > LiftPick" in m for m in speed)
+    assert "TCP speed limit 0.25 m/s" in report["context"]
+    assert len(report["moves"]) == 13 and report["cycle_time"] > 10
+
+
+def test_a_missing_installation_is_named(tmp_path, capsys):
+    program = tmp_path / "alone.urp"
+    program.write_text(_program('<Wait type="Sleep"><waitTime>0.1</waitTime></Wait>'))
+    assert main(["check", str(program), "--json"]) == 0
+    assert "no installation default.installation beside the program" in json.loads(
+        capsys.readouterr().out)["context"]
+    program.write_text(_program('<Set type="DigitalOutput"><pin referencedName="gripper"/>'
+                                '<digitalValue>1</digitalValue></Set>'))
+    assert main(["check", str(program)]) == 1
+    err = capsys.readouterr().err
+    assert f"{program}: error: node Robot Program > Set" in err and "Traceback" not in err

@@ -1,0 +1,418 @@
+"""``urdsl check X.urp`` and ``urdsl lint X.urp``: a PolyScope program compiled, then checked
+and linted as the script it generates, each finding naming the program node it comes from.
+
+The findings are placed on the generated script (the file name ``X.urp (compiled)``, the line
+of the script ``urdsl compile X.urp`` writes, shown with that line); the message names the
+node path as PolyScope shows it (``Robot Program > Loop > MoveL > Waypoint_3``) and the
+node's position in the program's XML (``X.urp:45:9``, line and column of the node's element
+in the decompressed XML). A script line belongs to the node of the nearest ``$ N`` marker
+above it; the waypoint globals (``Waypoint_1_p``/``_q``) to their waypoint; the preamble to
+the installation.
+
+URCap nodes generate code only their URCap can write: each gets an info finding (URS214) and
+the check runs the program without it. Names the program reads but defines nowhere while it
+has URCap nodes (a URCap's result variables) are given unknown values, as a device's reply
+(see :mod:`urdsl.runtime.unknown`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..script import nodes as n
+from ..script.diagnostics import Diagnostic
+from .compile import Compiled
+from .installation import Installation
+from .urp import Node, Program
+
+__all__ = ["Generated", "generate", "URCAP_CODE", "node_findings"]
+
+URCAP_CODE = "URS214"
+"""The code of the info finding on a URCap node (its code only the URCap can generate)."""
+
+_MARKER = re.compile(r"\s*\$ (\d+) ")
+_WAYPOINT_GLOBAL = re.compile(r"\s*global (\w+?)_(?:from_|to_)?[pq]\s*=")
+
+
+@dataclass
+class Generated:
+    """A compiled program ready to check: the ``.urp`` path, the program, the compilation,
+    the script text, the name findings are placed under, and the node of each script line
+    (index 0 is line 1; ``None``: the installation preamble)."""
+
+    path: str
+    program: Program
+    compiled: Compiled
+    text: str
+    filename: str
+    owners: list[Node | None]
+    installation: Installation | None = None
+
+    def node_at(self, line: int) -> Node | None:
+        """The node that generated script line ``line`` (1-based)."""
+        return self.owners[line - 1] if 1 <= line <= len(self.owners) else None
+
+    def where(self, node: Node | None) -> str:
+        """``node Robot Program > MoveL > Waypoint_1 (pick.urp:31:13)`` or the preamble."""
+        if node is None:
+            return "the installation's preamble"
+        place = f" ({self.path}:{node.position[0]}:{node.position[1]})" if node.position \
+            else ""
+        return f"node {node.path}{place}"
+
+    def urcap_nodes(self) -> list[tuple[int, Node]]:
+        """(marker number, node) of every URCap node, in program order."""
+        return sorted((number, node) for number, node in self.compiled.numbers.items()
+                      if node.kind == "Contributed")
+
+
+def generate(path: str | Path) -> Generated:
+    """Read, compile and map the ``.urp`` at ``path``: a script line belongs to the node of
+    the nearest marker above it whose block it is in (raises
+    :class:`~urdsl.polyscope.urp.UrpError` or :class:`~urdsl.polyscope.compile.CompileError`,
+    messages naming the file and node)."""
+    from .command import load_all
+
+    program, installation, compiled = load_all(path)
+    text = compiled.text
+    waypoints = {node.name: node for root in program.top for node in root.walk()
+                 if node.kind == "Waypoint" and node.name}
+    owners: list[Node | None] = []
+    open_nodes: list[tuple[int, Node]] = []  # (indentation of the marker, node), innermost last
+    for line in text.splitlines():
+        indent = len(line) - len(line.lstrip())
+        marker = _MARKER.match(line)
+        node = compiled.numbers.get(int(marker.group(1))) if marker else None
+        if node is not None:
+            while open_nodes and open_nodes[-1][0] >= indent:
+                open_nodes.pop()
+            open_nodes.append((indent, node))
+        elif line.strip():
+            while open_nodes and open_nodes[-1][0] > indent:
+                open_nodes.pop()  # the block of the node ended
+        named = _WAYPOINT_GLOBAL.match(line)
+        if named and named.group(1) in waypoints:
+            owners.append(waypoints[named.group(1)])
+        else:
+            owners.append(open_nodes[-1][1] if open_nodes else None)
+    lines = text.splitlines()
+    for index in range(len(lines) - 1):  # the loop around the Robot Program is the program's
+        marker = _MARKER.match(lines[index + 1])
+        if owners[index] is None and marker and lines[index].strip().startswith("while"):
+            node = compiled.numbers.get(int(marker.group(1)))
+            if node is not None and node.kind == "MainProgram":
+                owners[index] = node
+    return Generated(str(path), program, compiled, text, f"{path} (compiled)", owners,
+                     installation)
+
+
+def _located(generated: Generated, line: int, message: str) -> str:
+    return f"{message} [{generated.where(generated.node_at(line))}]"
+
+
+def node_findings(generated: Generated, findings: list) -> list:
+    """``findings`` (verifier :class:`~urdsl.verify.findings.Finding` or lint
+    :class:`Diagnostic`) with the node each comes from named in its message."""
+    out = []
+    for finding in findings:
+        line = finding.span.line if hasattr(finding, "span") else finding.line
+        if line <= 0:
+            out.append(finding)
+            continue
+        out.append(dataclasses.replace(finding,
+                                       message=_located(generated, line, finding.message)))
+    return out
+
+
+def urcap_diagnostics(generated: Generated) -> list[Diagnostic]:
+    """An info finding per URCap node: only the URCap can generate its code."""
+    lines = generated.text.splitlines()
+    out = []
+    for number, node in generated.urcap_nodes():
+        line = next((i for i, text in enumerate(lines, 1)
+                     if _MARKER.match(text) and _MARKER.match(text).group(1) == str(number)),
+                    1)  # a URCap node without a marker of its own: on the program's line
+        urcap = node.attrs.get("strategyURCapName", "?")
+        message = (f"URCap node {node.title} of {urcap}: only the URCap can generate its "
+                   "code; urdsl checks the program without it and treats what it does as a "
+                   "device (its results are unknown)")
+        out.append(Diagnostic(generated.filename, line, 1, "info", URCAP_CODE,
+                              f"{message} [{generated.where(node)}]",
+                              source_line=lines[line - 1] if lines else None))
+    return out
+
+
+def undefined_globals(module: n.Module) -> list[str]:
+    """Variables the compiled program reads but defines nowhere (what a URCap's code would
+    have defined)."""
+    from ..project.check import needed_names
+
+    reads, _calls, _threads = needed_names(module)
+    return sorted(reads)
+
+
+def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
+    """When the program has URCap nodes: the variables it reads but defines nowhere (what a
+    URCap's code defines), each with where its unknown value comes from."""
+    urcaps = generated.urcap_nodes()
+    if not urcaps:
+        return {}
+    names = ", ".join(dict.fromkeys(node.title for _number, node in urcaps))
+    return {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
+
+
+def with_urcap_time(module: n.Module, numbers: set[int]) -> n.Module:
+    """``module`` with each URCap node (marker number in ``numbers``) taking a device's
+    reply time (:data:`urdsl.runtime.unknown.DEVICE_REPLY_TIME`, as ``sleep``, placed on the
+    node's marker): what the URCap's code does takes robot time, never none, so a loop of
+    URCap nodes is not taken for a busy loop."""
+    from ..runtime.unknown import DEVICE_REPLY_TIME
+
+    def block(items: tuple) -> tuple:
+        out = []
+        for item in items:
+            out.append(visit(item))
+            if isinstance(item, n.Marker) and item.number in numbers:
+                out.append(n.ExprStmt(n.Call(n.Name("sleep", span=item.span),
+                                             (n.Number(DEVICE_REPLY_TIME, span=item.span),),
+                                             span=item.span), span=item.span))
+        return tuple(out)
+
+    def visit(node):
+        if not dataclasses.is_dataclass(node) or isinstance(node, n.Expr):
+            return node
+        changes = {}
+        for f in dataclasses.fields(node):
+            value = getattr(node, f.name)
+            if isinstance(value, tuple) and value and all(
+                    isinstance(v, (n.Stmt, n.Comment, n.Blank, n.Marker, n.Elif))
+                    for v in value):
+                changes[f.name] = tuple(visit(v) for v in value) if all(
+                    isinstance(v, n.Elif) for v in value) else block(value)
+        return dataclasses.replace(node, **changes) if changes else node
+
+    return visit(module) if numbers else module
+
+
+def calibration_of(program: Program, robot: str | None = None):
+    """The program's ``<kinematics>`` as a :class:`~urdsl.kinematics.Calibration` of the
+    model whose arm it describes (``robot`` when given), with that model's name;
+    ``(None, None)`` when the program has none or it matches no model (``robot``).
+
+    Factory calibrations are "linearized": the lengths along parallel axes trade off (a
+    UR3e's stores d = 1.79, 30.86, −32.52 m where the nominal table has 0, 0, 0.131 m), so
+    the table is compared by what it does: a model matches when the flange positions of the
+    calibrated and nominal tables differ by at most :data:`_FK_MATCH` m at every one of a
+    fixed set of joint positions (two models differ by centimetres to decimetres)."""
+    import numpy as np
+
+    from ..kinematics import MODELS, Calibration, KinematicsError, Robot
+    from ..kinematics.models import model_spec
+
+    block = program.kinematics
+    if block is None or any(len(v) != 6 for v in (block.a, block.d, block.alpha,
+                                                   block.delta_theta)):
+        return None, None
+    samples = np.random.default_rng(13).uniform(-np.pi, np.pi, (24, 6))
+    best = None
+    for name in [robot] if robot else list(MODELS):
+        spec = model_spec(name)
+        calibration = Calibration(np.asarray(block.delta_theta),
+                                  np.asarray(block.a) - spec.dh_a,
+                                  np.asarray(block.d) - spec.dh_d,
+                                  np.asarray(block.alpha) - spec.dh_alpha, model=spec.name)
+        try:
+            nominal = Robot.model(spec.name).fk_many(samples)
+            calibrated = Robot.model(spec.name, calibration=calibration).fk_many(samples)
+        except (KinematicsError, ValueError, FloatingPointError):
+            continue
+        error = float(np.max(np.linalg.norm(nominal[:, :3, 3] - calibrated[:, :3, 3],
+                                            axis=1)))
+        if error <= _FK_MATCH and (best is None or error < best[0]):
+            best = (error, spec.name, calibration)
+    if best is None:
+        return None, None
+    return best[2], best[1]
+
+
+_FK_MATCH = 0.01
+"""Largest flange position difference [m] between a program's calibrated kinematics and a
+model's nominal ones for the calibration to be that model's (factory corrections move the
+flange by a few millimetres at most)."""
+
+
+def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=None,
+              nominal: bool = False, cell_path: str | None = None):
+    """``urdsl check X.urp``: compile the program and check the script it generates on the
+    very arm (the program's ``<kinematics>`` as the calibration unless ``nominal``), with the
+    installation's settings as defaults (see :func:`installation_defaults`) where ``options``
+    leave them open. Raises UrpError/CompileError for a program that cannot be compiled."""
+    from ..script.diagnostics import ScriptError
+    from ..script.parser import parse
+    from ..verify.findings import Finding
+    from ..verify.infer import apply, infer
+    from ..verify.run import check_text, check_tree
+
+    generated = generate(path)
+    try:
+        module = parse(generated.text, generated.filename)
+    except ScriptError:
+        return check_text(generated.text, generated.filename, options=options)
+    notes = [f"compiled from {path} (PolyScope {generated.program.saved_in or '?'})"]
+    if generated.installation is None:
+        named = generated.program.installation
+        notes.append(f"no installation {named + '.installation ' if named else ''}beside the "
+                     "program: compiled and checked without its preamble and limits")
+    calibration, calibrated_model = (None, None)
+    if generated.program.kinematics is not None:
+        if nominal:
+            notes.append("nominal kinematics (--nominal): the program's <kinematics> ignored")
+        else:
+            calibration, calibrated_model = calibration_of(
+                generated.program, options.robot if robot_given else None)
+            if calibration is None:
+                notes.append("the program's <kinematics> matches no "
+                             + (f"{options.robot}" if robot_given else "UR model")
+                             + "; nominal kinematics used")
+    inference = infer(module, path, robot=options.robot if robot_given else calibrated_model,
+                      start_joints=start_joints, tcp=tcp, default_robot=options.robot)
+    if calibrated_model is not None and not robot_given:
+        model = calibrated_model
+        inference.robot_source = "program"  # the arm the program's <kinematics> describe
+        inference.robot_line = lambda: (  # type: ignore[method-assign]
+            f"robot {model} from the program's <kinematics> (the arm's calibration)")
+    file_options = apply(options, inference, tcp_given=tcp is not None)
+    if cell_path and file_options.robot != options.robot:
+        from .._cli import load_cell
+
+        file_options.cell = load_cell(file_options.robot, cell_path)
+    if calibration is not None and calibration.model == file_options.robot:
+        file_options.calibration = calibration
+        notes.append(f"on this very arm: the {calibration.model} calibration of the program's "
+                     "<kinematics>")
+    if generated.installation is not None and generated.installation.safety is not None:
+        notes.extend(installation_defaults(file_options, generated.installation,
+                                           cell_given=bool(cell_path)))
+    file_options.unknown_globals = urcap_values(generated, module)
+    if file_options.unknown_globals:
+        notes.append("unknown values from URCap nodes: "
+                     + ", ".join(sorted(file_options.unknown_globals)))
+    urcaps = {number for number, _node in generated.urcap_nodes()}
+    report = check_tree(with_urcap_time(module, urcaps), generated.filename, file_options)
+    report.inferred = inference
+    report.findings = node_findings(generated, [
+        f for f in report.findings if not _polyscope_threads_only(f)])
+    source = module.span.source
+    for diagnostic in urcap_diagnostics(generated):
+        span = n.Span(source, _offset(generated.text, diagnostic.line), _offset(
+            generated.text, diagnostic.line) + len(diagnostic.source_line or "")) \
+            if diagnostic.line else n.NO_SPAN
+        report.findings.append(Finding(URCAP_CODE, "info", diagnostic.message, span))
+    report.findings.sort(key=lambda f: (f.span.line, f.span.column, f.time or 0.0, f.code))
+    report.context = "; ".join(notes)
+    report.generated = generated  # type: ignore[attr-defined]
+    return report
+
+
+def installation_defaults(options, installation: Installation, cell_given: bool) -> list[str]:
+    """Set the installation's normal-mode safety limits on ``options`` (a
+    :class:`~urdsl.verify.run.CheckOptions` for its robot) where the command line left them
+    open: joint position limits (a joint the installation does not limit keeps the model's),
+    joint speed limits, the TCP speed limit, and the safety planes that restrict normal mode
+    (``NORMAL``, ``BOTH``) as planes of the cell (unless ``--cell`` was given). Returns what
+    was taken, for the report."""
+    import numpy as np
+
+    from ..kinematics import Robot
+    from ..kinematics.collision import CollisionModel
+
+    safety = installation.safety
+    if safety is None:
+        return []
+    robot = Robot.model(options.robot, calibration=options.calibration)
+    taken: list[str] = []
+    if options.q_min is None and options.q_max is None and safety.q_min and safety.q_max:
+        low = tuple(float(robot.q_min[j]) if v is None else max(v, float(robot.q_min[j]))
+                    for j, v in enumerate(safety.q_min))
+        high = tuple(float(robot.q_max[j]) if v is None else min(v, float(robot.q_max[j]))
+                     for j, v in enumerate(safety.q_max))
+        if low != tuple(float(v) for v in robot.q_min) or \
+                high != tuple(float(v) for v in robot.q_max):
+            options.q_min, options.q_max = low, high
+            taken.append("joint position limits")
+    if safety.joint_speed and bool(np.any(np.asarray(safety.joint_speed) < robot.qd_max)):
+        options.joint_speed_limit = tuple(safety.joint_speed)
+        taken.append("joint speed limits")
+    if options.tcp_speed_limit is None and safety.tcp_speed is not None:
+        options.tcp_speed_limit = safety.tcp_speed
+        taken.append(f"TCP speed limit {safety.tcp_speed:g} m/s")
+    planes = [p for p in safety.planes if p.mode in ("NORMAL", "BOTH")]
+    if planes and not cell_given:
+        cell = options.cell if isinstance(options.cell, CollisionModel) else \
+            CollisionModel(robot)
+        for plane in planes:
+            cell.add_plane(plane.normal, -plane.distance, plane.name)
+        options.cell = cell
+        taken.append(f"{len(planes)} safety plane(s) as cell planes ("
+                     + ", ".join(p.name for p in planes) + ")")
+    if not taken:
+        return []
+    return [f"from {Path(installation.path).name}: " + ", ".join(taken)]
+
+
+_THREADS_LEFT = re.compile(r"thread\(s\) (.+?) still ran")
+
+
+def _polyscope_threads_only(finding) -> bool:
+    """A URS311 finding about PolyScope's own step-counter thread only (the controller stops
+    it at the program's end, as it is meant to)."""
+    if finding.code != "URS311":
+        return False
+    names = _THREADS_LEFT.search(finding.message)
+    return names is not None and all(name.startswith("Step_Counter_Thread_")
+                                     for name in names.group(1).split(", "))
+
+
+def _offset(text: str, line: int) -> int:
+    """Character offset of the start of 1-based ``line`` in ``text``."""
+    offset = 0
+    for _ in range(line - 1):
+        offset = text.index("\n", offset) + 1
+    return offset
+
+
+def send_check(path: str, robot: str, check: bool):
+    """``urdsl send X.urp``: ``(tree, filename, report)`` of the compiled program, the report
+    of :func:`check_urp` (None when ``check`` is false); None when the program cannot be
+    compiled (the message printed). ``robot`` is the command line's model; the default
+    (ur5e) gives way to the arm the program's ``<kinematics>`` describe."""
+    import sys
+    from pathlib import Path
+
+    from .._cli import UsageError
+    from ..script.diagnostics import ScriptError
+    from ..script.parser import parse
+    from ..verify.run import CheckOptions
+    from .compile import CompileError
+    from .urp import UrpError
+
+    if not Path(path).is_file():
+        raise UsageError(f"cannot read {path}: No such file")
+    try:
+        generated = generate(path)
+        tree = parse(generated.text, generated.filename)
+    except (UrpError, CompileError) as error:
+        print(str(error), file=sys.stderr)
+        return None
+    except ScriptError as error:
+        print(error.diagnostic.render(), file=sys.stderr)
+        return None
+    report = None
+    if check:
+        report = check_urp(path, CheckOptions(robot=robot), robot_given=robot != "ur5e")
+        if report.context:
+            print(report.context, file=sys.stderr)
+    return tree, generated.filename, report
