@@ -258,3 +258,14 @@ def test_a_force_sensor_loop_ends_where_contact_would_end_it():
     assert [f.span.line for f in report.findings if f.code == "URS210"] == [2]
     assert "force() at line 2" in report.findings[0].message
     assert len([m for m in report.moves if m.kind == "movel"]) == UNKNOWN_LOOP_PASSES
+
+
+def test_one_device_read_gets_one_reply_across_comparisons():
+    # PolyScope writes a switch on a PLC's job number as separate ifs: a working PLC sends
+    # one job, so only the branches of one number are followed
+    result = run('if (modbus_get_signal_status("JOB") == 2):\n  a = 1\nend\n'
+                 'if (modbus_get_signal_status("JOB") == 7):\n  b = 1\nend\n'
+                 'if modbus_get_signal_status("JOB") != 2:\n  c = 1\nend\n'
+                 'if (modbus_get_signal_status("SPEED") == 7):\n  d = 1\nend\n')
+    assert result.error is None
+    assert {k for k in "abcd" if k in result.globals} == {"a", "d"}

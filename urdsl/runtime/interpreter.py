@@ -208,6 +208,8 @@ class Interpreter:
         self.calls = 0  # user function calls so far
         self.loop_node: n.Node | None = None  # the loop last entered (for "how far")
         self.unknown = getattr(self.env, "devices", "quiet") == "unknown"
+        # replies taken for device reads compared with constants (see _device_reply)
+        self.device_replies: dict[str, object] = {}
         self.warnings: list[Event] = []
         self._dead = 0
         self.events_dropped = 0
@@ -745,7 +747,8 @@ class _Compiler:
                            else "it takes this branch once the move it stops has come as "
                            "far as it can" if stopping and value.lean is not False
                            else "it takes this branch" if take
-                           else "it skips this branch (the reply is as expected)"),
+                           else "it skips this branch (a working device's reply does not "
+                           "lead here)"),
                         test_node)
                     if not take:
                         continue
@@ -1038,12 +1041,18 @@ class _Compiler:
         operation = binary(op)
         if op in ("==", "!="):
             lean = op == "=="  # a working device answers what the program expects
+            reply = _device_reply(node)  # (the read as text, the constant compared with)
 
             def compare(frame):
                 a = left(frame)
                 b = right(frame)
                 found = has_unknown(a) or has_unknown(b)
                 if found is not None:
+                    if reply is not None:
+                        # one device, one reply: the first constant a read is compared with
+                        # is the reply taken; `JOB == 2` then `JOB == 7` is not both true
+                        taken = rt.device_replies.setdefault(reply[0], reply[1])
+                        return found.leaning((taken == reply[1]) is lean)
                     return found.leaning(lean)
                 return operation(a, b)
             return compare
@@ -1247,3 +1256,24 @@ def _name_hint(name: str, frame: Frame, rt: Interpreter) -> str | None:
     if frame.top:
         return None
     return "inside a function or thread, assign it first or declare it global at the top"
+
+
+def _device_reply(node: n.BinOp) -> tuple[str, object] | None:
+    """For ``read(...) == constant`` (either side), where the read is a device read with
+    constant arguments (``modbus_get_signal_status("JOB") == 2``): the read as text and the
+    constant; else None."""
+    from ..script.printer import format_expr
+    from .unknown import DEVICE_READS
+
+    literals = (n.Number, n.String, n.Bool)
+    for call, other in ((node.left, node.right), (node.right, node.left)):
+        while isinstance(call, n.Paren):
+            call = call.expr
+        while isinstance(other, n.Paren):
+            other = other.expr
+        if (isinstance(call, n.Call) and isinstance(call.func, n.Name)
+                and call.func.id in DEVICE_READS and isinstance(other, literals)
+                and all(isinstance(arg, literals) for arg in call.args)
+                and not call.keywords):
+            return format_expr(call), other.value
+    return None
