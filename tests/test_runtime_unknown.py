@@ -269,3 +269,20 @@ def test_one_device_read_gets_one_reply_across_comparisons():
                  'if (modbus_get_signal_status("SPEED") == 7):\n  d = 1\nend\n')
     assert result.error is None
     assert {k for k in "abcd" if k in result.globals} == {"a", "d"}
+
+
+def test_a_name_left_unassigned_by_a_branch_the_check_skipped_is_a_warning():
+    from urdsl.verify.run import check_text
+
+    text = ('answer = request_integer_from_primary_client("1, 2 or 5 to stop")\n'
+            "if answer == 5:\n  answer = 0\nend\n"
+            "if answer == 1:\n  kind = 10\nelif answer == 2:\n  kind = 20\nend\n"
+            "textmsg(kind)\n")
+    report = check_text(text, "ask.script")
+    (finding,) = [f for f in report.findings if f.code == "URS201"]
+    assert finding.severity == "warning" and finding.span.line == 10
+    assert "depends on the replies the check assumed (the first at line 2)" in finding.message
+    # a name the program never assigns stays an error
+    report = check_text(text.replace("textmsg(kind)", "textmsg(knid)"), "ask.script")
+    (finding,) = [f for f in report.findings if f.code == "URS201"]
+    assert finding.severity == "error"
