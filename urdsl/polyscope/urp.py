@@ -447,38 +447,8 @@ def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None
         node.fields["params"] = {key: float(value) for key, value in params.attrib.items()
                                  if re.fullmatch(r"-?[0-9.Ee+-]+", value)}
         node.fields["params_attrs"] = dict(params.attrib)
-    position = element.find("position")
-    if position is not None:
-        position = reader.resolve(position)
-        if position.get("joints"):  # PolyScope 3: joints and the TCP pose as attributes
-            node.fields["q"] = _floats(position.get("joints"))
-        if position.get("pose"):
-            node.fields["pose"] = _floats(position.get("pose"))
-        angles = position.find("JointAngles")
-        if angles is not None:
-            node.fields["q"] = _floats(reader.resolve(angles).get("angles"))
-        offset = position.find("TCPOffset")
-        if offset is not None:
-            node.fields["tcp_offset"] = _floats(reader.resolve(offset).get("pose"))
-        kin = position.find("Kinematics")
-        if kin is not None:
-            node.fields["kinematics"] = _kinematics(reader.resolve(kin))
-    relative = element.find("relativeFromPosition")
-    if relative is not None:
-        relative = reader.resolve(relative)
-        if relative.get("joints"):
-            node.fields["from_q"] = _floats(relative.get("joints"))
-        if relative.get("pose"):
-            node.fields["from_pose"] = _floats(relative.get("pose"))
-        angles = relative.find("JointAngles")
-        if angles is not None:
-            node.fields["from_q"] = _floats(reader.resolve(angles).get("angles"))
-        offset = relative.find("TCPOffset")
-        if offset is not None:
-            node.fields["from_tcp_offset"] = _floats(reader.resolve(offset).get("pose"))
-        kin = relative.find("Kinematics")
-        if kin is not None:
-            node.fields["from_kinematics"] = _kinematics(reader.resolve(kin))
+    for tag, prefix in (("position", ""), ("relativeFromPosition", "from_")):
+        _read_position(reader, element.find(tag), node.fields, prefix)
     base = element.find("BaseToFeature")
     if base is not None:
         node.fields["base_to_feature"] = _floats(reader.resolve(base).get("pose"))
@@ -486,6 +456,28 @@ def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None
     if variable is not None:
         node.fields["variable"] = reader.variable_name(variable)
 
+
+
+def _read_position(reader, position, fields: dict, prefix: str) -> None:
+    """A waypoint's ``position`` (or ``relativeFromPosition``, with ``prefix`` "from_"):
+    joints and TCP pose (PolyScope 3 attributes, PolyScope 5 elements), TCP offset and the
+    arm's kinematics, into ``fields`` as ``q``/``pose``/``tcp_offset``/``kinematics``."""
+    if position is None:
+        return
+    position = reader.resolve(position)
+    if position.get("joints"):  # PolyScope 3: joints and the TCP pose as attributes
+        fields[prefix + "q"] = _floats(position.get("joints"))
+    if position.get("pose"):
+        fields[prefix + "pose"] = _floats(position.get("pose"))
+    angles = position.find("JointAngles")
+    if angles is not None:
+        fields[prefix + "q"] = _floats(reader.resolve(angles).get("angles"))
+    offset = position.find("TCPOffset")
+    if offset is not None:
+        fields[prefix + "tcp_offset"] = _floats(reader.resolve(offset).get("pose"))
+    kin = position.find("Kinematics")
+    if kin is not None:
+        fields[prefix + "kinematics"] = _kinematics(reader.resolve(kin))
 
 def _loop(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["type"] = element.get("type", "Forever")
