@@ -415,3 +415,19 @@ def test_a_hand_written_script_keeps_the_default_model_certain(tmp_path, capsys)
     report = _check_json(tmp_path, capsys, text)
     (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
     assert finding["severity"] == "error"
+
+
+def test_a_fragment_of_a_polyscope_program_is_taught_too(tmp_path, capsys):
+    # a script file a PolyScope program includes (it uses the program's `speed`): its moves
+    # were taught on the program's arm, which is not known here
+    far = "movel(p[-1.1, -0.1, 0.3, 0, 3.14, 0], a=1.2, v=speed)\n"
+    host = _untaught_program("[-0.4, -0.1, 0.3, 0, 3.14, 0]").replace(
+        '  $ 2 "MoveL"\n', '  $ 2 "Script: far.script"\n  ' + far).replace(
+        '  $ 1 "Robot Program"\n', '  global speed = 0.25\n  $ 1 "Robot Program"\n')
+    (tmp_path / "host.script").write_text(host)
+    (tmp_path / "far.script").write_text(far)
+    main(["check", "--json", str(tmp_path / "far.script")])
+    report = json.loads(capsys.readouterr().out)
+    assert "context of" in report["context"]
+    (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
+    assert finding["severity"] == "warning" and "on the assumed ur5e" in finding["message"]

@@ -220,6 +220,8 @@ def _check_script(source, args: argparse.Namespace, options):
     file_options = apply(options, inference, tcp_given=args.tcp is not None)
     if args.cell and file_options.robot != options.robot:
         file_options.cell = load_cell(file_options.robot, args.cell)
+    if context is not None and context.hosts:
+        inference.polyscope = True  # a fragment of a program PolyScope runs: taught on an arm
     report = check_tree(module, source.name, file_options, started=started)
     report.inferred = inference
     qualify(report, inference)
