@@ -20,7 +20,7 @@ from urdsl.protocol.realtime import (
     realtime_state,
 )
 
-# --- fixtures built from the documented byte offsets (UR_FACTS.md §3), not from our tables --
+# --- fixtures built from the documented byte offsets (docs/controller-facts.md §10), not from our t
 
 
 def packet(size: int, doubles: dict[int, tuple[float, ...]]) -> bytes:
@@ -250,5 +250,5 @@ def test_python_urx_reads_our_packets_at_the_same_offsets():
     assert tuple(monitor._qActual) == Q
     assert tuple(monitor._tcp_force) == (1,) * 6
     # urx indexes 3.x packets with the 1.x order: its "tcp" is the target pose at 588
-    # (UR_FACTS.md §3.3 pitfall), which urdsl reads by name instead.
+    # (docs/controller-facts.md §10: python-urx), which urdsl reads by name instead.
     assert tuple(monitor._tcp) == target == decode_realtime(data).tool_vector_target

@@ -37,7 +37,7 @@ from urdsl.protocol.rtde import (
 )
 from urdsl.protocol.rtde_fields import FIELDS, TYPES, field_available, output_fields
 
-# --- fixtures built from UR's RTDE guide (UR_FACTS.md §5), not from our encoder ---------------
+# --- fixtures built from UR's RTDE guide (docs/controller-facts.md §12), not from our encoder -----
 
 
 def package(code: str, payload: bytes) -> bytes:

@@ -37,6 +37,7 @@ import struct
 from dataclasses import dataclass, fields
 from types import MappingProxyType
 
+from ..versions import ControllerVersion
 from .errors import ProtocolError
 
 __all__ = [
@@ -72,7 +73,7 @@ def _i(name: str, count: int = 1) -> RealtimeField:
     return RealtimeField(name, "int", count)
 
 
-# --- the tables (UR "Realtime Client Interface" guide; UR_FACTS.md §3) ---------------------
+# --- the tables (UR "Realtime Client Interface" guide; docs/controller-facts.md §10) --------------
 
 _HEAD = (  # identical in every version: offsets 4 .. 396
     _d("time"), _d("q_target", 6), _d("qd_target", 6), _d("qdd_target", 6),
@@ -185,10 +186,10 @@ def layout_for_size(size: int) -> RealtimeLayout:
 
 
 def _version_tuple(version: str) -> tuple[int, int]:
+    """``(major, minor)`` of ``version`` (:class:`urdsl.versions.ControllerVersion` parses)."""
     try:
-        parts = version.strip().split(".")
-        return int(parts[0]), int(parts[1]) if len(parts) > 1 else 0
-    except (ValueError, IndexError):
+        return ControllerVersion.parse(version).feature
+    except ValueError:
         raise ProtocolError(f"controller version {version!r} is not of the form 'major.minor'",
                             interface="realtime") from None
 

@@ -1,7 +1,7 @@
 """The dashboard server's commands and replies (port 29999), without sockets.
 
-One line in, one line out, with the replies of UR_FACTS.md §6. The virtual controller is
-always in remote control. ``load`` reads URScript files (``.script``, ``.urscript``,
+One line in, one line out, with the replies of docs/controller-facts.md §13. The virtual
+controller is always in remote control. ``load`` reads URScript files (``.script``, ``.urscript``,
 ``.txt``) from the controller's programs folder; PolyScope ``.urp`` files cannot be run by
 urdsl and answer ``Error while loading program``.
 """
@@ -10,8 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .controller import SimError
-from .state import ProgramState
+from .state import ProgramState, SimError
 
 __all__ = ["WELCOME", "DashboardSession", "MAX_LINE"]
 

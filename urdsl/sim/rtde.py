@@ -2,7 +2,7 @@
 
 Feed the client's bytes to :meth:`RtdeSession.receive`; it returns the reply bytes. Call
 :meth:`RtdeSession.output` at every controller step with the snapshot; it returns a data
-package when one is due at the negotiated frequency. Layouts: UR_FACTS.md §5.
+package when one is due at the negotiated frequency. Layouts: docs/controller-facts.md §12.
 
 Limits, with their reason: a package may be 65535 bytes (the size field is a uint16); a
 variable-name list may be 2048 bytes (the RTDE guide's limit); a client that sends a package
@@ -315,7 +315,7 @@ class RtdeSession:
             self.frequency = frequency
             if self.version.e_series:
                 self._every = 1
-            else:  # CB3 decimates: one package every floor(125 / f) cycles (UR_FACTS §8.13)
+            else:  # CB3 decimates: one package every floor(125 / f) steps (controller-facts.md §12)
                 self._every = max(int(self.max_frequency // frequency), 1)
         text = ",".join(types).encode("ascii")
         if self.protocol >= 2:

@@ -1,7 +1,7 @@
 """Server-side byte formats of the virtual controller: realtime packets, primary/secondary
 robot state and robot messages (no sockets).
 
-Layouts follow ../shared/reference/UR_FACTS.md §3 (realtime) and §4 (primary/secondary); all
+Layouts follow docs/controller-facts.md §10 (realtime) and §11 (primary/secondary); all
 big-endian. Quantities the simulation does not model (motor currents, temperatures,
 voltages, forces) are sent as 0.0 so that clients parse complete packets; the real values
 are what the arm moves (joints, speeds, TCP pose and speed, modes, I/O).
@@ -34,7 +34,8 @@ SOURCE_CONTROLLER = -2  # [U] the int8 source the controller puts on its own mes
 
 def realtime_size(version: ControllerVersion) -> int:
     """Total packet size (bytes, including the int32 size field) for a software version
-    (UR_FACTS.md §3.3; 3.14/3.15 and 5.9 are sent as 1116, the last confirmed layout [U])."""
+    (docs/controller-facts.md §10; 3.14/3.15 and 5.9 are sent as 1116, the last confirmed
+    layout [U])."""
     major, minor = version.major, version.minor
     if major == 3:
         if minor <= 1:
@@ -57,7 +58,8 @@ def _col(number: int) -> int:
 
 
 def encode_realtime(snap: Snapshot, version: ControllerVersion) -> bytes:
-    """One realtime packet: int32 size, then doubles at the offsets of UR_FACTS.md §3.1."""
+    """One realtime packet: int32 size, then doubles at the offsets of
+    docs/controller-facts.md §10."""
     size = realtime_size(version)
     values = np.zeros((size - 4) // 8)
     values[_col(1)] = snap.time
