@@ -16,7 +16,7 @@ import struct
 
 import numpy as np
 
-from .state import ControllerVersion, ProgramState, RobotMode, SafetyMode, Snapshot
+from .state import ControllerVersion, SafetyMode, Snapshot
 
 __all__ = [
     "realtime_size", "encode_realtime", "encode_robot_state", "encode_version_message",
@@ -220,21 +220,3 @@ def encode_safety_message(code: int, argument: int, mode: SafetyMode, time: floa
     uint32 report data type (0: none), uint32 report data."""
     body = struct.pack(">iiBII", code, argument, int(mode), 0, 0)
     return _robot_message(time, 5, body)
-
-
-def robot_status_bits(snap: Snapshot) -> int:
-    """RTDE ``robot_status_bits``: bit 0 power on, 1 program running, 2 teach button,
-    3 power button."""
-    return int(snap.power_on) | int(snap.program_running) << 1
-
-
-def safety_status_bits(snap: Snapshot) -> int:
-    """RTDE ``safety_status_bits``: bit 0 normal, 1 reduced, 2 protective stop, 3 recovery,
-    4 safeguard stop, 5 system e-stop, 6 robot e-stop, 7 e-stop, 8 violation, 9 fault."""
-    mode = snap.safety_mode
-    if mode == SafetyMode.NORMAL:
-        return 1
-    return 1 << (int(mode) - 1) if 1 <= int(mode) <= 10 else 0
-
-
-__all__ += ["robot_status_bits", "safety_status_bits", "ProgramState", "RobotMode"]
