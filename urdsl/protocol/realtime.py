@@ -132,6 +132,13 @@ class RealtimeLayout:
         self._int_vectors = tuple(int_vectors)
         self.names = tuple(f.name for f in table)
 
+    def slot(self, name: str) -> slice:
+        """Where field ``name`` sits in the packet's array of doubles (after the size field);
+        a KeyError for a field this layout does not send."""
+        start = (self.offset(name) - _HEADER.size) // 8
+        count = next(f.count for f in self.table if f.name == name)
+        return slice(start, start + count)
+
     def offset(self, name: str) -> int:
         """Byte offset of a field from the start of the packet (the size field is at 0)."""
         try:

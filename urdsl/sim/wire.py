@@ -1,21 +1,25 @@
-"""Server-side byte formats of the virtual controller: realtime packets, primary/secondary
-robot state and robot messages (no sockets).
+"""What the virtual controller sends on its realtime and primary/secondary ports (no sockets).
 
-Layouts follow docs/controller-facts.md §10 (realtime) and §11 (primary/secondary); all
-big-endian. Quantities the simulation does not model (motor currents, temperatures,
-voltages, forces) are sent as 0.0 so that clients parse complete packets; the real values
-are what the arm moves (joints, speeds, TCP pose and speed, modes, I/O).
+Realtime packets are laid out by the one layout table per controller version of
+:mod:`urdsl.protocol.realtime` (docs/controller-facts.md §10); this module only says which
+snapshot value each named field carries. Quantities the simulation does not model (motor
+currents, temperatures, voltages, forces) are sent as 0.0 so that clients parse complete
+packets.
 
-The sans-I/O client side (decoders) lives in :mod:`urdsl.protocol`; these encoders exist
-because the simulator had to serve before that layer landed (see the issue-8 note).
+The primary/secondary robot state and robot messages (docs/controller-facts.md §11) are
+still packed here by hand; moving them onto :mod:`urdsl.protocol.primary`'s encoders is
+the remaining part of issue 15's sim work.
 """
 
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
+from ..protocol.realtime import layout_for_version
 from .state import ControllerVersion, SafetyMode, Snapshot
 
 __all__ = [
@@ -31,65 +35,54 @@ SOURCE_CONTROLLER = -2  # [U] the int8 source the controller puts on its own mes
 
 # ---- realtime (30003 / 30013) ---------------------------------------------------------------
 
+_REALTIME: tuple[tuple[str, Callable[[Snapshot], Any]], ...] = (
+    # the controller's behaviour: which snapshot value each named field of the protocol's
+    # layout carries (the planner's path is the target); fields not named here are 0
+    ("time", lambda s: s.time), ("controller_timer", lambda s: s.time),
+    ("q_target", lambda s: s.q), ("qd_target", lambda s: s.qd),
+    ("qdd_target", lambda s: s.qdd), ("q_actual", lambda s: s.q), ("qd_actual", lambda s: s.qd),
+    ("tool_vector_actual", lambda s: s.tcp), ("tcp_speed_actual", lambda s: s.tcp_speed),
+    ("tool_vector_target", lambda s: s.tcp), ("tcp_speed_target", lambda s: s.tcp_speed),
+    ("digital_input_bits", lambda s: s.digital_inputs),
+    ("robot_mode", lambda s: int(s.robot_mode)),
+    ("joint_modes", lambda s: int(s.joint_mode)),
+    ("safety_mode", lambda s: int(s.safety_mode)),
+    ("speed_scaling", lambda s: s.speed_scaling),
+    ("digital_outputs", lambda s: s.digital_outputs),
+    ("program_state", lambda s: int(s.program_state)),
+    ("elbow_position", lambda s: s.elbow), ("elbow_velocity", lambda s: s.elbow_speed),
+    ("safety_status", lambda s: int(s.safety_mode)),
+    ("payload_mass", lambda s: s.payload_mass), ("payload_cog", lambda s: s.payload_cog),
+)
+
+_PLANS: dict[ControllerVersion, tuple[bytes, int, tuple]] = {}
+
+
+def _realtime_plan(version: ControllerVersion) -> tuple[bytes, int, tuple]:
+    """(size field, doubles, (slot, value) pairs) of ``version``'s layout, from the one
+    layout table of :mod:`urdsl.protocol.realtime`."""
+    plan = _PLANS.get(version)
+    if plan is None:
+        layout = layout_for_version(f"{version.major}.{version.minor}")
+        slots = tuple((layout.slot(name), value) for name, value in _REALTIME
+                      if name in layout.names)
+        plan = _PLANS[version] = (struct.pack(">i", layout.size), layout.doubles, slots)
+    return plan
+
 
 def realtime_size(version: ControllerVersion) -> int:
     """Total packet size (bytes, including the int32 size field) for a software version
-    (docs/controller-facts.md §10; 3.14/3.15 and 5.9 are sent as 1116, the last confirmed
-    layout [U])."""
-    major, minor = version.major, version.minor
-    if major == 3:
-        if minor <= 1:
-            return 1044
-        if minor <= 4:
-            return 1060
-        if minor <= 9:
-            return 1108
-        return 1116
-    if minor <= 3:
-        return 1108
-    if minor <= 9:
-        return 1116
-    return 1220
-
-
-def _col(number: int) -> int:
-    """Index in the double array of the realtime table's 1-based (gnuplot) column."""
-    return number - 1
+    (docs/controller-facts.md §10)."""
+    return layout_for_version(f"{version.major}.{version.minor}").size
 
 
 def encode_realtime(snap: Snapshot, version: ControllerVersion) -> bytes:
-    """One realtime packet: int32 size, then doubles at the offsets of
-    docs/controller-facts.md §10."""
-    size = realtime_size(version)
-    values = np.zeros((size - 4) // 8)
-    values[_col(1)] = snap.time
-    values[_col(2):_col(8)] = snap.q           # q target (the planner's path is the target)
-    values[_col(8):_col(14)] = snap.qd         # qd target
-    values[_col(14):_col(20)] = snap.qdd       # qdd target
-    values[_col(32):_col(38)] = snap.q         # q actual
-    values[_col(38):_col(44)] = snap.qd        # qd actual
-    values[_col(56):_col(62)] = snap.tcp       # tool vector actual
-    values[_col(62):_col(68)] = snap.tcp_speed
-    values[_col(74):_col(80)] = snap.tcp       # tool vector target
-    values[_col(80):_col(86)] = snap.tcp_speed
-    values[_col(86)] = snap.digital_inputs
-    values[_col(93)] = snap.time               # controller timer
-    values[_col(95)] = int(snap.robot_mode)
-    values[_col(96):_col(102)] = int(snap.joint_mode)
-    values[_col(102)] = int(snap.safety_mode)
-    values[_col(118)] = snap.speed_scaling
-    if size > 1044:
-        values[_col(131)] = snap.digital_outputs
-        values[_col(132)] = int(snap.program_state)
-    if size > 1060:
-        values[_col(133):_col(136)] = snap.elbow
-        values[_col(136):_col(139)] = snap.elbow_speed
-    if size > 1108:
-        values[_col(139)] = int(snap.safety_mode)
-    if size > 1116:
-        values[_col(143)] = snap.payload_mass
-        values[_col(144):_col(147)] = snap.payload_cog
-    return struct.pack(">i", size) + values.astype(">f8").tobytes()
+    """One realtime packet of ``version``'s layout for ``snap``."""
+    head, doubles, slots = _realtime_plan(version)
+    values = np.zeros(doubles)
+    for where, value in slots:
+        values[where] = value(snap)
+    return head + values.astype(">f8").tobytes()
 
 
 # ---- primary / secondary (30001 / 30002, read-only 30011 / 30012) ----------------------------
