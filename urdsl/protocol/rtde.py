@@ -82,6 +82,16 @@ def _error(message: str, offset: int | None = None) -> ProtocolError:
 # --- recipes --------------------------------------------------------------------------------
 
 
+def _reader(plan: list[tuple[str, int, int]], skip: int):
+    """A function from a whole package's unpacked tuple (header first, ``skip`` items) to
+    the dict of name → value: one dict display, as a hand-written decoder would have."""
+    items = ", ".join(
+        f"{name!r}: flat[{skip + index}]" if count == 1
+        else f"{name!r}: flat[{skip + index}:{skip + index + count}]"
+        for name, index, count in plan)
+    return eval(f"lambda flat: {{{items}}}", {})  # noqa: S307 - names are repr() literals
+
+
 @dataclass(frozen=True)
 class Recipe:
     """A set-up recipe: ``id`` (``None`` for a v1 output recipe, which has none), the
@@ -94,6 +104,7 @@ class Recipe:
     _struct: struct.Struct | None = field(default=None, init=False, repr=False, compare=False)
     _plan: tuple[tuple[str, int, int], ...] = field(default=(), init=False, repr=False,
                                                     compare=False)
+    _whole: dict | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if len(self.names) != len(self.types):
@@ -112,6 +123,11 @@ class Recipe:
             index += count
         object.__setattr__(self, "_struct", struct.Struct("".join(fmt)))
         object.__setattr__(self, "_plan", tuple(plan))
+        body = "".join(fmt[1:])
+        object.__setattr__(self, "_whole", {
+            True: (struct.Struct(">HBB" + body), _reader(plan, 3)),   # with the recipe id
+            False: (struct.Struct(">HB" + body), _reader(plan, 2)),   # v1 output: none
+        })
 
     @property
     def not_found(self) -> tuple[str, ...]:
@@ -446,8 +462,20 @@ def decode_rtde(package: bytes, *, sender: str, protocol: int = 2,
     Data packages are decoded with ``recipes`` (recipe id → :class:`Recipe`; a v1 output
     recipe is under ``None``).
     """
-    if sender not in ("client", "server"):
+    if sender != "server" and sender != "client":
         raise ValueError(f"sender must be 'client' or 'server', not {sender!r}")
+    if recipes and len(package) > 3 and package[2] == 85:  # 'U': the fast path
+        with_id = sender == "client" or protocol >= 2
+        recipe = recipes.get(package[3] if with_id else None)
+        if recipe is not None and recipe._whole is not None:
+            whole, read = recipe._whole[with_id]
+            if whole.size == len(package):
+                flat = whole.unpack_from(package)
+                if flat[0] == whole.size:
+                    message = object.__new__(DataPackage)
+                    message.__dict__.update(recipe_id=flat[2] if with_id else None,
+                                            values=read(flat))
+                    return message
     if len(package) < _HEADER.size:
         raise _error(f"{len(package)} bytes cannot hold the 3-byte package header", 0)
     size, code = _HEADER.unpack_from(package)
