@@ -1,14 +1,12 @@
 """What the virtual controller sends on its realtime and primary/secondary ports (no sockets).
 
-Realtime packets are laid out by the one layout table per controller version of
-:mod:`urdsl.protocol.realtime` (docs/controller-facts.md §10); this module only says which
-snapshot value each named field carries. Quantities the simulation does not model (motor
-currents, temperatures, voltages, forces) are sent as 0.0 so that clients parse complete
-packets.
-
-The primary/secondary robot state and robot messages (docs/controller-facts.md §11) are
-still packed here by hand; moving them onto :mod:`urdsl.protocol.primary`'s encoders is
-the remaining part of issue 15's sim work.
+The bytes are :mod:`urdsl.protocol`'s: realtime packets follow the one layout table per
+controller version of :mod:`urdsl.protocol.realtime` (docs/controller-facts.md §10), the
+robot state and robot messages the sub-package and message encoders of
+:mod:`urdsl.protocol.primary` (§11), in the layout variant the version sends. This module
+only says which snapshot value each field carries. Quantities the simulation does not model
+(motor currents, temperatures, voltages, forces) are sent as 0 so that clients parse
+complete packets.
 """
 
 from __future__ import annotations
@@ -19,6 +17,22 @@ from typing import Any
 
 import numpy as np
 
+from ..protocol.primary import (
+    AdditionalInfo,
+    CartesianInfo,
+    ConfigurationData,
+    ForceModeData,
+    JointData,
+    KinematicsInfo,
+    MasterboardData,
+    RobotModeData,
+    RobotState,
+    RuntimeExceptionMessage,
+    SafetyModeMessage,
+    TextMessage,
+    ToolData,
+    VersionMessage,
+)
 from ..protocol.realtime import layout_for_version
 from .state import ControllerVersion, SafetyMode, Snapshot
 
@@ -30,6 +44,7 @@ __all__ = [
 
 ROBOT_STATE = 16
 ROBOT_MESSAGE = 20
+_ZEROS = (0.0,) * 6
 SOURCE_CONTROLLER = -2  # [U] the int8 source the controller puts on its own messages
 
 
@@ -88,128 +103,140 @@ def encode_realtime(snap: Snapshot, version: ControllerVersion) -> bytes:
 # ---- primary / secondary (30001 / 30002, read-only 30011 / 30012) ----------------------------
 
 
-def _package(kind: int, body: bytes) -> bytes:
-    """A ROBOT_STATE sub-package: uint32 size (incl. the 5-byte header), uint8 type, body."""
-    return struct.pack(">IB", len(body) + 5, kind) + body
+def _variant(version: ControllerVersion, *labels: str) -> str:
+    """The newest of a sub-package's layout ``labels`` (first versions that send them) that
+    ``version`` sends."""
+    chosen = labels[0]
+    for label in labels:
+        if version >= ControllerVersion.parse(label):
+            chosen = label
+    return chosen
 
 
-def _robot_mode_data(snap: Snapshot, version: ControllerVersion) -> bytes:
-    running = snap.program_running
-    head = struct.pack(
-        ">Q???????BBdd", int(snap.time * 1000), True, snap.power_on, snap.power_on,
-        False, snap.safety_mode == SafetyMode.PROTECTIVE_STOP, running, snap.program_paused,
-        max(int(snap.robot_mode), 0), 0, snap.target_speed_fraction, snap.speed_scaling)
-    if version < ControllerVersion(3, 2):
-        return _package(0, head)                                     # 38 bytes
-    head += struct.pack(">d", 1.0)                                   # target speed limit
-    if version < ControllerVersion(3, 5):
-        return _package(0, head)                                     # 46 bytes
-    return _package(0, head + b"\x00")                               # 47 bytes
+def _robot_mode_data(snap: Snapshot, version: ControllerVersion) -> RobotModeData:
+    variant = _variant(version, "3.0", "3.2", "3.5")
+    return RobotModeData(
+        variant=variant, timestamp=int(snap.time * 1000), is_real_robot_connected=True,
+        is_real_robot_enabled=snap.power_on, is_robot_power_on=snap.power_on,
+        is_emergency_stopped=False,
+        is_protective_stopped=snap.safety_mode == SafetyMode.PROTECTIVE_STOP,
+        is_program_running=snap.program_running, is_program_paused=snap.program_paused,
+        robot_mode=max(int(snap.robot_mode), 0), control_mode=0,
+        target_speed_fraction=snap.target_speed_fraction, speed_scaling=snap.speed_scaling,
+        target_speed_fraction_limit=None if variant == "3.0" else 1.0,
+        reserved=0 if variant == "3.5" else None)
 
 
-def _joint_data(snap: Snapshot) -> bytes:
-    body = b"".join(
-        struct.pack(">dddffffB", snap.q[i], snap.q[i], snap.qd[i], 0.0, 0.0, 0.0, 0.0,
-                    int(snap.joint_mode))
-        for i in range(6))
-    return _package(1, body)                                         # 251 bytes
+def _joint_data(snap: Snapshot) -> JointData:
+    q, qd = tuple(snap.q.tolist()), tuple(snap.qd.tolist())
+    return JointData(variant="3.0", q_actual=q, q_target=q, qd_actual=qd, i_actual=_ZEROS,
+                     v_actual=_ZEROS, t_motor=_ZEROS, t_micro=_ZEROS,
+                     joint_mode=(int(snap.joint_mode),) * 6)
 
 
-def _tool_data(snap: Snapshot) -> bytes:
-    body = struct.pack(">BBddfBffB", 0, 0, snap.tool_analog_inputs[0],
-                       snap.tool_analog_inputs[1], 0.0, 0, 0.0, 0.0, 0)
-    return _package(2, body)                                         # 37 bytes
+def _tool_data(snap: Snapshot) -> ToolData:
+    return ToolData(variant="3.0", analog_input_2=snap.tool_analog_inputs[0],
+                    analog_input_3=snap.tool_analog_inputs[1])
 
 
-def _masterboard_data(snap: Snapshot) -> bytes:
-    body = struct.pack(
-        ">IIBBddBBddffffBBBIBBB",
-        snap.digital_inputs & 0xFFFFFFFF, snap.digital_outputs & 0xFFFFFFFF, 0, 0,
-        snap.analog_inputs[0], snap.analog_inputs[1], 0, 0,
-        snap.analog_outputs[0], snap.analog_outputs[1], 0.0, 0.0, 0.0, 0.0,
-        int(snap.safety_mode), snap.safety_mode == SafetyMode.REDUCED, False, 0, 0, False, 0)
-    return _package(3, body)
+def _masterboard_data(snap: Snapshot, version: ControllerVersion) -> MasterboardData:
+    variant = _variant(version, "3.0", "3.2", "5.0")
+    return MasterboardData(
+        variant=variant, digital_input_bits=snap.digital_inputs & 0xFFFFFFFF,
+        digital_output_bits=snap.digital_outputs & 0xFFFFFFFF,
+        analog_input_0=snap.analog_inputs[0], analog_input_1=snap.analog_inputs[1],
+        analog_output_0=snap.analog_outputs[0], analog_output_1=snap.analog_outputs[1],
+        safety_mode=int(snap.safety_mode),
+        in_reduced_mode=snap.safety_mode == SafetyMode.REDUCED,
+        operational_mode_selector_input=None if variant == "3.0" else 0,
+        three_position_enabling_device_input=None if variant == "3.0" else False,
+        reserved_2=0 if variant == "5.0" else None)
 
 
-def _cartesian_info(snap: Snapshot, version: ControllerVersion) -> bytes:
-    body = struct.pack(">6d", *snap.tcp)
-    if version >= ControllerVersion(3, 2):
-        body += struct.pack(">6d", *snap.tcp_offset)
-    return _package(4, body)                                         # 101 bytes (53 < 3.2)
+def _cartesian_info(snap: Snapshot, version: ControllerVersion) -> CartesianInfo:
+    variant = _variant(version, "3.0", "3.2")
+    return CartesianInfo(variant=variant, tcp_pose=tuple(snap.tcp.tolist()),
+                         tcp_offset=tuple(snap.tcp_offset.tolist()) if variant == "3.2"
+                         else None)
 
 
-def _kinematics_info(spec) -> bytes:
-    body = struct.pack(">6I", *([0] * 6))
-    body += struct.pack(">24d", *([0.0] * 6), *spec.dh_a, *spec.dh_d, *spec.dh_alpha)
-    return _package(5, body + struct.pack(">I", 0))                  # 225 bytes
+def _kinematics_info(spec: Any) -> KinematicsInfo:
+    return KinematicsInfo(variant="3.0", checksum=(0,) * 6, dh_theta=_ZEROS,
+                          dh_a=tuple(spec.dh_a), dh_d=tuple(spec.dh_d),
+                          dh_alpha=tuple(spec.dh_alpha), calibration_status=0)
 
 
-def _configuration_data(spec, qd_max, q_min, q_max) -> bytes:
-    limits = [v for i in range(6) for v in (q_min[i], q_max[i])]
-    limits = [v if np.isfinite(v) else np.sign(v) * 1e9 for v in limits]
-    speeds = [v for i in range(6) for v in (qd_max[i], 0.0)]  # max accel: not published
-    defaults = (1.05, 1.4, 0.25, 1.2, 0.0)  # movej v, a; movel v, a (script defaults); eq radius
-    body = struct.pack(">12d12d5d", *limits, *speeds, *defaults)
-    body += struct.pack(">24d", *spec.dh_a, *spec.dh_d, *spec.dh_alpha, *([0.0] * 6))
-    body += struct.pack(">4i", 0, 0, int(getattr(spec, "robot_type", 0)), 0)
-    return _package(6, body)                                         # 445 bytes
+def _configuration_data(spec: Any, version: ControllerVersion, qd_max, q_min,
+                        q_max) -> ConfigurationData:
+    def finite(values) -> tuple[float, ...]:
+        return tuple(float(v) if np.isfinite(v) else float(np.sign(v)) * 1e9 for v in values)
 
-
-def _force_mode_data() -> bytes:
-    return _package(7, struct.pack(">7d", *([0.0] * 7)))             # 61 bytes
-
-
-def _additional_info(version: ControllerVersion) -> bytes:
-    if version.e_series:  # freedrive button pressed / enabled, IO-enabled freedrive [U]
-        return _package(8, struct.pack(">???", False, False, False))
-    return _package(8, struct.pack(">??", False, False))             # teach button
+    e_series = _variant(version, "3.0", "5.0") == "5.0"
+    return ConfigurationData(
+        variant="5.0" if e_series else "3.0", joint_min_limit=finite(q_min),
+        joint_max_limit=finite(q_max), joint_max_speed=tuple(float(v) for v in qd_max),
+        joint_max_acceleration=_ZEROS,  # not published by the models
+        # movej v, a; movel v, a (the script defaults); equivalent radius
+        v_joint_default=1.05, a_joint_default=1.4, v_tool_default=0.25, a_tool_default=1.2,
+        eq_radius=0.0, dh_a=tuple(spec.dh_a), dh_d=tuple(spec.dh_d),
+        dh_alpha=tuple(spec.dh_alpha), dh_theta=_ZEROS,
+        robot_type=int(getattr(spec, "robot_type", 0)),
+        reserved_1=0 if e_series else None, reserved_2=0 if e_series else None)
 
 
 def encode_robot_state(snap: Snapshot, version: ControllerVersion, spec=None,
                        limits: tuple | None = None, configuration: bool = False) -> bytes:
-    """A ROBOT_STATE message (type 16): robot mode, joint, tool, masterboard, cartesian,
+    """A ROBOT_STATE message (type 16) in ``version``'s sub-package layouts
+    (:mod:`urdsl.protocol.primary`): robot mode, joint, tool, masterboard, cartesian,
     (kinematics and configuration when ``configuration`` and a model ``spec`` are given),
-    force mode and additional info sub-packages. ``limits`` = (qd_max, q_min, q_max)."""
-    parts = [_robot_mode_data(snap, version), _joint_data(snap), _tool_data(snap),
-             _masterboard_data(snap), _cartesian_info(snap, version)]
+    force mode and additional info. ``limits`` = (qd_max, q_min, q_max)."""
+    parts: list[Any] = [_robot_mode_data(snap, version), _joint_data(snap), _tool_data(snap),
+                        _masterboard_data(snap, version), _cartesian_info(snap, version)]
     if configuration and spec is not None:
         parts.append(_kinematics_info(spec))
         if limits is not None:
-            parts.append(_configuration_data(spec, *limits))
+            parts.append(_configuration_data(spec, version, *limits))
     if version >= ControllerVersion(3, 2):
-        parts += [_force_mode_data(), _additional_info(version)]
-    body = b"".join(parts)
-    return struct.pack(">iB", len(body) + 5, ROBOT_STATE) + body
+        e_series = version.e_series
+        parts += [ForceModeData(variant="3.0", wrench=_ZEROS, robot_dexterity=0.0),
+                  AdditionalInfo(variant="5.0" if e_series else "3.2",
+                                 io_enabled_freedrive=False if e_series else None,
+                                 reserved=0 if e_series else None)]
+    return RobotState(tuple(parts)).encode()
 
 
-def _robot_message(time: float, kind: int, body: bytes) -> bytes:
-    head = struct.pack(">QbB", int(time * 1000), SOURCE_CONTROLLER, kind)
-    payload = head + body
-    return struct.pack(">iB", len(payload) + 5, ROBOT_MESSAGE) + payload
+def _text(text: str) -> str:
+    """``text`` as it survives UTF-8 (lone surrogates replaced)."""
+    return text.encode("utf-8", errors="replace").decode("utf-8")
+
+
+def _ms(time: float) -> int:
+    return int(time * 1000)
 
 
 def encode_version_message(version: ControllerVersion, time: float = 0.0,
                            build_date: str = "urdsl virtual controller") -> bytes:
     """ROBOT_MESSAGE VERSION (type 3), the first message on 30001/30002 (layout of 3.12+/5.x)."""
-    name = b"URControl"
-    body = struct.pack(">b", len(name)) + name
-    body += struct.pack(">BBii", version.major, version.minor, version.bugfix, version.build)
-    return _robot_message(time, 3, body + build_date.encode("utf-8"))
+    return VersionMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER,
+                          project_name="URControl", major=version.major, minor=version.minor,
+                          bugfix=version.bugfix, build_number=version.build,
+                          build_date=build_date).encode()
 
 
 def encode_text_message(text: str, time: float = 0.0) -> bytes:
     """ROBOT_MESSAGE TEXT (type 0): what ``textmsg`` shows."""
-    return _robot_message(time, 0, text.encode("utf-8", errors="replace"))
+    return TextMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER, text=_text(text)).encode()
 
 
 def encode_runtime_exception(line: int, column: int, text: str, time: float = 0.0) -> bytes:
-    """ROBOT_MESSAGE RUNTIME_EXCEPTION (type 10): uint32 line, uint32 column, text."""
-    body = struct.pack(">II", max(line, 0), max(column, 0))
-    return _robot_message(time, 10, body + text.encode("utf-8", errors="replace"))
+    """ROBOT_MESSAGE RUNTIME_EXCEPTION (type 10): line, column (1-based), text."""
+    return RuntimeExceptionMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER,
+                                   line=max(line, 0), column=max(column, 0),
+                                   text=_text(text)).encode()
 
 
 def encode_safety_message(code: int, argument: int, mode: SafetyMode, time: float = 0.0) -> bytes:
-    """ROBOT_MESSAGE SAFETY_MODE (type 5): int32 code, int32 argument, uint8 safety mode,
-    uint32 report data type (0: none), uint32 report data."""
-    body = struct.pack(">iiBII", code, argument, int(mode), 0, 0)
-    return _robot_message(time, 5, body)
+    """ROBOT_MESSAGE SAFETY_MODE (type 5): code, argument, safety mode, no report data."""
+    return SafetyModeMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER, code=code,
+                             argument=argument, safety_mode_type=int(mode),
+                             report_data_type=0, report_data=0).encode()
