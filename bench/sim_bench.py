@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-OFFSET = 3100
+OFFSET = int(os.environ.get("SIM_BENCH_OFFSET", "3100"))
 PROGRAM = """def bench():
   while True:
     movej([0.8, -1.3, 1.2, -1.5, -1.5, 0.5], a=2, v=1.5)

@@ -22,7 +22,8 @@ from urdsl.protocol.dashboard import (
 )
 from urdsl.protocol.errors import ProtocolError
 
-# Reply texts as UR documents them (UR_FACTS.md §6), with the meaning a client must see.
+# Reply texts as UR documents them (docs/controller-facts.md §13), with the meaning a client
+# must see.
 DOCUMENTED = [
     ("load", "Loading program: /programs/pick.urp", True, None),
     ("load", "File not found: /programs/pick.urp", False, None),

@@ -36,7 +36,7 @@ from urdsl.protocol.primary import (
     encode_primary,
 )
 
-# --- fixtures built by hand from UR's documented layouts (UR_FACTS.md §4) -------------------
+# --- fixtures built by hand from UR's documented layouts (docs/controller-facts.md §11) -----------
 
 Q = (0.1, -1.2, 1.3, -1.7, -1.5, 0.4)
 

@@ -20,7 +20,8 @@ from urdsl.protocol.realtime import (
     realtime_state,
 )
 
-# --- fixtures built from the documented byte offsets (UR_FACTS.md §3), not from our tables --
+# --- fixtures built from the documented byte offsets (docs/controller-facts.md §10), not from
+# our tables ------------------------------------------------------------------------------------
 
 
 def packet(size: int, doubles: dict[int, tuple[float, ...]]) -> bytes:
@@ -250,5 +251,13 @@ def test_python_urx_reads_our_packets_at_the_same_offsets():
     assert tuple(monitor._qActual) == Q
     assert tuple(monitor._tcp_force) == (1,) * 6
     # urx indexes 3.x packets with the 1.x order: its "tcp" is the target pose at 588
-    # (UR_FACTS.md §3.3 pitfall), which urdsl reads by name instead.
+    # (docs/controller-facts.md §10: python-urx), which urdsl reads by name instead.
     assert tuple(monitor._tcp) == target == decode_realtime(data).tool_vector_target
+
+
+def test_slot_is_where_a_field_sits_among_the_doubles():
+    layout = LAYOUTS["5.10"]
+    assert layout.slot("q_actual") == slice(31, 37)  # byte 252 = 4 + 8 * 31
+    assert layout.slot("time") == slice(0, 1)
+    with pytest.raises(KeyError):
+        LAYOUTS["3.0"].slot("payload_mass")

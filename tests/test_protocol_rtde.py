@@ -37,7 +37,7 @@ from urdsl.protocol.rtde import (
 )
 from urdsl.protocol.rtde_fields import FIELDS, TYPES, field_available, output_fields
 
-# --- fixtures built from UR's RTDE guide (UR_FACTS.md §5), not from our encoder ---------------
+# --- fixtures built from UR's RTDE guide (docs/controller-facts.md §12), not from our encoder -----
 
 
 def package(code: str, payload: bytes) -> bytes:
@@ -368,3 +368,45 @@ def test_every_output_field_can_be_streamed_by_the_server():
     for chunk in chunks:
         (reply,) = talk(client, server, client.setup_outputs(chunk, 500))
         assert NOT_FOUND not in reply.types, chunk
+
+
+def test_setup_names_drop_empty_entries_as_the_controller_does():
+    # ur_rtde ends its name list with a comma
+    data = package("O", struct.pack(">d", 125.0) + b"timestamp,actual_q,")
+    assert decode_rtde(data, sender="client") == SetupOutputs(("timestamp", "actual_q"), 125.0)
+
+
+def test_a_malformed_request_is_refused_and_the_server_goes_on():
+    client, server = handshake()
+    bad = package("V", b"\x00")  # one byte where a uint16 belongs
+    (whole,) = server.packages(bad)
+    with pytest.raises(ProtocolError):
+        server.receive_package(whole)
+    server.refuse(whole, "protocol version request payload has 1 bytes")
+    events = [decode_rtde(p, sender="server") for p in RtdeFramer().feed(server.data_to_send())]
+    assert events[0].level == ERROR and "package ignored" in events[0].message
+    assert events[1] == ProtocolVersionReply(False)
+    assert talk(client, server, client.get_controller_version()) == [
+        ControllerVersion(5, 11, 1, 108318)]
+
+
+def test_the_256th_input_recipe_is_refused_with_id_0_and_its_types():
+    client, server = handshake()
+    for expected in range(1, 256):
+        (reply,) = talk(client, server, client.setup_inputs(["input_int_register_0"]))
+        assert reply == InputSetupReply(expected, ("INT32",))
+    server.receive_data(encode_rtde(SetupInputs(("input_int_register_0",))))
+    events = [decode_rtde(p, sender="server") for p in RtdeFramer().feed(server.data_to_send())]
+    assert "255 per connection" in events[0].message
+    assert events[1] == InputSetupReply(0, ("INT32",))
+    assert 0 not in server.input_recipes
+
+
+def test_output_package_is_the_data_package_of_the_recipe():
+    client, server = handshake()
+    talk(client, server, client.setup_outputs(["timestamp", "actual_q", "robot_mode"], 500))
+    talk(client, server, client.start())
+    values = {"timestamp": 2.5, "actual_q": (0.1, 0.2, 0.3, 0.4, 0.5, 0.6), "robot_mode": 7}
+    fast = server.output_package([2.5, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 7])
+    assert fast == server.outputs(values, 0)
+    assert client.receive_data(fast) == [DataPackage(1, values)]

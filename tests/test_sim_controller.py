@@ -259,3 +259,10 @@ def test_framer_never_crashes_on_random_bytes(data):
             assert chunk.kind in ("def", "sec", "bare")
     except ValueError:
         pass
+
+
+def test_models_resolve_as_every_command_resolves_them_and_versions_are_3_or_5():
+    long = VirtualController(robot="UR8 Long")  # the one model resolver: any case, spaces
+    assert long.robot_name == "ur8long" and long.version == ControllerVersion(5, 15)
+    with pytest.raises(SimError, match="imitates CB3 software 3.x and e-Series software 5.x"):
+        VirtualController(robot="ur5e", version="10.7")

@@ -1,7 +1,7 @@
 """The virtual controller's network interfaces, spoken to with raw sockets on loopback.
 
-Byte layouts are decoded here from UR_FACTS.md (offsets, sizes, type codes) independently of
-the simulator's encoders. Every socket has a timeout, so no test can hang.
+Byte layouts are decoded here from docs/controller-facts.md (offsets, sizes, type codes)
+independently of the simulator's encoders. Every socket has a timeout, so no test can hang.
 """
 
 from __future__ import annotations

@@ -33,10 +33,12 @@ are computed from the tables, never written by hand; ``layout.offset("q_actual")
 
 from __future__ import annotations
 
+import operator
 import struct
 from dataclasses import dataclass, fields
 from types import MappingProxyType
 
+from ..versions import ControllerVersion
 from .errors import ProtocolError
 
 __all__ = [
@@ -72,7 +74,7 @@ def _i(name: str, count: int = 1) -> RealtimeField:
     return RealtimeField(name, "int", count)
 
 
-# --- the tables (UR "Realtime Client Interface" guide; UR_FACTS.md §3) ---------------------
+# --- the tables (UR "Realtime Client Interface" guide; docs/controller-facts.md §10) --------------
 
 _HEAD = (  # identical in every version: offsets 4 .. 396
     _d("time"), _d("q_target", 6), _d("qd_target", 6), _d("qdd_target", 6),
@@ -130,6 +132,24 @@ class RealtimeLayout:
         self._ints = tuple(ints)
         self._int_vectors = tuple(int_vectors)
         self.names = tuple(f.name for f in table)
+        # one C-level call each: every field's value, the integer scalars, the integer
+        # vectors (the decoder's hot path)
+        self._get_all = operator.itemgetter(*keys)
+        self._int_names = tuple(name for name, _, _ in ints)
+        starts = [begin for _, begin, _ in ints]
+        # the first index once more: itemgetter of one key would return a bare value
+        self._get_ints = (operator.itemgetter(*starts, starts[0]) if starts
+                          else lambda values: ())
+        self._int_vector_names = tuple(name for name, _, _ in int_vectors)
+        self._get_int_vectors = operator.itemgetter(
+            *(slice(begin, end) for _, begin, end in int_vectors), slice(0, 0))
+
+    def slot(self, name: str) -> slice:
+        """Where field ``name`` sits in the packet's array of doubles (after the size field);
+        a KeyError for a field this layout does not send."""
+        start = (self.offset(name) - _HEADER.size) // 8
+        count = next(f.count for f in self.table if f.name == name)
+        return slice(start, start + count)
 
     def offset(self, name: str) -> int:
         """Byte offset of a field from the start of the packet (the size field is at 0)."""
@@ -185,10 +205,10 @@ def layout_for_size(size: int) -> RealtimeLayout:
 
 
 def _version_tuple(version: str) -> tuple[int, int]:
+    """``(major, minor)`` of ``version`` (:class:`urdsl.versions.ControllerVersion` parses)."""
     try:
-        parts = version.strip().split(".")
-        return int(parts[0]), int(parts[1]) if len(parts) > 1 else 0
-    except (ValueError, IndexError):
+        return ControllerVersion.parse(version).feature
+    except ValueError:
         raise ProtocolError(f"controller version {version!r} is not of the form 'major.minor'",
                             interface="realtime") from None
 
@@ -311,20 +331,19 @@ _INF = float("inf")
 def _decode_fields(layout: RealtimeLayout, data: bytes | bytearray | memoryview,
                    start: int) -> dict[str, object]:
     values = layout.struct.unpack_from(data, start + _HEADER.size)
-    out = dict(zip(layout.names, map(values.__getitem__, layout._keys), strict=False))
+    out = dict(zip(layout.names, layout._get_all(values), strict=True))
     try:
-        for name, begin, _ in layout._ints:
-            value = values[begin]
-            number = int(value)
-            if number != value:
+        scalars = layout._get_ints(values)
+        numbers = tuple(map(int, scalars))
+        if numbers != scalars:
+            raise ValueError
+        out.update(zip(layout._int_names, numbers, strict=False))
+        for name, segment in zip(layout._int_vector_names, layout._get_int_vectors(values),
+                                 strict=False):
+            vector = tuple(map(int, segment))
+            if vector != segment:
                 raise ValueError(name)
-            out[name] = number
-        for name, begin, end in layout._int_vectors:
-            segment = values[begin:end]
-            numbers = tuple(map(int, segment))
-            if numbers != segment:
-                raise ValueError(name)
-            out[name] = numbers
+            out[name] = vector
     except (ValueError, OverflowError):
         raise _int_error(layout, values) from None
     return out
@@ -501,6 +520,17 @@ class RealtimeDecoder:
 
     def feed(self, data: bytes) -> list[RealtimeState]:
         """Add received bytes; return every packet they complete, oldest first."""
+        if not self._buffer and self._error is None and len(data) >= _HEADER.size:
+            # the common case: exactly one whole packet, decoded without copying it
+            (size,) = _HEADER.unpack_from(data, 0)
+            if size == len(data) and MIN_SIZE <= size <= MAX_SIZE:
+                try:
+                    state = _decode_at(data, 0, size, self.version)
+                except ProtocolError as exc:
+                    self._error = exc
+                    raise
+                self.decoded += 1
+                return [state]
         frames = self._take(data)
         states = [self._decode(start, size) for start, size in frames]
         if frames:

@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 import struct
 from collections import deque
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -82,6 +82,16 @@ def _error(message: str, offset: int | None = None) -> ProtocolError:
 # --- recipes --------------------------------------------------------------------------------
 
 
+def _reader(plan: list[tuple[str, int, int]], skip: int):
+    """A function from a whole package's unpacked tuple (header first, ``skip`` items) to
+    the dict of name → value: one dict display, as a hand-written decoder would have."""
+    items = ", ".join(
+        f"{name!r}: flat[{skip + index}]" if count == 1
+        else f"{name!r}: flat[{skip + index}:{skip + index + count}]"
+        for name, index, count in plan)
+    return eval(f"lambda flat: {{{items}}}", {})  # noqa: S307 - names are repr() literals
+
+
 @dataclass(frozen=True)
 class Recipe:
     """A set-up recipe: ``id`` (``None`` for a v1 output recipe, which has none), the
@@ -94,6 +104,7 @@ class Recipe:
     _struct: struct.Struct | None = field(default=None, init=False, repr=False, compare=False)
     _plan: tuple[tuple[str, int, int], ...] = field(default=(), init=False, repr=False,
                                                     compare=False)
+    _whole: dict | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if len(self.names) != len(self.types):
@@ -112,6 +123,11 @@ class Recipe:
             index += count
         object.__setattr__(self, "_struct", struct.Struct("".join(fmt)))
         object.__setattr__(self, "_plan", tuple(plan))
+        body = "".join(fmt[1:])
+        object.__setattr__(self, "_whole", {
+            True: (struct.Struct(">HBB" + body), _reader(plan, 3)),   # with the recipe id
+            False: (struct.Struct(">HB" + body), _reader(plan, 2)),   # v1 output: none
+        })
 
     @property
     def not_found(self) -> tuple[str, ...]:
@@ -410,6 +426,12 @@ def _csv(payload: bytes) -> tuple[str, ...]:
     return tuple(text.split(",")) if text else ()
 
 
+def _names(payload: bytes) -> tuple[str, ...]:
+    """The names of a setup request. Empty entries are dropped and blanks around a name
+    stripped, as the controller does: ur_rtde ends its list with a comma."""
+    return tuple(name for name in (n.strip(" \t\r\n\x00") for n in _csv(payload)) if name)
+
+
 def _decode_text_message(payload: bytes, protocol: int) -> RtdeTextMessage:
     if protocol >= 2:
         pos = 0
@@ -440,8 +462,20 @@ def decode_rtde(package: bytes, *, sender: str, protocol: int = 2,
     Data packages are decoded with ``recipes`` (recipe id → :class:`Recipe`; a v1 output
     recipe is under ``None``).
     """
-    if sender not in ("client", "server"):
+    if sender != "server" and sender != "client":
         raise ValueError(f"sender must be 'client' or 'server', not {sender!r}")
+    if recipes and len(package) > 3 and package[2] == 85:  # 'U': the fast path
+        with_id = sender == "client" or protocol >= 2
+        recipe = recipes.get(package[3] if with_id else None)
+        if recipe is not None and recipe._whole is not None:
+            whole, read = recipe._whole[with_id]
+            if whole.size == len(package):
+                flat = whole.unpack_from(package)
+                if flat[0] == whole.size:
+                    message = object.__new__(DataPackage)
+                    message.__dict__.update(recipe_id=flat[2] if with_id else None,
+                                            values=read(flat))
+                    return message
     if len(package) < _HEADER.size:
         raise _error(f"{len(package)} bytes cannot hold the 3-byte package header", 0)
     size, code = _HEADER.unpack_from(package)
@@ -475,12 +509,12 @@ def _decode_payload(code: int, payload: bytes, sender: str, protocol: int,
             if len(payload) > MAX_NAMES_BYTES:
                 raise _error(f"output setup names take {len(payload)} bytes; at most "
                              f"{MAX_NAMES_BYTES} are allowed", 3)
-            return SetupOutputs(_csv(payload), frequency)
+            return SetupOutputs(_names(payload), frequency)
         if char == "I":
             if len(payload) > MAX_NAMES_BYTES:
                 raise _error(f"input setup names take {len(payload)} bytes; at most "
                              f"{MAX_NAMES_BYTES} are allowed", 3)
-            return SetupInputs(_csv(payload))
+            return SetupInputs(_names(payload))
     else:
         if char in "VSP":
             _exact(payload, 1, f"'{char}' reply")
@@ -679,7 +713,7 @@ class RtdeClient:
                 self.output_recipe = _recipe(recipe_id, request.names, types)  # type: ignore
             case InputSetupReply(recipe_id, types):
                 recipe = _recipe(recipe_id, request.names, types)  # type: ignore[union-attr]
-                if recipe.valid:
+                if recipe.valid and recipe_id:
                     self.input_recipes[recipe_id] = recipe
             case StartReply(accepted):
                 self.running = self.running or accepted
@@ -777,14 +811,39 @@ class RtdeServer:
         self._reply(RtdeTextMessage(message, "urdsl sim", level))
 
     def receive_data(self, data: bytes) -> list[Request]:
-        events: list[Request] = []
-        for package in self._framer.feed(data):
-            recipes: dict[int | None, Recipe] = dict(self.input_recipes)
-            event = decode_rtde(package, sender="client", protocol=self.protocol,
-                                recipes=recipes)
-            self._handle(event)  # type: ignore[arg-type]
-            events.append(event)  # type: ignore[arg-type]
-        return events
+        """Parse and handle every package ``data`` completes; raises :class:`ProtocolError`
+        at the first malformed one (see :meth:`packages` and :meth:`refuse` to go on)."""
+        return [self.receive_package(package) for package in self._framer.feed(data)]
+
+    def packages(self, data: bytes) -> list[bytes]:
+        """The whole packages ``data`` completes (header included), not yet handled; raises
+        :class:`ProtocolError` when the framing is lost (a size field below 3)."""
+        return self._framer.feed(data)
+
+    def receive_package(self, package: bytes) -> Request:
+        """Decode one whole package from the client, update the state, queue the reply."""
+        event = decode_rtde(package, sender="client", protocol=self.protocol,
+                            recipes=self.input_recipes)  # type: ignore[arg-type]
+        self._handle(event)  # type: ignore[arg-type]
+        return event  # type: ignore[return-value]
+
+    def refuse(self, package: bytes, reason: str) -> None:
+        """Answer a well-framed package that could not be decoded (``reason``): an error
+        text message, then the refusal its request type expects (none for data packages,
+        text messages and unknown types), so a client waiting for a reply gets one."""
+        self._text(f"package ignored: {reason}")
+        code = package[2] if len(package) > 2 else 0
+        if code in (RequestProtocolVersion.CODE, Start.CODE):
+            self._reply((ProtocolVersionReply if code == RequestProtocolVersion.CODE
+                         else StartReply)(False))
+        elif code == SetupOutputs.CODE:
+            self._reply(OutputSetupReply(0 if self.protocol >= 2 else None, ()))
+        elif code == SetupInputs.CODE:
+            self._reply(InputSetupReply(0, ()))
+        elif code == Pause.CODE:
+            self._reply(PauseReply(False))
+        elif code == GetControllerVersion.CODE:
+            self._reply(ControllerVersion(*self.version))
 
     def _types(self, names: tuple[str, ...], want_input: bool) -> list[str]:
         types = []
@@ -833,13 +892,13 @@ class RtdeServer:
                 recipe_id = 0
                 if all(t not in (NOT_FOUND, IN_USE) for t in types):
                     if self._next_input_id > 255:
+                        # refused with id 0, the types still named; earlier recipes live on
                         self._text("no more input recipe ids (255 per connection)")
-                        types = [NOT_FOUND] * len(names)
                     else:
                         recipe_id = self._next_input_id
                         self._next_input_id += 1
                 recipe = Recipe(recipe_id, names, tuple(types))
-                if recipe.valid:
+                if recipe.valid and recipe_id:
                     self.input_recipes[recipe_id] = recipe
                     self.ownership.claim(names, self)
                 self._reply(InputSetupReply(recipe_id, recipe.types))
@@ -861,6 +920,20 @@ class RtdeServer:
         """Control cycles per output package: ``floor(rate / frequency)``, at least 1 (the
         RTDE guide's rule for CB3; e-Series behaves the same at divisors of 500 Hz)."""
         return max(1, math.floor(self.rate / self.frequency + 1e-9))
+
+    def output_package(self, values: Sequence[object]) -> bytes:
+        """The data package of the output recipe from ``values`` in recipe order, vectors
+        flattened (the simulator's fast path: no dict, no dataclass). Raises
+        :class:`ProtocolError` without a usable output recipe or for values that do not fit."""
+        recipe = self.output_recipe
+        if recipe is None or recipe._struct is None:
+            raise _error("no usable output recipe")
+        try:
+            body = recipe._struct.pack(*values)
+        except struct.error as exc:
+            raise _error(f"data package for recipe {recipe.id}: {exc}") from None
+        head = b"" if recipe.id is None else bytes((recipe.id,))
+        return _HEADER.pack(_HEADER.size + len(head) + len(body), DataPackage.CODE) + head + body
 
     def outputs(self, values: Mapping[str, object], cycle: int) -> bytes | None:
         """The output data package for control cycle ``cycle`` (counting from 0), or

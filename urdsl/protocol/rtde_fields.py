@@ -1,8 +1,8 @@
 """The RTDE field table: every documented input and output name with its type, as data.
 
 Restated from UR's RTDE guide and cross-checked against the type table of UR's C++ client
-library (UR_FACTS.md §5.3–5.4). ``since`` gives the first CB3 and e-Series software version
-that knows a field (``None``: that series does not have it). Where the guide's version
+library (docs/controller-facts.md §12). ``since`` gives the first CB3 and e-Series software
+version that knows a field (``None``: that series does not have it). Where the guide's version
 column could not be checked, ``confirmed`` is false and ``since`` is the RTDE baseline
 (CB3 3.4, e-Series 5.0) or, for fields only newer e-Series releases have, 5.0 as well —
 a simulated controller then offers the field earlier than a real one would.
@@ -15,6 +15,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from types import MappingProxyType
+
+from ..versions import ControllerVersion
 
 __all__ = ["RtdeField", "FIELDS", "TYPES", "field_available", "output_fields", "input_fields"]
 
@@ -214,17 +216,13 @@ FIELDS: MappingProxyType[str, RtdeField] = MappingProxyType({f.name: f for f in 
 """Every RTDE name → its :class:`RtdeField`."""
 
 
-def _version(text: str) -> tuple[int, ...]:
-    return tuple(int(part) for part in text.split("."))
-
-
 def field_available(field: RtdeField, version: tuple[int, ...]) -> bool:
     """Does a controller of software ``version`` (``(5, 11, 1)``) know ``field``?"""
     cb3, eseries = field.since
     since = cb3 if version[0] < 5 else eseries
     if since is None:
         return False
-    return tuple(version) >= _version(since)
+    return ControllerVersion(*version[:4]) >= ControllerVersion.parse(since)
 
 
 def output_fields(version: tuple[int, ...] | None = None) -> list[RtdeField]:

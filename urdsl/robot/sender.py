@@ -54,7 +54,7 @@ END_GRACE = 0.3
 message may come just after the state message that shows the stop."""
 
 SCRIPT_PORTS = (30001, 30002, 30003)
-"""Ports that take URScript (UR_FACTS.md §7)."""
+"""Ports that take URScript (docs/controller-facts.md §7)."""
 
 READ_BEFORE_CLOSE = 79
 """Bytes to read on a separate sending connection before closing it: UR's manual says a

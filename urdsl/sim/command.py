@@ -82,13 +82,18 @@ def add_commands(commands) -> None:
 
 
 def cmd_sim(args: argparse.Namespace) -> int:
+    from .._cli import UsageError, robot_model
     from .controller import DEFAULT_START, SimError, VirtualController
 
     if not 0 <= args.port_offset <= 30000:
         return _usage("--port-offset must be between 0 and 30000")
     try:
+        robot = robot_model(args.robot)
+    except UsageError as error:
+        return _usage(str(error))
+    try:
         sim = VirtualController(
-            robot=args.robot, version=args.version, speed=args.speed,
+            robot=robot, version=args.version, speed=args.speed,
             start_joints=args.start_joints or DEFAULT_START, programs_dir=args.programs,
             powered=not args.powered_off)
     except SimError as error:

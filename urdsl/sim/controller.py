@@ -39,11 +39,13 @@ import numpy as np
 from ..script.diagnostics import ScriptError, ScriptSyntaxError
 from .framing import ScriptFramer
 from .state import (
+    ControllerMessage,
     ControllerVersion,
     JointMode,
     ProgramState,
     RobotMode,
     SafetyMode,
+    SimError,
     Snapshot,
 )
 
@@ -58,7 +60,8 @@ BOOT_TIME = 0.2
 seconds; clients poll ``robotmode`` either way."""
 
 UNLOCK_DELAY = 5.0
-"""Controller time (s) after a protective stop before it may be unlocked (UR_FACTS.md §6)."""
+"""Controller time (s) after a protective stop before it may be unlocked
+(docs/controller-facts.md §13)."""
 
 CATCH_UP = 50
 """Controller steps (100 ms on e-Series) the clock publishes late, back to back, after a
@@ -66,27 +69,6 @@ delay of the process; after a longer pause it skips ahead and counts the steps m
 
 FOREVER = 1e12
 """Robot time limit (s) for programs: a controller runs a ``while True`` cell forever."""
-
-
-class SimError(Exception):
-    """A request the virtual controller refuses (bad configuration, unknown program file)."""
-
-
-@dataclass(frozen=True)
-class ControllerMessage:
-    """Something the controller tells its primary clients.
-
-    ``kind``: ``"runtime_exception"`` (syntax and runtime errors; ``line``/``column`` 1-based
-    in the program), ``"text"`` (``textmsg``), ``"popup"``, ``"safety"`` (a protective stop),
-    ``"error"`` (a program refused). ``time`` is controller time in s.
-    """
-
-    time: float
-    kind: str
-    text: str
-    line: int = 0
-    column: int = 0
-    title: str = ""
 
 
 @dataclass
@@ -168,6 +150,9 @@ class VirtualController:
             self.version = ControllerVersion.parse(version)
         except ValueError as error:
             raise SimError(str(error)) from None
+        if self.version.major not in (3, 5):
+            raise SimError(f"controller version {version}: the virtual controller imitates "
+                           "CB3 software 3.x and e-Series software 5.x")
         if cb3 and self.version.e_series:
             raise SimError(f"{robot} is a CB3 arm: it runs software 3.x, not {version}")
         if not cb3 and not self.version.e_series:
@@ -176,7 +161,7 @@ class VirtualController:
         q = np.asarray(start_joints, dtype=float)
         if q.shape != (6,) or not np.isfinite(q).all():
             raise SimError("start joints must be 6 finite angles in rad")
-        self.robot_name = robot
+        self.robot_name = getattr(self.spec, "name", robot)
         self.serial_number = serial_number
         self.speed = float(speed)
         self.step_time = 0.002 if self.version.e_series else 0.008
@@ -798,8 +783,10 @@ class VirtualController:
             return "the joint positions are not finite"
         below, above = q < self.q_min - 1e-9, q > self.q_max + 1e-9
         if below.any() or above.any():
+            from ..kinematics.models import JOINT_NAMES
+
             joint = int(np.argmax(below | above))
-            return (f"C153A1 Protective Stop: joint {joint} ({_JOINT_NAMES[joint]}) position "
+            return (f"C153A1 Protective Stop: joint {joint} ({JOINT_NAMES[joint]}) position "
                     f"limit violated: {q[joint]:.4f} rad")
         if self.spec is not None:
             points = link_points(self.spec, q, self._tcp_offset)
@@ -885,7 +872,6 @@ class VirtualController:
 
 # ---- helpers ---------------------------------------------------------------------------------
 
-_JOINT_NAMES = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
 _POINT_NAMES = ("the shoulder", "the elbow", "wrist 1", "wrist 2", "wrist 3", "the flange")
 
 
@@ -978,13 +964,17 @@ def _program_name(module: Any) -> str | None:
 
 
 def _load_model(name: str) -> Any:
+    """The kinematics of model ``name`` through the one model resolver
+    (:func:`urdsl.kinematics.model_spec`: any case, ``"UR8 Long"``)."""
     try:
-        from ..kinematics import MODELS, Robot
+        from ..kinematics import Robot
+        from ..kinematics.errors import KinematicsError
     except ImportError as error:  # pragma: no cover - the kinematics layer is part of urdsl
         raise SimError(f"the kinematics layer is not available: {error}") from None
-    if name.lower() not in MODELS:
-        raise SimError(f"unknown robot model {name!r}; known: {', '.join(sorted(MODELS))}")
-    return Robot.model(name.lower())
+    try:
+        return Robot.model(name)
+    except KinematicsError as error:
+        raise SimError(str(error)) from None
 
 
 _WIRED = False

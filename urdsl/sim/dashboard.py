@@ -1,45 +1,54 @@
 """The dashboard server's commands and replies (port 29999), without sockets.
 
-One line in, one line out, with the replies of UR_FACTS.md §6. The virtual controller is
-always in remote control. ``load`` reads URScript files (``.script``, ``.urscript``,
-``.txt``) and PolyScope programs (``.urp``, compiled with their installation as ``urdsl
-compile`` does) from the controller's programs folder; a file that cannot be read or
-compiled answers ``Error while loading program``.
+One line in, one line out, with the replies of docs/controller-facts.md §13. The virtual
+controller is always in remote control. ``load`` reads URScript files (``.script``,
+``.urscript``, ``.txt``) and PolyScope programs (``.urp``, compiled with their installation
+as ``urdsl compile`` does) from the controller's programs folder; a file that cannot be read
+or compiled answers ``Error while loading program``.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from .controller import SimError
-from .state import ProgramState
+from ..protocol.dashboard import MAX_LINE, WELCOME, LineBuffer
+from ..protocol.errors import ProtocolError
+from .state import ProgramState, SimError
 
 __all__ = ["WELCOME", "DashboardSession", "MAX_LINE"]
 
-WELCOME = "Connected: Universal Robots Dashboard Server"
-MAX_LINE = 4096
-"""Longest command line (bytes); a longer one is answered as not understood."""
-
 
 class DashboardSession:
-    """Answers one client's dashboard commands against a :class:`VirtualController`."""
+    """Answers one client's dashboard commands against a :class:`VirtualController`.
+
+    Lines are cut by the protocol's :class:`~urdsl.protocol.dashboard.LineBuffer`, with its
+    one line limit (:data:`~urdsl.protocol.dashboard.MAX_LINE` bytes): a longer line is
+    answered as not understood and the connection lives on.
+    """
 
     def __init__(self, controller: Any) -> None:
         self.sim = controller
-        self._buffer = b""
+        self._lines = LineBuffer()
         self.closed = False
         self._operational_mode: str | None = None
 
+    @property
+    def pending(self) -> int:
+        """Bytes of an unfinished command line held back (at most :data:`MAX_LINE`)."""
+        return self._lines.pending
+
     def receive(self, data: bytes) -> list[str]:
         """Feed bytes; return the reply lines (without line breaks)."""
-        self._buffer += data
+        try:
+            lines = self._lines.feed(data)
+        except ProtocolError:
+            self._lines = LineBuffer()
+            return [] if self.closed else ["could not understand: '<line too long>'"]
         replies = []
-        while b"\n" in self._buffer and not self.closed:
-            raw, self._buffer = self._buffer.split(b"\n", 1)
-            replies.append(self.command(raw.decode("utf-8", errors="replace").strip("\r ")))
-        if len(self._buffer) > MAX_LINE:
-            self._buffer = b""
-            replies.append("could not understand: '<line too long>'")
+        for line in lines:
+            if self.closed:
+                break
+            replies.append(self.command(line.strip("\r ")))
         return replies
 
     def command(self, line: str) -> str:

@@ -1,6 +1,6 @@
 """Cutting the script text that arrives on ports 30001-30003 into programs (no sockets).
 
-The controller's rules (UR_FACTS.md §7): a program starts with ``def name():`` or
+The controller's rules (docs/controller-facts.md §7): a program starts with ``def name():`` or
 ``sec name():`` in column 0 and ends with ``end`` in column 0; lines outside such a block
 ("bare lines") run as a one-off program. Text arrives in arbitrary TCP chunks, so a block is
 buffered until its ``end`` line, and bare lines are handed over one complete line at a time,

@@ -31,15 +31,21 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from . import wire
-from .controller import ControllerMessage
 from .dashboard import WELCOME, DashboardSession
 from .rtde import InputOwners, RtdeProtocolError, RtdeSession
-from .state import Snapshot
+from .state import ControllerMessage, Snapshot
+from .wire import (
+    encode_realtime,
+    encode_robot_state,
+    encode_runtime_exception,
+    encode_safety_message,
+    encode_text_message,
+    encode_version_message,
+)
 
 __all__ = ["SimServers", "STANDARD_PORTS"]
 
-_log = logging.getLogger("urdsl.sim")
+_log = logging.getLogger(__name__.rpartition(".")[0])  # "urdsl.sim"
 
 STANDARD_PORTS = {
     "dashboard": 29999, "primary": 30001, "secondary": 30002, "realtime": 30003,
@@ -265,7 +271,7 @@ class SimServers:
             kind = client.kind
             if kind in ("realtime", "realtime_ro"):
                 if realtime is None:
-                    realtime = wire.encode_realtime(snap, self.sim.version)
+                    realtime = encode_realtime(snap, self.sim.version)
                 client.send(realtime)
             elif kind == "rtde":
                 session: RtdeSession = client.session
@@ -283,7 +289,7 @@ class SimServers:
                     client.send(data)
             elif kind != "dashboard" and state_due:
                 if state is None:
-                    state = wire.encode_robot_state(snap, self.sim.version)
+                    state = encode_robot_state(snap, self.sim.version)
                 client.send(state)
 
     def _on_message(self, message: ControllerMessage) -> None:
@@ -386,8 +392,8 @@ class SimServers:
                 client.framer = sim.framer()
             if kind in ("primary", "secondary", "primary_ro", "secondary_ro"):
                 snap = sim.snapshot()
-                client.send(wire.encode_version_message(sim.version, snap.time))
-                client.send(wire.encode_robot_state(
+                client.send(encode_version_message(sim.version, snap.time))
+                client.send(encode_robot_state(
                     snap, sim.version, sim.spec, (sim.kinematics.qd_max, sim.q_min, sim.q_max)
                     if hasattr(sim.kinematics, "qd_max") else None, configuration=True))
         # only now may the clock and the message publisher add to its stream: the version
@@ -502,14 +508,14 @@ def _encode_message(message: ControllerMessage) -> bytes:
     import re
 
     if message.kind == "runtime_exception":
-        return wire.encode_runtime_exception(message.line, message.column, message.text,
+        return encode_runtime_exception(message.line, message.column, message.text,
                                              message.time)
     if message.kind == "safety":
         match = re.match(r"C(\d+)A(\d+)", message.text)
         code, argument = (int(match.group(1)), int(match.group(2))) if match else (0, 0)
         from .state import SafetyMode
 
-        return (wire.encode_safety_message(code, argument, SafetyMode.PROTECTIVE_STOP,
+        return (encode_safety_message(code, argument, SafetyMode.PROTECTIVE_STOP,
                                            message.time)
-                + wire.encode_text_message(message.text, message.time))
-    return wire.encode_text_message(message.text, message.time)
+                + encode_text_message(message.text, message.time))
+    return encode_text_message(message.text, message.time)

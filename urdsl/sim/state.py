@@ -1,20 +1,22 @@
 """What the virtual controller publishes: the modes of a UR controller and one snapshot of the
 simulated robot per controller step.
 
-The numeric codes are the controller's (UR_FACTS.md §4.4): they appear unchanged on the
+The numeric codes are the controller's (docs/controller-facts.md §5): they appear unchanged on the
 realtime, primary and RTDE interfaces, and the dashboard prints their names.
 """
 
 from __future__ import annotations
 
 import enum
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..versions import ControllerVersion
+
 __all__ = [
     "RobotMode", "SafetyMode", "ProgramState", "JointMode", "ControllerVersion", "Snapshot",
+    "SimError", "ControllerMessage",
 ]
 
 
@@ -68,38 +70,25 @@ class JointMode(enum.IntEnum):
     IDLE = 255
 
 
-_VERSION = re.compile(r"^\s*(\d+)\.(\d+)(?:\.(\d+))?(?:\.(\d+))?\s*$")
+class SimError(Exception):
+    """A request the virtual controller refuses (bad configuration, unknown program file)."""
 
 
-@dataclass(frozen=True, order=True)
-class ControllerVersion:
-    """A controller software version, e.g. 5.15 or 3.15.7.106331 (major.minor.bugfix.build)."""
+@dataclass(frozen=True)
+class ControllerMessage:
+    """Something the controller tells its primary clients.
 
-    major: int
-    minor: int
-    bugfix: int = 0
-    build: int = 0
+    ``kind``: ``"runtime_exception"`` (syntax and runtime errors; ``line``/``column`` 1-based
+    in the program), ``"text"`` (``textmsg``), ``"popup"``, ``"safety"`` (a protective stop),
+    ``"error"`` (a program refused). ``time`` is controller time in s.
+    """
 
-    @classmethod
-    def parse(cls, text: str) -> ControllerVersion:
-        """``"5.15"``, ``"5.15.2"`` or ``"5.15.2.1234"``; raises ValueError otherwise, and for
-        majors other than 3 (CB3) and 5 (e-Series), the software the virtual controller
-        imitates."""
-        match = _VERSION.match(text)
-        if match is None:
-            raise ValueError(f"controller version {text!r} is not MAJOR.MINOR[.BUGFIX[.BUILD]]")
-        major, minor, bugfix, build = (int(part) if part else 0 for part in match.groups())
-        if major not in (3, 5):
-            raise ValueError(f"controller version {text}: the virtual controller imitates "
-                             "CB3 software 3.x and e-Series software 5.x")
-        return cls(major, minor, bugfix, build)
-
-    @property
-    def e_series(self) -> bool:
-        return self.major >= 5
-
-    def __str__(self) -> str:
-        return f"{self.major}.{self.minor}.{self.bugfix}.{self.build}"
+    time: float
+    kind: str
+    text: str
+    line: int = 0
+    column: int = 0
+    title: str = ""
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,22 +1,40 @@
-"""Server-side byte formats of the virtual controller: realtime packets, primary/secondary
-robot state and robot messages (no sockets).
+"""What the virtual controller sends on its realtime and primary/secondary ports (no sockets).
 
-Layouts follow ../shared/reference/UR_FACTS.md §3 (realtime) and §4 (primary/secondary); all
-big-endian. Quantities the simulation does not model (motor currents, temperatures,
-voltages, forces) are sent as 0.0 so that clients parse complete packets; the real values
-are what the arm moves (joints, speeds, TCP pose and speed, modes, I/O).
-
-The sans-I/O client side (decoders) lives in :mod:`urdsl.protocol`; these encoders exist
-because the simulator had to serve before that layer landed (see the issue-8 note).
+The bytes are :mod:`urdsl.protocol`'s: realtime packets follow the one layout table per
+controller version of :mod:`urdsl.protocol.realtime` (docs/controller-facts.md §10), the
+robot state and robot messages the sub-package and message encoders of
+:mod:`urdsl.protocol.primary` (§11), in the layout variant the version sends. This module
+only says which snapshot value each field carries. Quantities the simulation does not model
+(motor currents, temperatures, voltages, forces) are sent as 0 so that clients parse
+complete packets.
 """
 
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
-from .state import ControllerVersion, ProgramState, RobotMode, SafetyMode, Snapshot
+from ..protocol.primary import (
+    AdditionalInfo,
+    CartesianInfo,
+    ConfigurationData,
+    ForceModeData,
+    JointData,
+    KinematicsInfo,
+    MasterboardData,
+    RobotModeData,
+    RobotState,
+    RuntimeExceptionMessage,
+    SafetyModeMessage,
+    TextMessage,
+    ToolData,
+    VersionMessage,
+)
+from ..protocol.realtime import layout_for_version
+from .state import ControllerVersion, SafetyMode, Snapshot
 
 __all__ = [
     "realtime_size", "encode_realtime", "encode_robot_state", "encode_version_message",
@@ -26,213 +44,199 @@ __all__ = [
 
 ROBOT_STATE = 16
 ROBOT_MESSAGE = 20
+_ZEROS = (0.0,) * 6
 SOURCE_CONTROLLER = -2  # [U] the int8 source the controller puts on its own messages
 
 
 # ---- realtime (30003 / 30013) ---------------------------------------------------------------
 
+_REALTIME: tuple[tuple[str, Callable[[Snapshot], Any]], ...] = (
+    # the controller's behaviour: which snapshot value each named field of the protocol's
+    # layout carries (the planner's path is the target); fields not named here are 0
+    ("time", lambda s: s.time), ("controller_timer", lambda s: s.time),
+    ("q_target", lambda s: s.q), ("qd_target", lambda s: s.qd),
+    ("qdd_target", lambda s: s.qdd), ("q_actual", lambda s: s.q), ("qd_actual", lambda s: s.qd),
+    ("tool_vector_actual", lambda s: s.tcp), ("tcp_speed_actual", lambda s: s.tcp_speed),
+    ("tool_vector_target", lambda s: s.tcp), ("tcp_speed_target", lambda s: s.tcp_speed),
+    ("digital_input_bits", lambda s: s.digital_inputs),
+    ("robot_mode", lambda s: int(s.robot_mode)),
+    ("joint_modes", lambda s: int(s.joint_mode)),
+    ("safety_mode", lambda s: int(s.safety_mode)),
+    ("speed_scaling", lambda s: s.speed_scaling),
+    ("digital_outputs", lambda s: s.digital_outputs),
+    ("program_state", lambda s: int(s.program_state)),
+    ("elbow_position", lambda s: s.elbow), ("elbow_velocity", lambda s: s.elbow_speed),
+    ("safety_status", lambda s: int(s.safety_mode)),
+    ("payload_mass", lambda s: s.payload_mass), ("payload_cog", lambda s: s.payload_cog),
+)
+
+_PLANS: dict[ControllerVersion, tuple[bytes, int, tuple]] = {}
+
+
+def _realtime_plan(version: ControllerVersion) -> tuple[bytes, int, tuple]:
+    """(size field, doubles, (slot, value) pairs) of ``version``'s layout, from the one
+    layout table of :mod:`urdsl.protocol.realtime`."""
+    plan = _PLANS.get(version)
+    if plan is None:
+        layout = layout_for_version(f"{version.major}.{version.minor}")
+        slots = tuple((layout.slot(name), value) for name, value in _REALTIME
+                      if name in layout.names)
+        plan = _PLANS[version] = (struct.pack(">i", layout.size), layout.doubles, slots)
+    return plan
+
 
 def realtime_size(version: ControllerVersion) -> int:
     """Total packet size (bytes, including the int32 size field) for a software version
-    (UR_FACTS.md §3.3; 3.14/3.15 and 5.9 are sent as 1116, the last confirmed layout [U])."""
-    major, minor = version.major, version.minor
-    if major == 3:
-        if minor <= 1:
-            return 1044
-        if minor <= 4:
-            return 1060
-        if minor <= 9:
-            return 1108
-        return 1116
-    if minor <= 3:
-        return 1108
-    if minor <= 9:
-        return 1116
-    return 1220
-
-
-def _col(number: int) -> int:
-    """Index in the double array of the realtime table's 1-based (gnuplot) column."""
-    return number - 1
+    (docs/controller-facts.md §10)."""
+    return layout_for_version(f"{version.major}.{version.minor}").size
 
 
 def encode_realtime(snap: Snapshot, version: ControllerVersion) -> bytes:
-    """One realtime packet: int32 size, then doubles at the offsets of UR_FACTS.md §3.1."""
-    size = realtime_size(version)
-    values = np.zeros((size - 4) // 8)
-    values[_col(1)] = snap.time
-    values[_col(2):_col(8)] = snap.q           # q target (the planner's path is the target)
-    values[_col(8):_col(14)] = snap.qd         # qd target
-    values[_col(14):_col(20)] = snap.qdd       # qdd target
-    values[_col(32):_col(38)] = snap.q         # q actual
-    values[_col(38):_col(44)] = snap.qd        # qd actual
-    values[_col(56):_col(62)] = snap.tcp       # tool vector actual
-    values[_col(62):_col(68)] = snap.tcp_speed
-    values[_col(74):_col(80)] = snap.tcp       # tool vector target
-    values[_col(80):_col(86)] = snap.tcp_speed
-    values[_col(86)] = snap.digital_inputs
-    values[_col(93)] = snap.time               # controller timer
-    values[_col(95)] = int(snap.robot_mode)
-    values[_col(96):_col(102)] = int(snap.joint_mode)
-    values[_col(102)] = int(snap.safety_mode)
-    values[_col(118)] = snap.speed_scaling
-    if size > 1044:
-        values[_col(131)] = snap.digital_outputs
-        values[_col(132)] = int(snap.program_state)
-    if size > 1060:
-        values[_col(133):_col(136)] = snap.elbow
-        values[_col(136):_col(139)] = snap.elbow_speed
-    if size > 1108:
-        values[_col(139)] = int(snap.safety_mode)
-    if size > 1116:
-        values[_col(143)] = snap.payload_mass
-        values[_col(144):_col(147)] = snap.payload_cog
-    return struct.pack(">i", size) + values.astype(">f8").tobytes()
+    """One realtime packet of ``version``'s layout for ``snap``."""
+    head, doubles, slots = _realtime_plan(version)
+    values = np.zeros(doubles)
+    for where, value in slots:
+        values[where] = value(snap)
+    return head + values.astype(">f8").tobytes()
 
 
 # ---- primary / secondary (30001 / 30002, read-only 30011 / 30012) ----------------------------
 
 
-def _package(kind: int, body: bytes) -> bytes:
-    """A ROBOT_STATE sub-package: uint32 size (incl. the 5-byte header), uint8 type, body."""
-    return struct.pack(">IB", len(body) + 5, kind) + body
+def _variant(version: ControllerVersion, *labels: str) -> str:
+    """The newest of a sub-package's layout ``labels`` (first versions that send them) that
+    ``version`` sends."""
+    chosen = labels[0]
+    for label in labels:
+        if version >= ControllerVersion.parse(label):
+            chosen = label
+    return chosen
 
 
-def _robot_mode_data(snap: Snapshot, version: ControllerVersion) -> bytes:
-    running = snap.program_running
-    head = struct.pack(
-        ">Q???????BBdd", int(snap.time * 1000), True, snap.power_on, snap.power_on,
-        False, snap.safety_mode == SafetyMode.PROTECTIVE_STOP, running, snap.program_paused,
-        max(int(snap.robot_mode), 0), 0, snap.target_speed_fraction, snap.speed_scaling)
-    if version < ControllerVersion(3, 2):
-        return _package(0, head)                                     # 38 bytes
-    head += struct.pack(">d", 1.0)                                   # target speed limit
-    if version < ControllerVersion(3, 5):
-        return _package(0, head)                                     # 46 bytes
-    return _package(0, head + b"\x00")                               # 47 bytes
+def _robot_mode_data(snap: Snapshot, version: ControllerVersion) -> RobotModeData:
+    variant = _variant(version, "3.0", "3.2", "3.5")
+    return RobotModeData(
+        variant=variant, timestamp=int(snap.time * 1000), is_real_robot_connected=True,
+        is_real_robot_enabled=snap.power_on, is_robot_power_on=snap.power_on,
+        is_emergency_stopped=False,
+        is_protective_stopped=snap.safety_mode == SafetyMode.PROTECTIVE_STOP,
+        is_program_running=snap.program_running, is_program_paused=snap.program_paused,
+        robot_mode=max(int(snap.robot_mode), 0), control_mode=0,
+        target_speed_fraction=snap.target_speed_fraction, speed_scaling=snap.speed_scaling,
+        target_speed_fraction_limit=None if variant == "3.0" else 1.0,
+        reserved=0 if variant == "3.5" else None)
 
 
-def _joint_data(snap: Snapshot) -> bytes:
-    body = b"".join(
-        struct.pack(">dddffffB", snap.q[i], snap.q[i], snap.qd[i], 0.0, 0.0, 0.0, 0.0,
-                    int(snap.joint_mode))
-        for i in range(6))
-    return _package(1, body)                                         # 251 bytes
+def _joint_data(snap: Snapshot) -> JointData:
+    q, qd = tuple(snap.q.tolist()), tuple(snap.qd.tolist())
+    return JointData(variant="3.0", q_actual=q, q_target=q, qd_actual=qd, i_actual=_ZEROS,
+                     v_actual=_ZEROS, t_motor=_ZEROS, t_micro=_ZEROS,
+                     joint_mode=(int(snap.joint_mode),) * 6)
 
 
-def _tool_data(snap: Snapshot) -> bytes:
-    body = struct.pack(">BBddfBffB", 0, 0, snap.tool_analog_inputs[0],
-                       snap.tool_analog_inputs[1], 0.0, 0, 0.0, 0.0, 0)
-    return _package(2, body)                                         # 37 bytes
+def _tool_data(snap: Snapshot) -> ToolData:
+    return ToolData(variant="3.0", analog_input_2=snap.tool_analog_inputs[0],
+                    analog_input_3=snap.tool_analog_inputs[1])
 
 
-def _masterboard_data(snap: Snapshot) -> bytes:
-    body = struct.pack(
-        ">IIBBddBBddffffBBBIBBB",
-        snap.digital_inputs & 0xFFFFFFFF, snap.digital_outputs & 0xFFFFFFFF, 0, 0,
-        snap.analog_inputs[0], snap.analog_inputs[1], 0, 0,
-        snap.analog_outputs[0], snap.analog_outputs[1], 0.0, 0.0, 0.0, 0.0,
-        int(snap.safety_mode), snap.safety_mode == SafetyMode.REDUCED, False, 0, 0, False, 0)
-    return _package(3, body)
+def _masterboard_data(snap: Snapshot, version: ControllerVersion) -> MasterboardData:
+    variant = _variant(version, "3.0", "3.2", "5.0")
+    return MasterboardData(
+        variant=variant, digital_input_bits=snap.digital_inputs & 0xFFFFFFFF,
+        digital_output_bits=snap.digital_outputs & 0xFFFFFFFF,
+        analog_input_0=snap.analog_inputs[0], analog_input_1=snap.analog_inputs[1],
+        analog_output_0=snap.analog_outputs[0], analog_output_1=snap.analog_outputs[1],
+        safety_mode=int(snap.safety_mode),
+        in_reduced_mode=snap.safety_mode == SafetyMode.REDUCED,
+        operational_mode_selector_input=None if variant == "3.0" else 0,
+        three_position_enabling_device_input=None if variant == "3.0" else False,
+        reserved_2=0 if variant == "5.0" else None)
 
 
-def _cartesian_info(snap: Snapshot, version: ControllerVersion) -> bytes:
-    body = struct.pack(">6d", *snap.tcp)
-    if version >= ControllerVersion(3, 2):
-        body += struct.pack(">6d", *snap.tcp_offset)
-    return _package(4, body)                                         # 101 bytes (53 < 3.2)
+def _cartesian_info(snap: Snapshot, version: ControllerVersion) -> CartesianInfo:
+    variant = _variant(version, "3.0", "3.2")
+    return CartesianInfo(variant=variant, tcp_pose=tuple(snap.tcp.tolist()),
+                         tcp_offset=tuple(snap.tcp_offset.tolist()) if variant == "3.2"
+                         else None)
 
 
-def _kinematics_info(spec) -> bytes:
-    body = struct.pack(">6I", *([0] * 6))
-    body += struct.pack(">24d", *([0.0] * 6), *spec.dh_a, *spec.dh_d, *spec.dh_alpha)
-    return _package(5, body + struct.pack(">I", 0))                  # 225 bytes
+def _kinematics_info(spec: Any) -> KinematicsInfo:
+    return KinematicsInfo(variant="3.0", checksum=(0,) * 6, dh_theta=_ZEROS,
+                          dh_a=tuple(spec.dh_a), dh_d=tuple(spec.dh_d),
+                          dh_alpha=tuple(spec.dh_alpha), calibration_status=0)
 
 
-def _configuration_data(spec, qd_max, q_min, q_max) -> bytes:
-    limits = [v for i in range(6) for v in (q_min[i], q_max[i])]
-    limits = [v if np.isfinite(v) else np.sign(v) * 1e9 for v in limits]
-    speeds = [v for i in range(6) for v in (qd_max[i], 0.0)]  # max accel: not published
-    defaults = (1.05, 1.4, 0.25, 1.2, 0.0)  # movej v, a; movel v, a (script defaults); eq radius
-    body = struct.pack(">12d12d5d", *limits, *speeds, *defaults)
-    body += struct.pack(">24d", *spec.dh_a, *spec.dh_d, *spec.dh_alpha, *([0.0] * 6))
-    body += struct.pack(">4i", 0, 0, int(getattr(spec, "robot_type", 0)), 0)
-    return _package(6, body)                                         # 445 bytes
+def _configuration_data(spec: Any, version: ControllerVersion, qd_max, q_min,
+                        q_max) -> ConfigurationData:
+    def finite(values) -> tuple[float, ...]:
+        return tuple(float(v) if np.isfinite(v) else float(np.sign(v)) * 1e9 for v in values)
 
-
-def _force_mode_data() -> bytes:
-    return _package(7, struct.pack(">7d", *([0.0] * 7)))             # 61 bytes
-
-
-def _additional_info(version: ControllerVersion) -> bytes:
-    if version.e_series:  # freedrive button pressed / enabled, IO-enabled freedrive [U]
-        return _package(8, struct.pack(">???", False, False, False))
-    return _package(8, struct.pack(">??", False, False))             # teach button
+    e_series = _variant(version, "3.0", "5.0") == "5.0"
+    return ConfigurationData(
+        variant="5.0" if e_series else "3.0", joint_min_limit=finite(q_min),
+        joint_max_limit=finite(q_max), joint_max_speed=tuple(float(v) for v in qd_max),
+        joint_max_acceleration=_ZEROS,  # not published by the models
+        # movej v, a; movel v, a (the script defaults); equivalent radius
+        v_joint_default=1.05, a_joint_default=1.4, v_tool_default=0.25, a_tool_default=1.2,
+        eq_radius=0.0, dh_a=tuple(spec.dh_a), dh_d=tuple(spec.dh_d),
+        dh_alpha=tuple(spec.dh_alpha), dh_theta=_ZEROS,
+        robot_type=int(getattr(spec, "robot_type", 0)),
+        reserved_1=0 if e_series else None, reserved_2=0 if e_series else None)
 
 
 def encode_robot_state(snap: Snapshot, version: ControllerVersion, spec=None,
                        limits: tuple | None = None, configuration: bool = False) -> bytes:
-    """A ROBOT_STATE message (type 16): robot mode, joint, tool, masterboard, cartesian,
+    """A ROBOT_STATE message (type 16) in ``version``'s sub-package layouts
+    (:mod:`urdsl.protocol.primary`): robot mode, joint, tool, masterboard, cartesian,
     (kinematics and configuration when ``configuration`` and a model ``spec`` are given),
-    force mode and additional info sub-packages. ``limits`` = (qd_max, q_min, q_max)."""
-    parts = [_robot_mode_data(snap, version), _joint_data(snap), _tool_data(snap),
-             _masterboard_data(snap), _cartesian_info(snap, version)]
+    force mode and additional info. ``limits`` = (qd_max, q_min, q_max)."""
+    parts: list[Any] = [_robot_mode_data(snap, version), _joint_data(snap), _tool_data(snap),
+                        _masterboard_data(snap, version), _cartesian_info(snap, version)]
     if configuration and spec is not None:
         parts.append(_kinematics_info(spec))
         if limits is not None:
-            parts.append(_configuration_data(spec, *limits))
+            parts.append(_configuration_data(spec, version, *limits))
     if version >= ControllerVersion(3, 2):
-        parts += [_force_mode_data(), _additional_info(version)]
-    body = b"".join(parts)
-    return struct.pack(">iB", len(body) + 5, ROBOT_STATE) + body
+        e_series = version.e_series
+        parts += [ForceModeData(variant="3.0", wrench=_ZEROS, robot_dexterity=0.0),
+                  AdditionalInfo(variant="5.0" if e_series else "3.2",
+                                 io_enabled_freedrive=False if e_series else None,
+                                 reserved=0 if e_series else None)]
+    return RobotState(tuple(parts)).encode()
 
 
-def _robot_message(time: float, kind: int, body: bytes) -> bytes:
-    head = struct.pack(">QbB", int(time * 1000), SOURCE_CONTROLLER, kind)
-    payload = head + body
-    return struct.pack(">iB", len(payload) + 5, ROBOT_MESSAGE) + payload
+def _text(text: str) -> str:
+    """``text`` as it survives UTF-8 (lone surrogates replaced)."""
+    return text.encode("utf-8", errors="replace").decode("utf-8")
+
+
+def _ms(time: float) -> int:
+    return int(time * 1000)
 
 
 def encode_version_message(version: ControllerVersion, time: float = 0.0,
                            build_date: str = "urdsl virtual controller") -> bytes:
     """ROBOT_MESSAGE VERSION (type 3), the first message on 30001/30002 (layout of 3.12+/5.x)."""
-    name = b"URControl"
-    body = struct.pack(">b", len(name)) + name
-    body += struct.pack(">BBii", version.major, version.minor, version.bugfix, version.build)
-    return _robot_message(time, 3, body + build_date.encode("utf-8"))
+    return VersionMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER,
+                          project_name="URControl", major=version.major, minor=version.minor,
+                          bugfix=version.bugfix, build_number=version.build,
+                          build_date=build_date).encode()
 
 
 def encode_text_message(text: str, time: float = 0.0) -> bytes:
     """ROBOT_MESSAGE TEXT (type 0): what ``textmsg`` shows."""
-    return _robot_message(time, 0, text.encode("utf-8", errors="replace"))
+    return TextMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER, text=_text(text)).encode()
 
 
 def encode_runtime_exception(line: int, column: int, text: str, time: float = 0.0) -> bytes:
-    """ROBOT_MESSAGE RUNTIME_EXCEPTION (type 10): uint32 line, uint32 column, text."""
-    body = struct.pack(">II", max(line, 0), max(column, 0))
-    return _robot_message(time, 10, body + text.encode("utf-8", errors="replace"))
+    """ROBOT_MESSAGE RUNTIME_EXCEPTION (type 10): line, column (1-based), text."""
+    return RuntimeExceptionMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER,
+                                   line=max(line, 0), column=max(column, 0),
+                                   text=_text(text)).encode()
 
 
 def encode_safety_message(code: int, argument: int, mode: SafetyMode, time: float = 0.0) -> bytes:
-    """ROBOT_MESSAGE SAFETY_MODE (type 5): int32 code, int32 argument, uint8 safety mode,
-    uint32 report data type (0: none), uint32 report data."""
-    body = struct.pack(">iiBII", code, argument, int(mode), 0, 0)
-    return _robot_message(time, 5, body)
-
-
-def robot_status_bits(snap: Snapshot) -> int:
-    """RTDE ``robot_status_bits``: bit 0 power on, 1 program running, 2 teach button,
-    3 power button."""
-    return int(snap.power_on) | int(snap.program_running) << 1
-
-
-def safety_status_bits(snap: Snapshot) -> int:
-    """RTDE ``safety_status_bits``: bit 0 normal, 1 reduced, 2 protective stop, 3 recovery,
-    4 safeguard stop, 5 system e-stop, 6 robot e-stop, 7 e-stop, 8 violation, 9 fault."""
-    mode = snap.safety_mode
-    if mode == SafetyMode.NORMAL:
-        return 1
-    return 1 << (int(mode) - 1) if 1 <= int(mode) <= 10 else 0
-
-
-__all__ += ["robot_status_bits", "safety_status_bits", "ProgramState", "RobotMode"]
+    """ROBOT_MESSAGE SAFETY_MODE (type 5): code, argument, safety mode, no report data."""
+    return SafetyModeMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER, code=code,
+                             argument=argument, safety_mode_type=int(mode),
+                             report_data_type=0, report_data=0).encode()
