@@ -157,3 +157,34 @@ def test_nested_loops_keep_their_findings():
     # a wait after the inner loop's end belongs to the outer loop only
     text = "x = 0\nwhile x < 5:\n  while x < 5:\n    y = 1\n  end\n  sleep(1)\nend\n"
     assert busy(text) == [3]
+
+
+def test_findings_on_a_long_line_show_a_window_of_it(tmp_path, capsys):
+    # 5,000 nested calls of an unknown function: 5,000 findings on one 20,000-character
+    # line used to print the whole line for each (100 MB)
+    levels = 5_000
+    path = tmp_path / "calls.script"
+    path.write_text("x = " + "f(" * levels + "1" + ")" * levels + "\n")
+    status = main(["lint", str(path)])
+    out = capsys.readouterr().out
+    assert status == 1
+    assert out.count("unknown function 'f'") == levels
+    assert max(len(line) for line in out.splitlines()) < 200
+    assert len(out) < 2_000_000
+    blocks = [block.splitlines() for block in out.split("\n\n") if "calls.script:1:" in block]
+    for _head, text, caret in (block[:3] for block in blocks[::997]):
+        assert text[caret.index("^")] == "f"  # the caret still points at the call
+
+
+def test_long_names_and_lines_render_bounded():
+    from urdsl.script.diagnostics import Diagnostic, excerpt
+
+    line = "x = " + "y" * 10_000 + " + zz"
+    diagnostic = Diagnostic("a.script", 1, 10_008, "error", "URS102", "unknown name '"
+                            + "zz" * 5_000 + "'", "hint " * 5_000, line, 10_010)
+    rendered = diagnostic.render().splitlines()
+    assert all(len(text) < 500 for text in rendered)
+    assert rendered[1].strip().endswith("y + zz") and rendered[2].strip() == "^^"
+    assert rendered[1][rendered[2].index("^"):].startswith("zz")
+    # a short line is shown whole, as before
+    assert excerpt("movej(q)", 1, 6) == ("movej(q)", "^^^^^")
