@@ -526,7 +526,8 @@ def add_commands(commands) -> None:
                             "how it ends", description=_SEND_DESCRIPTION, epilog=_SEND_EPILOG,
                             formatter_class=_FORMATTER)
     p.add_argument("program", metavar="FILE|PROGRAM.py",
-                   help="a URScript file ('-' reads stdin) or a Python DSL program")
+                   help="a URScript file ('-' reads stdin) or a Python DSL program (a .py "
+                   "file is run as Python, with your permissions, also with --dry-run)")
     _host(p)
     p.add_argument("--port", type=int, default=30002, metavar="PORT",
                    help="where to send: 30001, 30002 (default) or 30003")
