@@ -134,10 +134,21 @@ def _nested_loops(levels: int, innermost: str) -> str:
     return ("x = 0\n" + "while x < 5:\n" * levels + innermost + "\n" + "end\n" * levels)
 
 
-def test_lint_work_grows_linearly_with_loop_nesting(monkeypatch):
+_BLENDED = "movej([0, -1.57, 1.57, -1.57, -1.57, 0], r=0.01)\n"
+
+
+@pytest.mark.parametrize("shape", [
+    lambda levels: _nested_loops(levels, "sleep(0.1)"),
+    # a blended move before each loop: URS111 asked each loop whether it only waits
+    lambda levels: "x = 0\n" + (_BLENDED + "while x < 5:\n") * levels + "sync()\n"
+    + "end\n" * levels,
+    lambda levels: "x = 0\nif x > 0:\n  sync()\nend\n" + "while x < 5:\n" * levels
+    + "sleep(1)\n" + "end\n" * levels,
+], ids=["loops", "blended-moves", "after-if"])
+def test_lint_work_grows_linearly_with_loop_nesting(monkeypatch, shape):
     # each loop used to walk everything nested in it: 3,000 levels took 9 s, 10,000 over 100 s
-    small = _lint_work(monkeypatch, _nested_loops(500, "sleep(0.1)"))
-    large = _lint_work(monkeypatch, _nested_loops(2_000, "sleep(0.1)"))
+    small = _lint_work(monkeypatch, shape(500))
+    large = _lint_work(monkeypatch, shape(2_000))
     assert large < 5 * small  # 4 times the depth: linear is 4x, quadratic 16x
 
 
