@@ -10,7 +10,10 @@ ends. The properties:
   the text and renders;
 * when it parses, ``fmt`` output parses to the same tree, and formatting it again changes
   nothing;
-* ``lint_text`` returns diagnostics (at lines of the text) and raises nothing.
+* ``lint_text`` returns diagnostics (at lines of the text) and raises nothing;
+* the language server's document handling (lint, hover, definition, formatting with random
+  options) raises nothing but the documented refusal of absurd formatting options, and its
+  formatting keeps the program's tree.
 
 Bounded and seeded: each target runs for ``URDSL_FUZZ_SECONDS`` (default 3) of wall-clock
 time and at least :data:`MIN_CASES` cases. Case ``i`` is made by ``random.Random(f"{seed}/
@@ -306,6 +309,61 @@ def test_lint_of_mutated_programs(tmp_path):
             assert isinstance(found, list)
             for diagnostic in found:
                 _check_diagnostic(diagnostic, text, "fuzz.script")
+        except Exception as error:  # noqa: BLE001 - any escape is the finding
+            findings.add(case, text, error)
+    findings.check()
+
+
+_TAB_SIZES = (1, 2, 4, 8, 16, 17, 100, 1_000, 1_001, 10**8, 2**31 - 1, 0, -3, 2.0, 2.5, True,
+              None)
+
+
+def test_lsp_document_handling_of_mutated_programs(tmp_path):
+    # what the language server does with a document an editor keeps changing: a few
+    # successive edits (mutations), each linted as the server publishes it, hover and go to
+    # definition at random places, formatting with random (also absurd) options
+    from types import SimpleNamespace
+
+    from urdsl.lint.lsp import (
+        MAX_FORMATTED_CHARS,
+        FormattingOptionsError,
+        FormattingTooLargeError,
+        definition_of,
+        format_edits,
+        hover_text,
+        lint_document,
+        word_at,
+    )
+
+    findings = Findings("lsp", tmp_path)
+    for case in cases("lsp"):
+        if findings.full:
+            break
+        rng = random.Random(f"{SEED}/lsp-edits/{case}")
+        text = mutant("lsp", case)
+        try:
+            for _edit in range(rng.randint(1, 3)):
+                text = rng.choice(MUTATIONS)(rng, text)
+                lines = text.split("\n")
+                for diagnostic in lint_document("untitled:fuzz.script", text):
+                    assert 0 <= diagnostic.range.start.line <= _line_count(text), diagnostic
+                line = rng.randrange(len(lines) + 2) - 1
+                character = rng.randrange(80) - 1
+                word = word_at(text, line, character)
+                if word is not None:
+                    hover_text(text, word)
+                    definition_of(text, word)
+            options = SimpleNamespace(tab_size=rng.choice(_TAB_SIZES),
+                                      insert_spaces=rng.random() < 0.8)
+            try:
+                edits = format_edits(text, options)  # type: ignore[arg-type]
+            except (FormattingOptionsError, FormattingTooLargeError):
+                continue
+            if edits:
+                (edit,) = edits
+                assert len(edit.new_text) <= MAX_FORMATTED_CHARS, "formatting blew up"
+                assert _same_tree(urdsl.parse(text), urdsl.parse(edit.new_text)), \
+                    "formatting changed the program"
         except Exception as error:  # noqa: BLE001 - any escape is the finding
             findings.add(case, text, error)
     findings.check()

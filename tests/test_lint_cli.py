@@ -180,3 +180,12 @@ def test_help_teaches(capsys):
         main(["lint", "--help"])
     out = capsys.readouterr().out
     assert "[tool.urdsl.lint]" in out and "--format" in out and "Exit status" in out
+
+
+@pytest.mark.parametrize("command", ["check", "send", "compile"])
+def test_help_says_a_python_file_is_run(command, capsys):
+    # check/send/compile of a .py file run it as Python: the help says so (issue 14)
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "run as Python" in out

@@ -47,7 +47,6 @@ def test_deep_trees_print_without_recursion():
 @pytest.mark.parametrize("program", ["sum", "blocks"])
 def test_commands_follow_deep_programs(tmp_path, capsys, command, program):
     path = tmp_path / "deep.script"
-    # blocks: 2,000 levels (lint's time still grows with the square of loop nesting)
     path.write_text(_long_sum(DEEP) if program == "sum" else _nested_blocks(2_000))
     status = main([*command, str(path)])
     out, err = capsys.readouterr()
@@ -109,3 +108,94 @@ def test_byte_order_mark_is_no_character():
     diagnostic = caught.value.diagnostic
     assert (diagnostic.line, diagnostic.column) == (1, 5)  # the mark is no column
     assert "\ufeff" not in diagnostic.render()
+
+
+def _lint_work(monkeypatch, text: str) -> int:
+    """Nodes the linter's tree walks visit while linting ``text`` (a measure of its work
+    that does not depend on the machine's speed)."""
+    from urdsl.lint import linter
+    from urdsl.script import nodes
+
+    visited = 0
+    walk = nodes.walk
+
+    def counting_walk(node):
+        nonlocal visited
+        for inner in walk(node):
+            visited += 1
+            yield inner
+
+    monkeypatch.setattr(nodes, "walk", counting_walk)
+    linter.lint_text(text, "nest.script")
+    return visited
+
+
+def _nested_loops(levels: int, innermost: str) -> str:
+    return ("x = 0\n" + "while x < 5:\n" * levels + innermost + "\n" + "end\n" * levels)
+
+
+_BLENDED = "movej([0, -1.57, 1.57, -1.57, -1.57, 0], r=0.01)\n"
+
+
+@pytest.mark.parametrize("shape", [
+    lambda levels: _nested_loops(levels, "sleep(0.1)"),
+    # a blended move before each loop: URS111 asked each loop whether it only waits
+    lambda levels: "x = 0\n" + (_BLENDED + "while x < 5:\n") * levels + "sync()\n"
+    + "end\n" * levels,
+    lambda levels: "x = 0\nif x > 0:\n  sync()\nend\n" + "while x < 5:\n" * levels
+    + "sleep(1)\n" + "end\n" * levels,
+], ids=["loops", "blended-moves", "after-if"])
+def test_lint_work_grows_linearly_with_loop_nesting(monkeypatch, shape):
+    # each loop used to walk everything nested in it: 3,000 levels took 9 s, 10,000 over 100 s
+    small = _lint_work(monkeypatch, shape(500))
+    large = _lint_work(monkeypatch, shape(2_000))
+    assert large < 5 * small  # 4 times the depth: linear is 4x, quadratic 16x
+
+
+def test_nested_loops_keep_their_findings():
+    from urdsl.lint.linter import lint_text
+
+    def busy(text: str) -> list[int]:
+        return [d.line for d in lint_text(text, "nest.script") if d.code == "URS118"]
+
+    levels = 3_000
+    # the innermost loop changes x: every loop around it may end by itself
+    assert busy(_nested_loops(levels, "x = x + 1")) == []
+    # the innermost loop waits: every loop around it gives up its time slice
+    assert busy(_nested_loops(levels, "sync()")) == []
+    # nothing waits or changes x: every loop spins
+    assert busy(_nested_loops(levels, "y = 1")) == list(range(2, levels + 2))
+    # a wait after the inner loop's end belongs to the outer loop only
+    text = "x = 0\nwhile x < 5:\n  while x < 5:\n    y = 1\n  end\n  sleep(1)\nend\n"
+    assert busy(text) == [3]
+
+
+def test_findings_on_a_long_line_show_a_window_of_it(tmp_path, capsys):
+    # 5,000 nested calls of an unknown function: 5,000 findings on one 20,000-character
+    # line used to print the whole line for each (100 MB)
+    levels = 5_000
+    path = tmp_path / "calls.script"
+    path.write_text("x = " + "f(" * levels + "1" + ")" * levels + "\n")
+    status = main(["lint", str(path)])
+    out = capsys.readouterr().out
+    assert status == 1
+    assert out.count("unknown function 'f'") == levels
+    assert max(len(line) for line in out.splitlines()) < 200
+    assert len(out) < 2_000_000
+    blocks = [block.splitlines() for block in out.split("\n\n") if "calls.script:1:" in block]
+    for _head, text, caret in (block[:3] for block in blocks[::997]):
+        assert text[caret.index("^")] == "f"  # the caret still points at the call
+
+
+def test_long_names_and_lines_render_bounded():
+    from urdsl.script.diagnostics import Diagnostic, excerpt
+
+    line = "x = " + "y" * 10_000 + " + zz"
+    diagnostic = Diagnostic("a.script", 1, 10_008, "error", "URS102", "unknown name '"
+                            + "zz" * 5_000 + "'", "hint " * 5_000, line, 10_010)
+    rendered = diagnostic.render().splitlines()
+    assert all(len(text) < 500 for text in rendered)
+    assert rendered[1].strip().endswith("y + zz") and rendered[2].strip() == "^^"
+    assert rendered[1][rendered[2].index("^"):].startswith("zz")
+    # a short line is shown whole, as before
+    assert excerpt("movej(q)", 1, 6) == ("movej(q)", "^^^^^")

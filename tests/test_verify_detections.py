@@ -530,3 +530,34 @@ def test_where_a_direction_move_stops_is_unknown_until_a_move_to_a_known_target(
     (warning,) = [f for f in report.findings
                   if f.code == "URS210" and f.span.line == relative]
     assert "after the move at line 15" in warning.message
+
+
+_MOVE = "  movej([0, -1.9, 1.9, -1.57, -1.57, 0])\n"
+
+
+@pytest.mark.parametrize(("text", "names"), [
+    (f"def a():\n{_MOVE}end\ndef b():\n  a()\nend\n", "(a(), b())"),
+    (f"def go(speed):\n{_MOVE}end\n", "(go())"),  # a def with parameters is not the program
+    (f"global home = [0, 0, 0, 0, 0, 0]\ndef Program():\n{_MOVE}end\n", "(Program())"),
+    ("thread beat():\n  sleep(1)\nend\n", "(beat())"),
+])
+def test_a_file_that_only_defines_says_nothing_ran(text, names):
+    report = check_text(text, "defs.script", options=CheckOptions(timeout=None))
+    (finding,) = [f for f in report.findings if f.code == "URS314"]
+    assert finding.severity == "info" and names in finding.message
+    assert "runs none of them" in finding.message
+    assert report.moves == []
+
+
+@pytest.mark.parametrize("text", [
+    f"def Program():\n{_MOVE}end\n",  # a PolyScope export: the controller runs the def
+    f"def Program():\n{_MOVE}end\nthread t():\n  sleep(1)\nend\n",
+    f"def a():\n{_MOVE}end\ndef b():\n  a()\nend\nb()\n",
+    f"def a():\n{_MOVE}end\nglobal x = a()\n",  # a global whose value calls a()
+    "sec s():\n  set_standard_digital_out(0, True)\nend\n",
+    "x = 1\n",
+    "",
+])
+def test_a_program_that_runs_is_not_told_nothing_ran(text):
+    report = check_text(text, "prog.script", options=CheckOptions(timeout=None))
+    assert "URS314" not in report.codes()

@@ -81,7 +81,8 @@ def add_commands(commands) -> None:
                             description=_DESCRIPTION, epilog=_EPILOG,
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("program", metavar="PROGRAM.py|PROGRAM.urp",
-                   help="a Python file using urdsl.dsl, or a PolyScope program")
+                   help="a Python file using urdsl.dsl (it is run as Python, with your "
+                   "permissions), or a PolyScope program")
     p.add_argument("-o", "--output", metavar="OUT.script",
                    help="write the URScript here instead of standard output")
     p.set_defaults(run=cmd_compile)

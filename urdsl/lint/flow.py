@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import bisect
 import difflib
 from collections.abc import Iterator
 
@@ -217,23 +218,28 @@ def _blocking_functions(ctx: LintContext) -> set[str]:
 def _takes_time(ctx: LintContext, items: tuple, blocking: set[str], deep: bool = False) -> bool:
     """Whether running ``items`` may take physical time: a blocking builtin, a method call
     (RPC, may block), ``join``, or a user function in ``blocking``."""
-    for statement in statements(items):
-        if isinstance(statement, n.Join):
-            return True
-        if isinstance(statement, (n.FunctionDef, n.ThreadDef, n.SecDef)):
-            continue
-        for node in _expressions(statement):
-            for inner in n.walk(node):
-                if isinstance(inner, n.Call):
-                    if isinstance(inner.func, n.Attribute):
-                        return True
-                    name = inner.func.id  # type: ignore[union-attr]
-                    if name in blocking:
-                        return True
-                    if name in BLOCKING_CALLS and name not in ctx.analysis.functions:
-                        return True
-                    if name not in ctx.analysis.functions and lookup(name) is None:
-                        return True  # unknown function: give it the benefit of the doubt
+    return any(_statement_takes_time(ctx, statement, blocking) for statement in statements(items))
+
+
+def _statement_takes_time(ctx: LintContext, statement: n.Stmt, blocking: set[str]) -> bool:
+    """Whether ``statement`` itself (its expressions, not its nested blocks) may take
+    physical time, as :func:`_takes_time` counts it."""
+    if isinstance(statement, n.Join):
+        return True
+    if isinstance(statement, (n.FunctionDef, n.ThreadDef, n.SecDef)):
+        return False
+    for node in _expressions(statement):
+        for inner in n.walk(node):
+            if isinstance(inner, n.Call):
+                if isinstance(inner.func, n.Attribute):
+                    return True
+                name = inner.func.id  # type: ignore[union-attr]
+                if name in blocking:
+                    return True
+                if name in BLOCKING_CALLS and name not in ctx.analysis.functions:
+                    return True
+                if name not in ctx.analysis.functions and lookup(name) is None:
+                    return True  # unknown function: give it the benefit of the doubt
     return False
 
 
@@ -255,25 +261,60 @@ def _expressions(statement: n.Stmt) -> list[n.Node]:
     return []
 
 
-def _assigned_names(items: tuple) -> set[str]:
+def _statement_assigns(statement: n.Stmt) -> set[str]:
+    """Names ``statement`` itself (not its nested blocks) changes: assigned, declared, or
+    changed by a method call (``l.append(x)`` changes ``l``)."""
     names: set[str] = set()
-    for statement in statements(items):
-        if isinstance(statement, n.Assign):
-            target = statement.target
-            while isinstance(target, (n.Index, n.Attribute)):
-                target = target.value
-            if isinstance(target, n.Name):
-                names.add(target.id)
-        elif isinstance(statement, n.Declare):
-            names.add(statement.name)
-        elif isinstance(statement, n.ExprStmt):
-            # a method call such as l.append(x) changes l
-            for inner in n.walk(statement.expr):
-                if isinstance(inner, n.Call) and isinstance(inner.func, n.Attribute):
-                    value = inner.func.value
-                    if isinstance(value, n.Name):
-                        names.add(value.id)
+    if isinstance(statement, n.Assign):
+        target = statement.target
+        while isinstance(target, (n.Index, n.Attribute)):
+            target = target.value
+        if isinstance(target, n.Name):
+            names.add(target.id)
+    elif isinstance(statement, n.Declare):
+        names.add(statement.name)
+    elif isinstance(statement, n.ExprStmt):
+        for inner in n.walk(statement.expr):
+            if isinstance(inner, n.Call) and isinstance(inner.func, n.Attribute):
+                value = inner.func.value
+                if isinstance(value, n.Name):
+                    names.add(value.id)
     return names
+
+
+def _preorder(items: tuple) -> tuple[list[n.Stmt], list[int]]:
+    """The statements of ``items`` in the order of :func:`statements`, and for each the index
+    just past its last nested statement: the statements nested in ``order[i]`` are
+    ``order[i + 1:ends[i]]``. Linear, whatever the nesting depth."""
+    order: list[n.Stmt] = []
+    ends: list[int] = []
+    open_at: list[int] = []  # indices of the if/while statements whose blocks are being read
+    stack: list[Iterator | None] = [iter(items)]
+    while stack:
+        top = stack[-1]
+        if top is None:  # the blocks of order[open_at[-1]] are read
+            stack.pop()
+            ends[open_at.pop()] = len(order)
+            continue
+        item = next(top, None)
+        if item is None:
+            stack.pop()
+            continue
+        if not isinstance(item, n.Stmt):
+            continue
+        order.append(item)
+        ends.append(len(order))
+        if isinstance(item, (n.If, n.While)):
+            open_at.append(len(order) - 1)
+            stack.append(None)
+            if isinstance(item, n.If):
+                blocks = [item.body, *(branch.body for branch in item.elifs)]
+                if item.orelse:
+                    blocks.append(item.orelse)
+                stack.append(iter([s for block in blocks for s in block]))
+            else:
+                stack.append(iter(item.body))
+    return order, ends
 
 
 @rule(
@@ -295,17 +336,35 @@ def busy_loop(ctx: LintContext) -> Iterator[Diagnostic]:
     for scope in ctx.analysis.scopes:
         if ctx.in_sec(scope):
             continue
-        for statement in statements(scope.body):
+        order, ends = _preorder(scope.body)
+        if not any(isinstance(statement, n.While) for statement in order):
+            continue
+        if blocking is None:
+            blocking = _blocking_functions(ctx)
+        # one pass over the scope, then each loop is a range of it (nested loops would make
+        # a walk per loop quadratic in the nesting depth)
+        timed = [0]  # timed[i]: how many of order[:i] take time
+        assigning: dict[str, list[int]] = {}  # name: indices of the statements changing it
+        for index, statement in enumerate(order):
+            timed.append(timed[-1] + _statement_takes_time(ctx, statement, blocking))
+            for name in _statement_assigns(statement):
+                assigning.setdefault(name, []).append(index)
+        for index, statement in enumerate(order):
             if not isinstance(statement, n.While):
                 continue
-            if blocking is None:
-                blocking = _blocking_functions(ctx)
-            if _takes_time(ctx, (statement,), blocking):
+            end = ends[index]
+            if timed[end] > timed[index]:
                 continue
             tested = {node.id for node in n.walk(statement.test) if isinstance(node, n.Name)}
-            if tested & _assigned_names(statement.body):
+            if any(_within(assigning.get(name, ()), index + 1, end) for name in tested):
                 continue  # a counting loop: it ends by itself
             where = "" if scope.kind == "top" else f" in {scope.kind} {scope.name}()"
             yield ctx.diagnostic(
                 "URS118", statement, f"this loop{where} never gives up its time slice",
                 "call sync() in the loop (it waits for the next controller step)")
+
+
+def _within(indices: list[int] | tuple, start: int, end: int) -> bool:
+    """Whether the sorted ``indices`` hold one in ``start <= i < end``."""
+    at = bisect.bisect_left(indices, start)
+    return at < len(indices) and indices[at] < end

@@ -7,7 +7,14 @@ What an editor gets:
 * hover: the signature of a builtin (with its first controller version, deprecation and
   remarks from the catalog), or the ``def`` line of a function of the file;
 * go to definition of functions, threads and global variables;
-* formatting of the whole document with the printer of ``urdsl fmt``.
+* formatting of the whole document with the printer of ``urdsl fmt`` (``tabSize`` from 1 to
+  :data:`MAX_TAB_SIZE` is used as given, up to :data:`ABSURD_TAB_SIZE` it is clamped to
+  :data:`MAX_TAB_SIZE`; beyond, or not a whole number, the answer is an "invalid params"
+  error).
+
+Diagnostics of an edited document are debounced: they are published
+:data:`DEBOUNCE_SECONDS` after the last change (a burst of keystrokes is linted once, the
+last version always); opening and saving publish at once.
 
 Positions: LSP counts characters in UTF-16 code units, urdsl in code points; the two agree
 for every character of the Basic Multilingual Plane, which is all URScript ever holds.
@@ -15,7 +22,9 @@ for every character of the Basic Multilingual Plane, which is all URScript ever 
 
 from __future__ import annotations
 
+import asyncio
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 from lsprotocol import types
@@ -30,8 +39,27 @@ from .config import ConfigError, LintSettings, build_settings, settings_for
 from .linter import lint_tree
 from .scope import analyse
 
-__all__ = ["build_server", "serve", "to_lsp_diagnostic", "word_at"]
+__all__ = ["ABSURD_TAB_SIZE", "DEBOUNCE_SECONDS", "MAX_TAB_SIZE", "Debouncer",
+           "FormattingOptionsError", "FormattingTooLargeError", "MAX_FORMATTED_CHARS",
+           "build_server", "format_edits", "indent_for", "serve",
+           "to_lsp_diagnostic", "word_at"]
 
+DEBOUNCE_SECONDS = 0.3
+"""Quiet time (s) after a document's last change before its diagnostics are published."""
+
+MAX_TAB_SIZE = 16
+"""Widest indent (spaces) the formatter writes; wider requests are clamped to it."""
+
+MAX_FORMATTED_CHARS = 10_000_000
+"""Longest formatted document the server sends (characters): indentation grows with the
+square of the nesting depth, and a document thousands of levels deep would format to
+gigabytes; such a request is answered with a "request failed" error instead."""
+
+ABSURD_TAB_SIZE = 1_000
+"""A ``tabSize`` above this is refused with an "invalid params" error, not clamped (an
+editor that sends it is broken; 10^8 spaces per level used to end in a MemoryError)."""
+
+_REQUEST_FAILED = -32803  # LSP's RequestFailed error code
 _WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _SEVERITY = {
     "error": types.DiagnosticSeverity.Error,
@@ -205,6 +233,97 @@ def _range(span: n.Span) -> types.Range:
     return types.Range(types.Position(line, span.column - 1), types.Position(line, end))
 
 
+class FormattingOptionsError(ValueError):
+    """Formatting options urdsl refuses (the server answers "invalid params" with this
+    message)."""
+
+
+class FormattingTooLargeError(ValueError):
+    """The formatted document would be longer than :data:`MAX_FORMATTED_CHARS` (the server
+    answers "request failed" with this message)."""
+
+
+def indent_for(options: types.FormattingOptions) -> str:
+    """The indent of one block level for LSP formatting ``options``: ``tabSize`` spaces
+    (clamped to :data:`MAX_TAB_SIZE`) when ``insertSpaces``, else two spaces.
+
+    >>> indent_for(types.FormattingOptions(4, True))
+    '    '
+    >>> len(indent_for(types.FormattingOptions(100, True)))
+    16
+    """
+    if not options.insert_spaces:
+        return "  "
+    size = options.tab_size
+    if isinstance(size, float) and size.is_integer():
+        size = int(size)
+    if isinstance(size, bool) or not isinstance(size, int):
+        raise FormattingOptionsError(f"tabSize must be a whole number, not {size!r}")
+    if not 1 <= size <= ABSURD_TAB_SIZE:
+        raise FormattingOptionsError(
+            f"tabSize {size} is out of range: urdsl indents 1 to {MAX_TAB_SIZE} spaces")
+    return " " * min(size, MAX_TAB_SIZE)
+
+
+def format_edits(source: str, options: types.FormattingOptions) -> list[types.TextEdit] | None:
+    """The edits that format a whole document: none when it is formatted already, None when
+    it does not parse (its diagnostics show why). Raises :class:`FormattingOptionsError`
+    for options urdsl refuses, :class:`FormattingTooLargeError` when the result would be
+    longer than :data:`MAX_FORMATTED_CHARS`."""
+    indent = indent_for(options)
+    try:
+        tree = parse(source)
+    except ScriptError:
+        return None
+    # printed with one space per level first: its size and indentation predict the size
+    # with the requested indent before that text is built
+    formatted = format_tree(tree, indent=" ")
+    depths = [len(line) - len(line.lstrip(" ")) for line in formatted.split("\n")]
+    predicted = len(formatted) + sum(depths) * (len(indent) - 1)
+    if predicted > MAX_FORMATTED_CHARS:
+        raise FormattingTooLargeError(
+            f"formatting would write {predicted:,} characters (the document nests "
+            f"{max(depths):,} levels deep); not formatted")
+    if indent != " ":
+        formatted = format_tree(tree, indent=indent)
+    if formatted == source:
+        return []
+    lines = source.split("\n")
+    end = types.Position(len(lines) - 1, len(lines[-1]))
+    return [types.TextEdit(types.Range(types.Position(0, 0), end), formatted)]
+
+
+class Debouncer:
+    """Runs a callback per key once things settle: :meth:`schedule` again before the delay
+    has passed replaces the pending call, so only the last one runs. Lives on the running
+    asyncio loop (the server's)."""
+
+    def __init__(self, delay: float = DEBOUNCE_SECONDS) -> None:
+        self.delay = delay  # s
+        self._pending: dict[str, asyncio.TimerHandle] = {}
+
+    def schedule(self, key: str, callback: Callable[[], None]) -> None:
+        """Call ``callback`` after :attr:`delay` seconds unless ``key`` is scheduled or
+        cancelled again before."""
+        self.cancel(key)
+        self._pending[key] = asyncio.get_running_loop().call_later(
+            self.delay, self._fire, key, callback)
+
+    def cancel(self, key: str) -> None:
+        """Drop the pending call of ``key``, if any."""
+        handle = self._pending.pop(key, None)
+        if handle is not None:
+            handle.cancel()
+
+    def pending(self, key: str) -> bool:
+        """Whether a call of ``key`` waits."""
+        return key in self._pending
+
+    def _fire(self, key: str, callback: Callable[[], None]) -> None:
+        self._pending.pop(key, None)
+        callback()
+
+
 def build_server():
     """A pygls server with urdsl's features registered (not started)."""
     from pygls.lsp.server import LanguageServer
@@ -212,7 +331,10 @@ def build_server():
     server = LanguageServer("urdsl", __version__,
                             text_document_sync_kind=types.TextDocumentSyncKind.Full)
 
+    debouncer = Debouncer()
+
     def publish(ls, uri: str) -> None:
+        debouncer.cancel(uri)
         document = ls.workspace.get_text_document(uri)
         ls.text_document_publish_diagnostics(types.PublishDiagnosticsParams(
             uri=uri, version=document.version, diagnostics=lint_document(uri, document.source)))
@@ -222,8 +344,9 @@ def build_server():
         publish(ls, params.text_document.uri)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
-    def did_change(ls, params: types.DidChangeTextDocumentParams) -> None:
-        publish(ls, params.text_document.uri)
+    async def did_change(ls, params: types.DidChangeTextDocumentParams) -> None:
+        uri = params.text_document.uri
+        debouncer.schedule(uri, lambda: publish(ls, uri))
 
     @server.feature(types.TEXT_DOCUMENT_DID_SAVE)
     def did_save(ls, params: types.DidSaveTextDocumentParams) -> None:
@@ -231,6 +354,7 @@ def build_server():
 
     @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
     def did_close(ls, params: types.DidCloseTextDocumentParams) -> None:
+        debouncer.cancel(params.text_document.uri)
         ls.text_document_publish_diagnostics(types.PublishDiagnosticsParams(
             uri=params.text_document.uri, diagnostics=[]))
 
@@ -255,17 +379,15 @@ def build_server():
 
     @server.feature(types.TEXT_DOCUMENT_FORMATTING)
     def formatting(ls, params: types.DocumentFormattingParams) -> list[types.TextEdit] | None:
+        from pygls.exceptions import JsonRpcException, JsonRpcInvalidParams
+
         document = ls.workspace.get_text_document(params.text_document.uri)
-        indent = " " * (params.options.tab_size if params.options.insert_spaces else 2)
         try:
-            formatted = format_tree(parse(document.source), indent=indent)
-        except ScriptError:
-            return None  # the diagnostics already show the syntax error
-        if formatted == document.source:
-            return []
-        lines = document.source.split("\n")
-        end = types.Position(len(lines) - 1, len(lines[-1]))
-        return [types.TextEdit(types.Range(types.Position(0, 0), end), formatted)]
+            return format_edits(document.source, params.options)
+        except FormattingOptionsError as error:
+            raise JsonRpcInvalidParams(str(error)) from None
+        except FormattingTooLargeError as error:
+            raise JsonRpcException(str(error), code=_REQUEST_FAILED) from None
 
     return server
 

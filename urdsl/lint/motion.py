@@ -10,7 +10,7 @@ from ..script import nodes as n
 from ..script.diagnostics import Diagnostic
 from .context import BLOCKING_CALLS, MOTION_CALLS, LintContext
 from .registry import rule
-from .scope import Scope, statements
+from .scope import Scope
 
 # Parameters that take joint positions [rad] (6 values) when given a list.
 _JOINT_POSITIONS: dict[str, tuple[str, ...]] = {
@@ -211,9 +211,11 @@ def _is_move(ctx: LintContext, item: n.Node) -> n.Call | None:
     return None
 
 
-def _stops(ctx: LintContext, item: n.Node) -> str | None:
+def _stops(ctx: LintContext, item: n.Node,
+           memo: dict[int, tuple[bool, bool]] | None = None) -> str | None:
     """Why ``item`` makes the arm stop before any further move: a statement that takes time
-    without moving (sleep, sync, waiting), or halt. None when it may move or takes no time."""
+    without moving (sleep, sync, waiting), or halt. None when it may move or takes no time.
+    ``memo`` keeps what each loop and ``if`` holds across calls (see :func:`_waits_moves`)."""
     if isinstance(item, n.Halt):
         return "halt"
     if isinstance(item, n.ExprStmt):
@@ -226,19 +228,56 @@ def _stops(ctx: LintContext, item: n.Node) -> str | None:
                 return f"{name}()"
     if isinstance(item, n.While):
         waits = moves = False
-        for statement in statements(item.body):
-            for node in n.walk(statement):
-                if isinstance(node, n.Call):
-                    found = ctx.builtin_call(node)
-                    if found is None:
-                        moves = True  # a user function or a method: it may move
-                    elif found[0] in ("sleep", "sync"):
-                        waits = True
-                    elif found[0] in MOTION_CALLS:
-                        moves = True
+        for statement in item.body:
+            if isinstance(statement, n.Stmt):
+                inner_waits, inner_moves = _waits_moves(ctx, statement, memo
+                                                        if memo is not None else {})
+                waits, moves = waits or inner_waits, moves or inner_moves
         if waits and not moves:
             return "a waiting loop"
     return None
+
+
+def _waits_moves(ctx: LintContext, node: n.Node, memo: dict[int, tuple[bool, bool]]
+                 ) -> tuple[bool, bool]:
+    """Whether running ``node`` may wait (sleep, sync) and whether it may move (a move, a
+    user function, a method), from every call in it. The answer for each ``while`` and
+    ``if`` is kept in ``memo`` (by ``id``): nested loops are read once, not once per loop
+    around them (that was quadratic in the nesting depth)."""
+    if isinstance(node, (n.While, n.If)) and id(node) in memo:
+        return memo[id(node)]
+    waits = moves = False
+    if isinstance(node, (n.While, n.If)):
+        if isinstance(node, n.While):
+            tests: list[n.Node] = [node.test]
+            blocks = [node.body]
+        else:
+            tests = [node.test, *(branch.test for branch in node.elifs)]
+            blocks = [node.body, *(branch.body for branch in node.elifs)]
+            if node.orelse:
+                blocks.append(node.orelse)
+        parts = [(test, False) for test in tests] + [
+            (statement, True) for block in blocks for statement in block
+            if isinstance(statement, n.Stmt)]
+    else:
+        parts = [(node, False)]
+    for part, nested in parts:
+        if nested:
+            inner_waits, inner_moves = _waits_moves(ctx, part, memo)
+            waits, moves = waits or inner_waits, moves or inner_moves
+            continue
+        for inner in n.walk(part):
+            if isinstance(inner, n.Call):
+                found = ctx.builtin_call(inner)
+                if found is None:
+                    moves = True  # a user function or a method: it may move
+                elif found[0] in ("sleep", "sync"):
+                    waits = True
+                elif found[0] in MOTION_CALLS:
+                    moves = True
+    if isinstance(node, (n.While, n.If)):
+        memo[id(node)] = (waits, moves)
+    return waits, moves
 
 
 def _executable(items: tuple) -> list[n.Stmt]:
@@ -259,6 +298,8 @@ between two blended moves are fine: the controller runs them during the approach
     "movel(p_above)\nsleep(1.0)\nmovel(p_pick)",
 )
 def blend_without_next_move(ctx: LintContext) -> Iterator[Diagnostic]:
+    memo: dict[int, tuple[bool, bool]] = {}  # what each loop and if holds (_waits_moves)
+
     def check_block(items: tuple, tail: str | None, scope: Scope) -> Iterator[Diagnostic]:
         executable = _executable(items)
         for index, item in enumerate(executable):
@@ -286,7 +327,7 @@ def blend_without_next_move(ctx: LintContext) -> Iterator[Diagnostic]:
 
     def _follow(rest: list[n.Stmt], tail: str | None) -> str | None:
         for item in rest:
-            reason = _stops(ctx, item)
+            reason = _stops(ctx, item, memo)
             if reason is not None:
                 return reason
             if not isinstance(item, (n.Assign, n.Declare)) and not (

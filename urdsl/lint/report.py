@@ -18,7 +18,7 @@ from pathlib import Path
 from urllib.parse import quote
 
 from .. import __version__
-from ..script.diagnostics import Diagnostic
+from ..script.diagnostics import Diagnostic, clip
 from .registry import RULES, Rule
 
 __all__ = ["FORMATS", "render_text", "render_json", "render_sarif", "render_github"]
@@ -28,13 +28,14 @@ FORMATS = ("text", "json", "sarif", "github")
 _SARIF_LEVEL = {"error": "error", "warning": "warning", "info": "note"}
 _GITHUB_LEVEL = {"error": "error", "warning": "warning", "info": "notice"}
 _SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
+_SNIPPET_WIDTH = 1000  # a longer line is left out of SARIF (a snippet is the whole line)
 
 
 def render_one(diagnostic: Diagnostic) -> str:
     """One finding, ruff style: ``path:line:col: CODE message``, then the source line with a
     caret and the hint (as :meth:`Diagnostic.render` draws them)."""
     head = f"{diagnostic.filename}:{diagnostic.line}:{diagnostic.column}: " \
-           f"{diagnostic.code} {diagnostic.message}"
+           f"{diagnostic.code} {clip(diagnostic.message)}"
     rest = diagnostic.render().split("\n")[1:]
     return "\n".join([head, *rest])
 
@@ -99,7 +100,7 @@ def render_sarif(diagnostics: list[Diagnostic], codes: set[str] | frozenset[str]
             region: dict = {"startLine": d.line, "startColumn": max(d.column, 1)}
             if d.end_column is not None and d.end_column > d.column:
                 region["endColumn"] = d.end_column
-            if d.source_line is not None:
+            if d.source_line is not None and len(d.source_line) <= _SNIPPET_WIDTH:
                 region["snippet"] = {"text": d.source_line}
             location["region"] = region
         result["locations"] = [{"physicalLocation": location}]

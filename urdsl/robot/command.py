@@ -535,7 +535,8 @@ def add_commands(commands) -> None:
                             "how it ends", description=_SEND_DESCRIPTION, epilog=_SEND_EPILOG,
                             formatter_class=_FORMATTER)
     p.add_argument("program", metavar="FILE|PROGRAM.py",
-                   help="a URScript file ('-' reads stdin), a Python DSL program or a "
+                   help="a URScript file ('-' reads stdin), a Python DSL program (a .py "
+                   "file is run as Python, with your permissions, also with --dry-run) or a "
                    "PolyScope program (.urp, compiled and checked as urdsl compile and "
                    "urdsl check do)")
     _host(p)

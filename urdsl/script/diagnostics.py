@@ -15,9 +15,55 @@ from dataclasses import dataclass
 
 from .nodes import Source, Span
 
-__all__ = ["Diagnostic", "ScriptSyntaxError", "ScriptError", "render"]
+__all__ = ["Diagnostic", "ScriptSyntaxError", "ScriptError", "clip", "excerpt", "render"]
 
 SEVERITIES = ("error", "warning", "info")
+
+EXCERPT_WIDTH = 120
+"""Characters of a source line a rendered finding shows at most: a longer line (a generated
+one, ``f(f(f(...)))`` 20,000 characters long) is cut to a window around the column, so that
+each finding's text stays short however long the line is."""
+
+TEXT_WIDTH = 400
+"""Characters of a message or hint a rendered finding shows at most (a message quotes names
+and values from the program, which may be arbitrarily long)."""
+
+_MORE = "..."
+
+
+def clip(text: str, width: int = TEXT_WIDTH) -> str:
+    """``text``, or its first ``width`` characters and ``...`` when it is longer."""
+    return text if len(text) <= width else text[:width] + _MORE
+
+
+def excerpt(line: str, column: int, end_column: int | None = None,
+            width: int = EXCERPT_WIDTH) -> tuple[str, str]:
+    """The source ``line`` as a finding shows it and the caret line under it, both at most
+    about ``width`` characters: a longer line is cut to a window that holds ``column``
+    (1-based), marked with ``...`` where text is left out; the underline from ``column`` to
+    ``end_column`` (exclusive) stops at the window's end. Tabs count as one column.
+
+    >>> excerpt("x = 1", 5)
+    ('x = 1', '    ^')
+    >>> text, caret = excerpt("y" * 1000 + " = 1", 1002)
+    >>> len(text) <= 130, text[caret.index("^")]
+    (True, '=')
+    """
+    text = line.expandtabs(1)
+    at = max(column - 1, 0)
+    span = 1
+    if end_column is not None and end_column > column:
+        span = end_column - column
+    if len(text) <= width:
+        return text, " " * at + "^" * span
+    start = max(0, min(at - width // 3, len(text) - width))
+    stop = min(len(text), start + width)
+    shown = text[start:stop]
+    prefix = _MORE if start > 0 else ""
+    suffix = _MORE if stop < len(text) else ""
+    column_in = len(prefix) + (at - start)
+    underline = max(1, min(span, stop - at))
+    return prefix + shown + suffix, " " * column_in + "^" * underline
 
 
 @dataclass(frozen=True)
@@ -68,19 +114,17 @@ class Diagnostic:
 
     def render(self) -> str:
         """``file:line:col: severity: message``, the source line, a caret, and the hint."""
-        head = f"{self.filename}:{self.line}:{self.column}: {self.severity}: {self.message}"
+        head = f"{self.filename}:{self.line}:{self.column}: {self.severity}: " \
+               f"{clip(self.message)}"
         if self.code:
             head += f" [{self.code}]"
         lines = [head]
         if self.source_line is not None:
-            text = self.source_line.expandtabs(1)
+            text, caret = excerpt(self.source_line, self.column, self.end_column)
             lines.append("  " + text)
-            width = 1
-            if self.end_column is not None and self.end_column > self.column:
-                width = self.end_column - self.column
-            lines.append("  " + " " * (self.column - 1) + "^" * max(width, 1))
+            lines.append("  " + caret)
         if self.hint:
-            lines.append(f"  hint: {self.hint}")
+            lines.append(f"  hint: {clip(self.hint)}")
         return "\n".join(lines)
 
     def __str__(self) -> str:

@@ -73,7 +73,8 @@ def add_commands(commands) -> None:
         description=_DESCRIPTION, epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("files", nargs="+", metavar="FILE",
-                   help="a URScript file (.script), a DSL program (.py) or a PolyScope "
+                   help="a URScript file (.script), a DSL program (.py; a .py file is run "
+                   "as Python, with your permissions, to build its program) or a PolyScope "
                    "program (.urp: compiled, checked on its arm with its installation)")
     p.add_argument("--robot", metavar="MODEL",
                    help="robot model: ur3, ur5, ur10, ur3e, ur5e, ur10e, ur16e, ur20, ur30, "

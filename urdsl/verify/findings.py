@@ -4,7 +4,8 @@ Every code is a rule of the one registry (:data:`urdsl.rules.RULES`; ``urdsl rul
 each): URS2xx runtime errors (:mod:`urdsl.runtime.errors`), the trace checks URS302–URS308
 and URS310 (:mod:`urdsl.verify.checks`), and here the findings of the run itself: URS301
 (unreachable pose), URS309 (Overlapping Blends), URS311 (threads still running), URS312
-(time limit), URS313 (stopped early) and URS210 (depends on a value unknown offline).
+(time limit), URS313 (stopped early), URS314 (defines functions but runs none) and URS210
+(depends on a value unknown offline).
 """
 
 from __future__ import annotations
@@ -13,10 +14,11 @@ import re
 from dataclasses import dataclass, field, replace
 
 from ..rules import RULES, Rule, register
+from ..script import nodes as n
 from ..script.diagnostics import Diagnostic
 from ..script.nodes import NO_SPAN, Span
 
-__all__ = ["Finding"]
+__all__ = ["Finding", "nothing_runs"]
 
 _NUMBER = re.compile(r"(?<![\w.])(?<!wrist )[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
 """Numbers in a message (not inside names such as ``Waypoint_1``, nor a wrist's number)."""
@@ -146,3 +148,50 @@ where it got to, and the checks left undone are named.""",
       'while True:\n  socket_read_byte_list(1, "g", 0)\nend',
       'socket_open("127.0.0.1", 30000, "g")\nwhile True:\n  socket_read_byte_list(1, "g", 2)\n'
       "end")
+_rule("URS314", "nothing-runs", "info",
+      "The program defines functions or threads but runs none of them.",
+      """
+A file whose top level only defines things (functions, threads, globals with plain values)
+does nothing when it runs: the check runs no move and finds nothing, which says nothing
+about the functions. A file that is a single `def` without parameters (a PolyScope export's
+`def Program(): ... end`) is a program: the controller runs that def, and so does the check.
+Several defs, or a def that takes parameters, need a call at the top level. A file of
+definitions that another program includes is checked with that program (urdsl check finds
+it in the project, or name it with --include).""",
+      f"def pick():\n  {_READY}\nend\ndef place():\n  {_READY}\nend",
+      f"def pick():\n  {_READY}\nend\ndef place():\n  {_READY}\nend\npick()\nplace()")
+
+
+def nothing_runs(module: n.Module) -> Finding | None:
+    """URS314 when running ``module`` runs none of the functions and threads it defines: its
+    top level only defines things (a ``global``/``local`` or assignment whose value calls
+    nothing counts as a definition), and it is not one program ``def`` without parameters
+    nor a ``sec`` alone, which the controller (and :class:`urdsl.runtime.Interpreter`) runs
+    as the program."""
+    body = [item for item in module.body if isinstance(item, n.Stmt)]
+    functions = [item for item in body if isinstance(item, n.FunctionDef)]
+    threads = [item for item in body if isinstance(item, n.ThreadDef)]
+    secs = [item for item in body if isinstance(item, n.SecDef)]
+    others = [item for item in body if not isinstance(item, (n.FunctionDef, n.ThreadDef,
+                                                               n.SecDef))]
+    if not functions and not threads:
+        return None  # nothing defined to run (an empty file, or a sec alone)
+    for item in others:
+        if not isinstance(item, (n.Declare, n.Assign)) or any(
+                isinstance(node, (n.Call, n.Run)) for node in n.walk(item)):
+            return None  # something runs
+    if not others and len(functions) == 1 and not functions[0].params:
+        return None  # the program's def: it runs
+    if not others and not functions and secs:
+        return None  # the sec runs
+    defined = [f"{item.name}()" for item in functions + threads]
+    what = "functions" if functions else "threads"
+    if functions and threads:
+        what = "functions and threads"
+    shown = ", ".join(defined[:5]) + (", ..." if len(defined) > 5 else "")
+    first = (functions or threads)[0]
+    return Finding.of(
+        "URS314", f"the program defines {what} ({shown}) but runs none of them, so "
+        "none of them was checked", first.span, 0.0,
+        f"call the program's entry at the top level (e.g. {first.name}()), or check the "
+        "program that includes this file")

@@ -35,7 +35,7 @@ from ..script.diagnostics import ScriptSyntaxError
 from ..script.nodes import NO_SPAN, Assign, Declare, Name, walk
 from ..script.parser import parse
 from . import checks
-from .findings import Finding
+from .findings import Finding, nothing_runs
 from .report import Move, Report
 
 __all__ = ["CheckOptions", "check_text", "check_tree", "check_file", "DEFAULT_START",
@@ -194,6 +194,9 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
                 "URS313", f"{event.message}; this thread was not checked further",
                 event.span, event.time, "give the read a timeout, or make sure something "
                 "answers"))
+    idle = nothing_runs(module)
+    if idle is not None:
+        report.findings.append(idle)
     if result.stopped_at_max_time:
         report.findings.append(Finding.of(
             "URS312", f"the program still ran after {options.max_time:g} s of robot time and "
