@@ -3,12 +3,12 @@ virtual controller's dashboard ``load X.urp`` / ``play``, over loopback."""
 
 from __future__ import annotations
 
-import socket
 import time
 
 import numpy as np
 import pytest
 from _robot_fakes import LOOPBACK, FakeController, FakeServer
+from _sim_clients import Dashboard
 
 from urdsl.cli import main
 from urdsl.sim.controller import VirtualController
@@ -65,24 +65,6 @@ def sim(tmp_path):
             yield controller
 
 
-class Dashboard:
-    def __init__(self, sim):
-        self.sock = socket.create_connection(
-            ("127.0.0.1", sim.servers.ports["dashboard"]), TIMEOUT)
-        self.sock.settimeout(TIMEOUT)
-        self.file = self.sock.makefile("rb")
-        self.welcome = self.line()
-
-    def line(self) -> str:
-        return self.file.readline().decode().rstrip("\n")
-
-    def ask(self, command: str) -> str:
-        self.sock.sendall(command.encode() + b"\n")
-        return self.line()
-
-    def close(self):
-        self.file.close()
-        self.sock.close()
 
 
 def wait_until(predicate, timeout=TIMEOUT):

@@ -10,6 +10,7 @@ import struct
 import time
 
 import pytest
+from _sim_clients import Dashboard, connect
 
 from urdsl.sim import dashboard as sim_dashboard
 from urdsl.sim import rtde as sim_rtde
@@ -33,28 +34,8 @@ def sim(tmp_path):
             yield controller
 
 
-def connect(sim, interface: str) -> socket.socket:
-    sock = socket.create_connection(("127.0.0.1", sim.servers.ports[interface]), TIMEOUT)
-    sock.settimeout(TIMEOUT)
-    return sock
 
 
-class Dashboard:
-    def __init__(self, sim):
-        self.sock = connect(sim, "dashboard")
-        self.file = self.sock.makefile("rb")
-        self.welcome = self.line()
-
-    def line(self) -> str:
-        return self.file.readline().decode("utf-8", "replace").rstrip("\n")
-
-    def ask(self, command: str) -> str:
-        self.sock.sendall(command.encode() + b"\n")
-        return self.line()
-
-    def close(self) -> None:
-        self.file.close()
-        self.sock.close()
 
 
 def read_exactly(sock: socket.socket, count: int) -> bytes:

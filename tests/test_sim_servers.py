@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 import pytest
+from _sim_clients import Dashboard, connect
 
 from urdsl.sim.controller import VirtualController
 from urdsl.sim.servers import STANDARD_PORTS
@@ -33,10 +34,6 @@ def sim(tmp_path):
             yield controller
 
 
-def connect(sim, interface: str) -> socket.socket:
-    sock = socket.create_connection(("127.0.0.1", sim.servers.ports[interface]), TIMEOUT)
-    sock.settimeout(TIMEOUT)
-    return sock
 
 
 def read_exactly(sock: socket.socket, count: int) -> bytes:
@@ -61,22 +58,6 @@ def wait_until(predicate, timeout=TIMEOUT):
 # ---- dashboard --------------------------------------------------------------------------------
 
 
-class Dashboard:
-    def __init__(self, sim):
-        self.sock = connect(sim, "dashboard")
-        self.file = self.sock.makefile("rb")
-        self.welcome = self.line()
-
-    def line(self) -> str:
-        return self.file.readline().decode().rstrip("\n")
-
-    def ask(self, command: str) -> str:
-        self.sock.sendall(command.encode() + b"\n")
-        return self.line()
-
-    def close(self):
-        self.file.close()
-        self.sock.close()
 
 
 def test_dashboard_answers_with_the_documented_replies(sim):
