@@ -16,8 +16,11 @@ def test_demo_story_records_the_program_it_sent(tmp_path):
     data = np.array([[float(v) for v in row.split()] for row in rows])
     assert len(data) == result.samples > 50
     assert 2 in data[:, -1] and data[-1, -1] == 1  # PLAYING during the run, STOPPED after
-    # the recording follows the checker's plan: the same cycle time, the same joints
-    assert abs(result.observed_time - result.planned_time) < 0.2
+    # the recording follows the checker's plan: the same joints, and about the same cycle
+    # time — the sim runs at 4x real time, and on a loaded 2-core machine its interpreter has
+    # fallen behind its clock by up to 1.9 s of controller time (0.5 s of real time) in a
+    # full test run, so the time is compared within 10 %
+    assert abs(result.observed_time - result.planned_time) < 0.1 * result.planned_time
     assert result.max_deviation < 0.1
     assert "observed PLAYING" in result.report.read_text()
     assert result.plot.stat().st_size > 10_000
