@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import socket
+import time
 
 TIMEOUT = 5.0
 """Seconds any one connect or read may take."""
@@ -34,3 +35,24 @@ class Dashboard:
     def close(self):
         self.file.close()
         self.sock.close()
+
+
+def read_exactly(sock: socket.socket, count: int) -> bytes:
+    """``count`` bytes from ``sock`` (each recv bounded by the socket's timeout)."""
+    data = b""
+    while len(data) < count:
+        chunk = sock.recv(count - len(data))
+        if not chunk:
+            raise ConnectionError("closed")
+        data += chunk
+    return data
+
+
+def wait_until(predicate, timeout: float = TIMEOUT) -> bool:
+    """Whether ``predicate()`` became true within ``timeout`` s (polled every 20 ms)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        time.sleep(0.02)
+    return False

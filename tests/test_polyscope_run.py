@@ -3,12 +3,10 @@ virtual controller's dashboard ``load X.urp`` / ``play``, over loopback."""
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 from _robot_fakes import LOOPBACK, FakeController, FakeServer
-from _sim_clients import Dashboard
+from _sim_clients import Dashboard, wait_until
 
 from urdsl.cli import main
 from urdsl.sim.controller import VirtualController
@@ -63,17 +61,6 @@ def sim(tmp_path):
         with controller.serve(ports={k: 0 for k in STANDARD_PORTS}) as servers:
             controller.servers = servers
             yield controller
-
-
-
-
-def wait_until(predicate, timeout=TIMEOUT):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.02)
-    return False
 
 
 def test_dashboard_loads_and_plays_a_polyscope_program(sim):

@@ -10,7 +10,7 @@ import struct
 import time
 
 import pytest
-from _sim_clients import Dashboard, connect
+from _sim_clients import Dashboard, connect, read_exactly
 
 from urdsl.sim import dashboard as sim_dashboard
 from urdsl.sim import rtde as sim_rtde
@@ -32,20 +32,6 @@ def sim(tmp_path):
             controller.servers = servers
             controller.tmp = tmp_path
             yield controller
-
-
-
-
-
-
-def read_exactly(sock: socket.socket, count: int) -> bytes:
-    data = b""
-    while len(data) < count:
-        chunk = sock.recv(count - len(data))
-        if not chunk:
-            raise ConnectionError("closed")
-        data += chunk
-    return data
 
 
 def rtde_ask(sock: socket.socket, kind: str, payload: bytes = b"") -> bytes:

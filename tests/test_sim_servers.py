@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 import pytest
-from _sim_clients import Dashboard, connect
+from _sim_clients import Dashboard, connect, read_exactly, wait_until
 
 from urdsl.sim.controller import VirtualController
 from urdsl.sim.servers import STANDARD_PORTS
@@ -34,30 +34,7 @@ def sim(tmp_path):
             yield controller
 
 
-
-
-def read_exactly(sock: socket.socket, count: int) -> bytes:
-    data = b""
-    while len(data) < count:
-        chunk = sock.recv(count - len(data))
-        if not chunk:
-            raise ConnectionError("closed")
-        data += chunk
-    return data
-
-
-def wait_until(predicate, timeout=TIMEOUT):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.02)
-    return False
-
-
 # ---- dashboard --------------------------------------------------------------------------------
-
-
 
 
 def test_dashboard_answers_with_the_documented_replies(sim):
