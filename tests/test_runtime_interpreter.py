@@ -51,6 +51,8 @@ def test_poses_lists_structs_matrices():
     s = value("x = struct(a=1, b=\"t\")\nx.a = 5\n")
     assert s == StructValue({"a": 5, "b": "t"})
     assert value("s = struct(a=1, b=2)\nx = s[1] + s.a") == 3
+    # a struct loops like a list in real 5.14 programs: length() counts its members
+    assert value("s = struct(a=1, b=2, c=p[0, 0, 0, 0, 0, 0])\nx = length(s)") == 3
     assert value("x = make_list(2, 0, 5)\nx.append(7)\nx.append(8)\n") == ListValue([0, 0, 7, 8])
 
 

@@ -367,9 +367,17 @@ def _str_find(rt, node, src, target, start_from=0):
 
 @implements("get_list_length", "length")
 def _length(rt, node, **kw):
+    """Elements of a list, characters of a string, members of a struct.
+
+    The manual documents lists and strings. A struct is read by position like a list
+    (``s[1]``) and assigns to a list; real programs on 5.14 call ``length(s)`` on one (its
+    member count) in production, so urdsl accepts it [U: not in UR's documentation].
+    """
     value = next(iter(kw.values()))
     if type(value) in (ListValue, str):
         return len(value)
+    if type(value) is StructValue:
+        return len(value.members)
     raise rt.error("type", f"length of a {type_name(value)}", node)
 
 
