@@ -36,7 +36,7 @@ from ..script.nodes import (
 from .installation import Installation
 from .urp import Program
 
-__all__ = ["preamble", "step_counter"]
+__all__ = ["BLOCKS", "preamble", "preamble_blocks", "step_counter"]
 
 
 def _call(name: str, *args: Expr, **keywords: Expr) -> Call:
@@ -85,14 +85,27 @@ _OUTPUT_MODE = {"SINKING": 1, "SOURCING": 2, "PUSH_PULL": 3}
 _VOLTAGE = {"ZERO": 0, "TWELVE": 12, "TWENTY_FOUR": 24}
 
 
+def _baud(text: str) -> int:
+    """Bit/s of PolyScope's ``BAUD_115200``, ``BAUD_1M`` or ``BAUD_1000000`` (115200 if
+    unreadable)."""
+    if text in _BAUD:
+        return _BAUD[text]
+    digits = text.removeprefix("BAUD_")
+    return int(digits) if digits.isdigit() else 115200
+
+
 def _tool_communication(attrs: dict[str, str] | None) -> list[Item]:
     """The tool connector's settings as PolyScope writes them (baud rate in bit/s, idle
     times in characters, voltage in V)."""
     if not attrs:
         return []
+    voltage = attrs.get("toolOutputVoltage")
+    if "enabled" not in attrs:  # PolyScope 3.x: the tool output voltage only
+        return [_stmt("set_tool_voltage", Number(_VOLTAGE[voltage]))] \
+            if voltage in _VOLTAGE else []
     items: list[Item] = [_stmt(
         "set_tool_communication", Bool(attrs.get("enabled") == "true"),
-        Number(_BAUD.get(attrs.get("baudRate", ""), 115200)),
+        Number(_baud(attrs.get("baudRate", ""))),
         Number(_PARITY.get(attrs.get("parity", ""), 0)),
         Number(_STOP_BITS.get(attrs.get("stopBits", ""), 1)),
         _num(float(attrs.get("rxIdleChars", "1.5"))), _num(float(attrs.get("txIdleChars", "3.5"))))]
@@ -103,31 +116,130 @@ def _tool_communication(attrs: dict[str, str] | None) -> list[Item]:
         if mode in _OUTPUT_MODE:
             items.append(_stmt("set_tool_digital_output_mode", Number(index),
                                Number(_OUTPUT_MODE[mode])))
-    voltage = attrs.get("toolOutputVoltage")
     if voltage in _VOLTAGE:
         items.append(_stmt("set_tool_voltage", Number(_VOLTAGE[voltage])))
     return items
 
 
+def _version(text: str | None) -> tuple[int, int]:
+    """(major, minor) of a ``"5.11.9.1010452"``-like version; (0, 0) when unknown."""
+    parts = [int(p) if p.isdigit() else 0 for p in (text or "").split(".")[:2]] + [0, 0]
+    return parts[0], parts[1]
+
+
+_RUNSTATE = {"LOW_WHEN_PROGRAM_STOPPED": 1, "HIGH_WHEN_PROGRAM_STOPPED": 2,
+             "HIGH_WHEN_PROGRAM_RUNNING_LOW_WHEN_STOPPED": 3}
+"""Output actions when the program stops → the state number of ``set_runstate_*`` (1 seen;
+2 and 3 as the URScript manual numbers them [U])."""
+_RUNSTATE_BANKS = (("DigitalOutputActions", "standard"),
+                   ("ConfigurableOutputActions", "configurable"),
+                   ("ToolDigitalOutputActions", "tool"))
+_MODBUS_KINDS = {"DIGITAL_INPUT": 0, "DIGITAL_OUTPUT": 1, "REGISTER_INPUT": 2,
+                 "REGISTER_OUTPUT": 3}
+_MOTION_VERSIONS = {"JERK_LIMITED": 2}
+"""``MotionSettingsConfiguration motionVersion`` → ``motion_version_set`` (5.22 on; only
+JERK_LIMITED seen)."""
+
+BLOCKS = ("steps", "safety", "wrench", "motion", "tool", "gravity", "io", "modbus", "payload",
+          "tcp")
+"""The kinds of the preamble blocks whose order PolyScope does not keep: the same
+installation saved twice gives them in two orders (a Java hash set's order). urdsl writes
+them in this order."""
+
+
+def preamble_blocks(program: Program, installation: Installation | None,
+                    variables: list[tuple[str, str]]) -> list[tuple[str, list[Item]]]:
+    """The preamble as (kind, statements) blocks in the order urdsl writes them. Kinds:
+    ``verification`` (PolyScope 5.13 on: a hidden global, always first), the movable
+    blocks of :data:`BLOCKS`, then ``variables`` (the installation variables) and
+    ``features`` (feature poses, by name). Installation URCap code and Modbus signals'
+    input/output actions are not written."""
+    blocks: list[tuple[str, list[Item]]] = []
+    saved = _version(program.saved_in or program.created_in)
+    major = program.major_version or saved[0] or 5
+    if saved >= (5, 13):
+        blocks.append(("verification", [Declare("global", "_hidden_verificationVariable",
+                                                Number(0))]))
+    movable: dict[str, list[Item]] = {"steps": step_counter(program)}
+    if installation is not None:
+        movable.update(_installation_blocks(installation, major))
+    for kind in BLOCKS:
+        if movable.get(kind):
+            blocks.append((kind, movable[kind]))
+    if installation is None:
+        return blocks
+    values: list[Item] = []
+    for name, value in variables:
+        try:
+            values.append(Declare("global", name, _value(value)))
+        except ValueError:  # not a value URScript reads: PolyScope would not run it
+            values.append(Comment(f" urdsl: installation variable {name} is not URScript"))
+    if values:
+        blocks.append(("variables", values))
+    features = [Declare("global", name, Pose(tuple(_num(v) for v in pose)))
+                for name, pose in sorted(installation.features or ())]
+    if features:
+        blocks.append(("features", features))
+    return blocks
+
+
 def preamble(program: Program, installation: Installation | None,
              variables: list[tuple[str, str]]) -> list[Item]:
-    """What PolyScope 5 writes from the installation before the program: safety
-    transition, tool communication and output, gravity, analog domains, input actions,
-    payload and TCP. (PolyScope writes these blocks in an order that changes from one
-    save to the next; this is one of them.) Installation variables, features, Modbus
-    signals and URCap installation code are not written."""
-    items: list[Item] = step_counter(program)
-    if installation is None or (program.major_version or 5) < 5:
-        return items
+    """What PolyScope 3.x and 5.x write before the program tree, from the installation
+    (and the program's PolyScope version): the blocks of :func:`preamble_blocks` in
+    order."""
+    return [item for _kind, items in preamble_blocks(program, installation, variables)
+            for item in items]
+
+
+def _installation_blocks(installation: Installation, major: int) -> dict[str, list[Item]]:
     settings = installation.settings or {}
+    blocks: dict[str, list[Item]] = {}
+    safety: list[Item] = []
     hardness = settings.get("SmoothTransitionSettings", {}).get("transitionHardness")
     if hardness:
-        items.append(_stmt("set_safety_mode_transition_hardness",
-                           Number(1 if hardness == "SOFT" else 0)))
-    items.extend(_tool_communication(settings.get("ToolCommSettings")))
+        safety.append(_stmt("set_safety_mode_transition_hardness",
+                            Number(1 if hardness == "SOFT" else 0)))
+    blocks["safety"] = safety
+    wrench = settings.get("ToolWrenchConfiguration")
+    if wrench is not None:
+        if wrench.get("forceLimitEnabled") != "true" and wrench.get("momentLimitEnabled") \
+                != "true":
+            blocks["wrench"] = [_stmt("tool_wrench_limit_disable")]
+        else:  # the call PolyScope writes for an enabled limit is not known
+            blocks["wrench"] = [Comment(" urdsl: the tool wrench limit is not written")]
+    motion = settings.get("MotionSettingsConfiguration", {}).get("motionVersion")
+    if motion:
+        blocks["motion"] = [_stmt("motion_version_set", Number(_MOTION_VERSIONS.get(motion, 1)))]
+    blocks["tool"] = _tool_communication(settings.get("ToolCommSettings"))
     gravity = installation.gravity
     if gravity is not None:
-        items.append(_stmt("set_gravity", List(tuple(_num(v) for v in gravity))))
+        blocks["gravity"] = [_stmt("set_gravity", List(tuple(_num(v) for v in gravity)))]
+    blocks["io"] = _io(settings)
+    blocks["modbus"] = _modbus(installation)
+    payload = installation.payload
+    if payload is not None:
+        raw = settings.get(f"Payload/{payload.name}")
+        if raw is not None and raw.get("inertiaParameters"):
+            inertia = tuple(float(v) for v in raw["inertiaParameters"].split(","))
+            blocks["payload"] = [_stmt("set_target_payload", _num(payload.mass),
+                                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))),
+                                       List(tuple(_num(v) for v in inertia)))]
+        elif payload.cog is None and major < 5:
+            blocks["payload"] = [_stmt("set_payload", _num(payload.mass))]
+        else:
+            blocks["payload"] = [_stmt("set_payload", _num(payload.mass),
+                                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))))]
+    tcp = installation.tcp
+    if tcp is not None:
+        blocks["tcp"] = [_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset)))]
+    return blocks
+
+
+def _io(settings: dict[str, dict[str, str]]) -> list[Item]:
+    """Analog domains (0: current, 1: voltage), input actions and the outputs' states
+    when the program stops."""
+    items: list[Item] = []
     ranges = _ints(settings.get("IOs/analogInputRange", {}).get("value"))
     if len(ranges) == 4:
         for index in range(2):
@@ -143,34 +255,47 @@ def preamble(program: Program, installation: Installation | None,
         items.append(_stmt("set_input_actions_to_default"))
         # only the tool inputs' actions are written (seen: "freedrive"); the controller
         # keeps the standard and configurable inputs' actions itself
-        for key, function in (("ToolDigitalInputActions", "set_tool_digital_input_action"),):
-            actions = settings.get(f"IOs/{key}", {}).get("value", "").split(",")
-            for index, action in enumerate(a.strip() for a in actions):
-                if action and action != "NONE":
-                    items.append(_stmt(function, Number(index),
-                                       String(action.lower().replace("_", " "))))
-    payload = installation.payload
-    if payload is not None:
-        raw = settings.get(f"Payload/{payload.name}")
-        cog = payload.cog or (0.0, 0.0, 0.0)
-        if raw is not None and raw.get("inertiaParameters"):
-            inertia = tuple(float(v) for v in raw["inertiaParameters"].split(","))
-            items.append(_stmt("set_target_payload", _num(payload.mass),
-                               List(tuple(_num(v) for v in cog)),
-                               List(tuple(_num(v) for v in inertia))))
-        else:
-            items.append(_stmt("set_payload", _num(payload.mass),
-                               List(tuple(_num(v) for v in cog))))
-    tcp = installation.tcp
-    if tcp is not None:
-        items.append(_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset))))
-    for name, value in variables:
-        try:
-            items.append(Declare("global", name, _value(value)))
-        except ValueError:  # not a value URScript reads: PolyScope would not run it
-            items.append(Comment(f" urdsl: installation variable {name} is not URScript"))
-    for name, pose in sorted(installation.features or ()):
-        items.append(Declare("global", name, Pose(tuple(_num(v) for v in pose))))
+        actions = settings.get("IOs/ToolDigitalInputActions", {}).get("value", "").split(",")
+        for index, action in enumerate(a.strip() for a in actions):
+            if action and action != "NONE":
+                items.append(_stmt("set_tool_digital_input_action", Number(index),
+                                   String(action.lower().replace("_", " "))))
+    states: list[tuple[str, int, int]] = []
+    for key, bank in _RUNSTATE_BANKS:
+        actions = settings.get(f"IOs/{key}", {}).get("value", "").split(",")
+        pins = [(index, _RUNSTATE[a.strip()]) for index, a in enumerate(actions)
+                if a.strip() in _RUNSTATE]
+        if pins:
+            items.append(_stmt(f"set_runstate_{bank}_digital_outputs",
+                               List(tuple(Number(index) for index, _ in pins))))
+            states.extend((bank, index, state) for index, state in pins)
+    for bank, index, state in states:
+        items.append(_stmt(f"set_runstate_{bank}_digital_output_to_value", Number(index),
+                           Number(state)))
+    return items
+
+
+def _modbus(installation: Installation) -> list[Item]:
+    """Each Modbus signal: added, its update frequency (Hz) set, and for an output what it
+    does when the program stops."""
+    items: list[Item] = []
+    for signal in installation.modbus:
+        if signal.kind not in _MODBUS_KINDS:
+            items.append(Comment(f" urdsl: Modbus signal {signal.name} of type "
+                                 f"{signal.kind} is not written"))
+            continue
+        name = String(signal.name)
+        items.append(_stmt("modbus_add_signal", String(signal.ip), Number(signal.slave),
+                           Number(signal.address), Number(_MODBUS_KINDS[signal.kind]), name,
+                           Bool(signal.sequential)))
+        if signal.frequency is not None:
+            frequency = signal.frequency
+            items.append(_stmt("modbus_set_signal_update_frequency", name,
+                               Number(int(frequency)) if frequency == int(frequency)
+                               else _num(frequency)))
+        if signal.kind.endswith("OUTPUT") and signal.choice is not None:
+            items.append(_stmt("modbus_set_runstate_dependent_choice", name,
+                               Number(signal.choice)))
     return items
 
 
