@@ -15,6 +15,20 @@ compare by number and flag (their label text is in the language PolyScope ran in
 statements from the first waypoint global, definition or marker on: what the program tree,
 not the installation, generates).
 
+The preamble (what the installation generates before the program tree) is compared block
+by block in any order, each block's statements in order (blocks: the step-counter thread,
+transition hardness, tool wrench limit, motion version, tool communication, gravity, I/O
+setup, Modbus signals, payload, TCP, the verification global, the other globals). PolyScope
+does not keep the order of these blocks: GapeCobot/Soudure's
+``TRAVAIL 27112023/Cobot_soudure_29112023-2.script`` saved at 28e0e3a and at 05361bd with the
+same installation (blob 66068667) has them in two orders, and Snupai/SZ's four
+``UR/UR Programm/laengs_greifer_multi*.script`` share one installation file and show four
+orders. "Exact whole" is then: the program part equal line for line and the preamble
+blocks equal as a multiset; "as written" also needs PolyScope's order of that save.
+Pairs whose installation is not in the repository cannot have an exact preamble: they are
+counted, and the exact share is given over all pairs and over those with their
+installation.
+
 Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most. ``--show N`` prints the first differing lines of N programs.
