@@ -18,13 +18,15 @@ not the installation, generates).
 The preamble (what the installation generates before the program tree) is compared block
 by block in any order, each block's statements in order (blocks: the step-counter thread,
 transition hardness, tool wrench limit, motion version, tool communication, gravity, I/O
-setup, Modbus signals, payload, TCP, the verification global, the other globals). PolyScope
-does not keep the order of these blocks: GapeCobot/Soudure's
+setup, Modbus signals, payload, TCP, the verification global, the other globals): the
+statements of each kind in order, the kinds interleaved in any way. PolyScope does not keep
+the order of these blocks: GapeCobot/Soudure's
 ``TRAVAIL 27112023/Cobot_soudure_29112023-2.script`` saved at 28e0e3a and at 05361bd with the
 same installation (blob 66068667) has them in two orders, and Snupai/SZ's four
 ``UR/UR Programm/laengs_greifer_multi*.script`` share one installation file and show four
-orders. "Exact whole" is then: the program part equal line for line and the preamble
-blocks equal as a multiset; "as written" also needs PolyScope's order of that save.
+orders; the step-counter thread may also come between two globals. "Exact whole" is then:
+the program part equal line for line and each kind's preamble statements equal in order;
+"as written" also needs PolyScope's order of that save.
 Pairs whose installation is not in the repository cannot have an exact preamble: they are
 counted, and the exact share is given over all pairs and over those with their
 installation.
@@ -198,10 +200,7 @@ _PREAMBLE_KINDS = (
 
 def preamble_blocks(module: Module) -> list[tuple[str, tuple[str, ...]]]:
     """The preamble's blocks in written order: (kind, canonical lines), a block being a run
-    of top-level statements of one kind (see ``_PREAMBLE_KINDS``; ``other`` for the rest).
-    PolyScope does not keep the order of these blocks (the same installation saved twice
-    gives two orders), so ``sorted()`` of two block lists compares them in any order while
-    the statements of each block keep theirs."""
+    of top-level statements of one kind (see ``_PREAMBLE_KINDS``; ``other`` for the rest)."""
     blocks: list[tuple[str, list[str]]] = []
     for item in module.body:
         lines = canonical_lines(Module((item,)))
@@ -214,6 +213,16 @@ def preamble_blocks(module: Module) -> list[tuple[str, tuple[str, ...]]]:
         else:
             blocks.append((kind, list(lines)))
     return [(kind, tuple(lines)) for kind, lines in blocks]
+
+
+def by_kind(blocks: list[tuple[str, tuple[str, ...]]]) -> dict[str, tuple[str, ...]]:
+    """Kind → its statements' lines in written order. PolyScope does not keep the order of
+    the blocks (the same installation saved twice gives two orders), and may write a block
+    between two globals: two preambles are equal in any block order when these are."""
+    out: dict[str, tuple[str, ...]] = {}
+    for kind, lines in blocks:
+        out[kind] = out.get(kind, ()) + lines
+    return out
 
 
 def program_part(module: Module, waypoints: frozenset[str]) -> Module:
@@ -357,17 +366,15 @@ def main(argv: list[str] | None = None) -> int:
         st["pre_total"] += sum(theirs_pre.values())
         st["pre_found"] += sum((theirs_pre & ours_pre).values())
         st["pre_extra"] += sum((ours_pre - theirs_pre).values())
-        for kind, lines in theirs_blocks:
-            if (kind, lines) not in ours_blocks:
-                st["pre_kinds"][kind] += 1
-        for kind, lines in ours_blocks:
-            if (kind, lines) not in theirs_blocks:
+        theirs_kinds, ours_kinds = by_kind(theirs_blocks), by_kind(ours_blocks)
+        for kind in sorted(set(theirs_kinds) | set(ours_kinds)):
+            if theirs_kinds.get(kind) != ours_kinds.get(kind):
                 st["pre_kinds"][kind] += 1
         share = compare(ours, theirs)
         share_prog = compare(ours_prog, theirs_prog)
         st["share"] += share
         st["share_prog"] += share_prog
-        exact = ours_prog == theirs_prog and sorted(ours_blocks) == sorted(theirs_blocks)
+        exact = ours_prog == theirs_prog and ours_kinds == theirs_kinds
         st["exact"] += exact
         st["exact_written"] += ours == theirs
         st["exact_prog"] += ours_prog == theirs_prog
@@ -386,12 +393,13 @@ def main(argv: list[str] | None = None) -> int:
                 if number > 40:
                     break
                 print(line[:160])
-            for sign, mine, other in (("-", theirs_blocks, ours_blocks),
-                                      ("+", ours_blocks, theirs_blocks)):
-                for kind, lines in mine:
-                    if (kind, lines) not in other:
-                        for line in lines[:6]:
-                            print(f"{sign}[preamble {kind}] {line[:140]}")
+            for kind in sorted(set(theirs_kinds) | set(ours_kinds)):
+                if theirs_kinds.get(kind) != ours_kinds.get(kind):
+                    diff = difflib.unified_diff(theirs_kinds.get(kind, ()),
+                                                ours_kinds.get(kind, ()), n=0, lineterm="")
+                    for line in list(diff)[2:14]:
+                        if not line.startswith("@@"):
+                            print(f"{line[0]}[preamble {kind}] {line[1:140]}")
     for split, st in sorted(stats.items(), reverse=True):
         n = max(st["n"], 1)
         print(f"[{split}] {st['n']} programs ({st['missing']} missing, "

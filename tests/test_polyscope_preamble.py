@@ -241,3 +241,31 @@ def test_compile_names_a_missing_or_corrupt_installation(tmp_path, capsys):
     text = out.read_text()
     assert "modbus_add_signal(" in text and "global Table = p[" in text
     assert "warning" not in capsys.readouterr().err
+
+
+def test_initial_values_of_the_variables_setup_and_of_urcap_variables():
+    urp = (b'<URProgram name="pre" installation="cell" createdIn="5.11.9" lastSavedIn="5.11.9">'
+           b'<children><InitVariablesNode><variables>'
+           b'<variable name="ready"><expression><ExpressionToken token=" False "/>'
+           b'</expression></variable>'
+           b'<variable name="count"><expression><ExpressionChar character="1"/>'
+           b'<ExpressionChar character="2"/></expression></variable>'
+           b'<variable name="twice"><expression><ExpressionVariable><variable name="count"/>'
+           b'</ExpressionVariable><ExpressionChar character="*"/><ExpressionChar character="2"/>'
+           b'</expression></variable>'
+           b'<variable name="bad"><expression><ExpressionVariable/></expression></variable>'
+           b'</variables></InitVariablesNode>'
+           b'<MainProgram runOnlyOnce="true"><children>'
+           b'<Contributed strategyURCapName="Gripper"><dataModel><Variable key="v">'
+           b'<variable name="part"><initializeExpression><ExpressionToken token="True"/>'
+           b'</initializeExpression></variable></Variable></dataModel></Contributed>'
+           b'<Contributed strategyURCapName="Gripper"><dataModel><Variable key="v">'
+           b'<variable name="part"><initializeExpression><ExpressionToken token="True"/>'
+           b'</initializeExpression></variable></Variable></dataModel></Contributed>'
+           b'</children></MainProgram></children></URProgram>')
+    blocks = _blocks(urp, None)
+    assert blocks["initial"] == ["global ready = False", "global count = 12",
+                                 "global twice = count * 2",
+                                 "# urdsl: the initial value of bad is not compiled",
+                                 "global part = True"]  # each name once
+    assert list(blocks)[-1] == "initial"  # after the installation's blocks

@@ -8,6 +8,7 @@ program's ``def``.
 from __future__ import annotations
 
 import uuid
+from xml.etree import ElementTree
 
 from ..script import parse
 from ..script.build import literal
@@ -34,9 +35,9 @@ from ..script.nodes import (
     While,
 )
 from .installation import Installation
-from .urp import Program
+from .urp import Expression, Program
 
-__all__ = ["BLOCKS", "preamble", "preamble_blocks", "step_counter"]
+__all__ = ["BLOCKS", "initial_values", "preamble", "preamble_blocks", "step_counter"]
 
 
 def _call(name: str, *args: Expr, **keywords: Expr) -> Call:
@@ -152,8 +153,10 @@ def preamble_blocks(program: Program, installation: Installation | None,
     """The preamble as (kind, statements) blocks in the order urdsl writes them. Kinds:
     ``verification`` (PolyScope 5.13 on: a hidden global, always first), the movable
     blocks of :data:`BLOCKS`, then ``variables`` (the installation variables) and
-    ``features`` (feature poses, by name). Installation URCap code and Modbus signals'
-    input/output actions are not written."""
+    ``features`` (feature poses, by name), then ``initial`` (the program's initial variable
+    values, see :func:`initial_values`: PolyScope writes them after the installation's URCap
+    code). Installation URCap code and Modbus signals' input/output actions are not
+    written."""
     blocks: list[tuple[str, list[Item]]] = []
     saved = _version(program.saved_in or program.created_in)
     major = program.major_version or saved[0] or 5
@@ -166,10 +169,8 @@ def preamble_blocks(program: Program, installation: Installation | None,
     for kind in BLOCKS:
         if movable.get(kind):
             blocks.append((kind, movable[kind]))
-    if installation is None:
-        return blocks
     values: list[Item] = []
-    for name, value in variables:
+    for name, value in variables if installation is not None else ():
         try:
             values.append(Declare("global", name, _value(value)))
         except ValueError:  # not a value URScript reads: PolyScope would not run it
@@ -177,10 +178,61 @@ def preamble_blocks(program: Program, installation: Installation | None,
     if values:
         blocks.append(("variables", values))
     features = [Declare("global", name, Pose(tuple(_num(v) for v in pose)))
-                for name, pose in sorted(installation.features or ())]
+                for name, pose in sorted(installation.features if installation else ())]
     if features:
         blocks.append(("features", features))
+    initial = initial_values(program)
+    if initial:
+        blocks.append(("initial", initial))
     return blocks
+
+
+def _expression(element: ElementTree.Element) -> str | None:
+    """The URScript text of an expression element of characters, tokens and named variables;
+    None when it refers to anything else (a variable by reference, an I/O, a waypoint)."""
+    parts = []
+    for piece in element:
+        if piece.tag == "ExpressionChar":
+            parts.append(("char", piece.get("character", "")))
+        elif piece.tag == "ExpressionToken":
+            parts.append(("token", piece.get("token", "")))
+        elif piece.tag == "ExpressionVariable" and len(piece) and piece[0].get("name"):
+            parts.append(("var", piece[0].get("name", "")))
+        else:
+            return None
+    return Expression(tuple(parts)).script
+
+
+def initial_values(program: Program) -> list[Item]:
+    """The globals PolyScope writes after the installation's code: each variable of the
+    program's variables setup (``InitVariablesNode``) with its value, in file order, then
+    each variable declared elsewhere with an initial value (``<initializeExpression>``, as
+    URCap nodes declare them), in file order, each name once."""
+    items: list[Item] = []
+    seen: set[str] = set()
+
+    def declare(name: str | None, expression: ElementTree.Element | None) -> None:
+        if not name or name in seen or expression is None or not len(expression):
+            return
+        seen.add(name)
+        text = _expression(expression)
+        try:
+            if text is None:
+                raise ValueError(name)
+            items.append(Declare("global", name, _value(text)))
+        except ValueError:
+            items.append(Comment(f" urdsl: the initial value of {name} is not compiled"))
+
+    init = program.init_variables
+    if init is not None and init.element is not None:
+        for variable in init.element.iterfind("variables/variable"):
+            declare(variable.get("name"), variable.find("expression"))
+    for root in program.top:
+        if root.element is None or root is init:
+            continue
+        for variable in root.element.iter("variable"):
+            declare(variable.get("name"), variable.find("initializeExpression"))
+    return items
 
 
 def preamble(program: Program, installation: Installation | None,
