@@ -88,6 +88,12 @@ def _installation5(extra: str = "") -> bytes:
   <SmoothTransitionSettings transitionHardness="HARD"/>
   <ToolWrenchConfiguration forceLimitEnabled="false" momentLimitEnabled="false"/>
   <MotionSettingsConfiguration motionVersion="JERK_LIMITED"/>
+  <Contributions><URCaps>
+    <Contributed id="ConveyorTracking" name="Conveyor Tracking" vendor="Universal Robots"
+      installationContributionTitle="Conveyor Tracking"/>
+    <Contributed id="com.acme.GripperService" name="Acme Gripper" vendor="Acme Inc."
+      installationContributionTitle="Gripper"/>
+  </URCaps></Contributions>
   {extra}
 </Installation>""".encode()
 
@@ -176,6 +182,13 @@ def test_a_plane_feature_is_placed_as_polyscope_places_it(five):
     assert pose[3:] == pytest.approx((0.0, math.pi, 0.0), abs=1e-9)
 
 
+def test_urcap_installation_nodes_are_marked_empty_blocks(five):
+    """Their code only the URCap can generate; UR's built-in contributions write none."""
+    assert five["urcaps"] == ["# begin: URCap Installation Node",
+                              "#   Source: Acme Gripper, Acme Inc.", "#   Type: Gripper",
+                              "# end: URCap Installation Node"]
+
+
 def test_polyscope_3_preamble():
     blocks = _blocks(_urp("3.15.8.106339"), _INSTALLATION3)
     assert blocks["tool"] == ["set_tool_voltage(12)"]  # no tool communication on CB3
@@ -193,7 +206,7 @@ def test_the_blocks_come_in_one_fixed_order():
     installation = parse_installation(_installation5(), "cell.installation")
     kinds = [kind for kind, _ in preamble_blocks(program, installation, [("n", "1")])]
     movable = [kind for kind in kinds if kind in BLOCKS]
-    assert kinds[0] == "verification" and kinds[-2:] == ["variables", "features"]
+    assert kinds[0] == "verification" and kinds[-3:] == ["variables", "features", "urcaps"]
     assert movable == [kind for kind in BLOCKS if kind in movable]
     first = compile_program(program, installation).text
     assert compile_program(program, installation).text == first

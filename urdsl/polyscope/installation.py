@@ -223,6 +223,10 @@ class Installation:
     file has them."""
     modbus: tuple[ModbusSignal, ...] = ()
     """The Modbus signals, in file order."""
+    urcaps: tuple[tuple[str, str, str], ...] = ()
+    """The URCaps contributing an installation node, in file order: (name, vendor, node
+    title). UR's own conveyor tracking, EtherNet/IP, PROFINET and screwdriving nodes are
+    left out: they write nothing before the program."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -338,7 +342,7 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
                         mounting, version, _settings(root), _features(root, path),
-                        _io_names(root), _safety(root), _modbus(root, path))
+                        _io_names(root), _safety(root), _modbus(root, path), _urcaps(root))
 
 
 def _safety(root: ElementTree.Element) -> Safety | None:
@@ -443,6 +447,19 @@ def _features(root: ElementTree.Element, path: str) -> tuple[tuple[str, tuple[fl
             if pose is not None:
                 features.append((name, pose))
     return tuple(features)
+
+
+_BUILT_IN = frozenset((
+    "ConveyorTracking", "EthernetIP", "com.ur.urcap.profinet",
+    "com.ur.polyscope.screwdriving.installation.ScrewdrivingInstallationNodeService"))
+"""Installation contributions PolyScope ships whose code is not in a program's preamble."""
+
+
+def _urcaps(root: ElementTree.Element) -> tuple[tuple[str, str, str], ...]:
+    return tuple((element.get("name", "?"), element.get("vendor", "?"),
+                  element.get("installationContributionTitle", element.get("name", "?")))
+                 for element in root.iterfind("Contributions/URCaps/Contributed")
+                 if element.get("id") not in _BUILT_IN)
 
 
 def _modbus(root: ElementTree.Element, path: str) -> tuple[ModbusSignal, ...]:

@@ -153,10 +153,10 @@ def preamble_blocks(program: Program, installation: Installation | None,
     """The preamble as (kind, statements) blocks in the order urdsl writes them. Kinds:
     ``verification`` (PolyScope 5.13 on: a hidden global, always first), the movable
     blocks of :data:`BLOCKS`, then ``variables`` (the installation variables) and
-    ``features`` (feature poses, by name), then ``initial`` (the program's initial variable
-    values, see :func:`initial_values`: PolyScope writes them after the installation's URCap
-    code). Installation URCap code and Modbus signals' input/output actions are not
-    written."""
+    ``features`` (feature poses, by name), ``urcaps`` (a marked block per URCap
+    installation node: its code only the URCap can generate, so the block is empty), then
+    ``initial`` (the program's initial variable values, see :func:`initial_values`).
+    Modbus signals' input/output actions are not written."""
     blocks: list[tuple[str, list[Item]]] = []
     saved = _version(program.saved_in or program.created_in)
     major = program.major_version or saved[0] or 5
@@ -181,6 +181,13 @@ def preamble_blocks(program: Program, installation: Installation | None,
                 for name, pose in sorted(installation.features if installation else ())]
     if features:
         blocks.append(("features", features))
+    urcaps: list[Item] = []
+    for name, vendor, title in installation.urcaps if installation else ():
+        urcaps.extend((Comment(" begin: URCap Installation Node"),
+                       Comment(f"   Source: {name}, {vendor}"), Comment(f"   Type: {title}"),
+                       Comment(" end: URCap Installation Node")))
+    if urcaps:
+        blocks.append(("urcaps", urcaps))
     initial = initial_values(program)
     if initial:
         blocks.append(("initial", initial))
