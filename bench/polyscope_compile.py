@@ -15,6 +15,22 @@ compare by number and flag (their label text is in the language PolyScope ran in
 statements from the first waypoint global, definition or marker on: what the program tree,
 not the installation, generates).
 
+The preamble (what the installation generates before the program tree) is compared block
+by block in any order, each block's statements in order (blocks: the step-counter thread,
+transition hardness, tool wrench limit, motion version, tool communication, gravity, I/O
+setup, Modbus signals, payload, TCP, the verification global, the other globals): the
+statements of each kind in order, the kinds interleaved in any way. PolyScope does not keep
+the order of these blocks: GapeCobot/Soudure's
+``TRAVAIL 27112023/Cobot_soudure_29112023-2.script`` saved at 28e0e3a and at 05361bd with the
+same installation (blob 66068667) has them in two orders, and Snupai/SZ's four
+``UR/UR Programm/laengs_greifer_multi*.script`` share one installation file and show four
+orders; the step-counter thread may also come between two globals. "Exact whole" is then:
+the program part equal line for line and each kind's preamble statements equal in order;
+"as written" also needs PolyScope's order of that save.
+Pairs whose installation is not in the repository cannot have an exact preamble: they are
+counted, and the exact share is given over all pairs and over those with their
+installation.
+
 Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most. ``--show N`` prints the first differing lines of N programs.
@@ -38,7 +54,11 @@ from urdsl.polyscope.compile import (  # noqa: E402
     compile_program,
     parse_variables,
 )
-from urdsl.polyscope.installation import InstallationError, parse_installation  # noqa: E402
+from urdsl.polyscope.installation import (  # noqa: E402
+    Installation,
+    InstallationError,
+    parse_installation,
+)
 from urdsl.polyscope.urp import UrpError, parse_urp  # noqa: E402
 from urdsl.script import parse  # noqa: E402
 from urdsl.script.diagnostics import ScriptError  # noqa: E402
@@ -55,6 +75,9 @@ from urdsl.script.printer import format as print_tree  # noqa: E402
 
 _ID = re.compile(r"_[0-9a-f]{8}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{12}")
 _NUMBER = re.compile(r"(?<![\w.])(\d+\.\d*|\.\d+|\d+)(e-?\d+)?(?![\w.])", re.IGNORECASE)
+_NEGATIVE_ZERO = re.compile(r"(?<![\w.)\]])-0(?![\w.])")
+"""A number that rounds to zero keeps no sign (PolyScope writes -1.2E-16 where urdsl
+computes 3.4E-17)."""
 _MARKER = re.compile(r'^(\s*)\$ (\d+) "(?:[^"]*)"(.*)$')
 
 
@@ -141,7 +164,7 @@ def canonical_lines(module: Module) -> list[str]:
         if marker:
             line = f"{marker.group(1)}$ {marker.group(2)}{marker.group(3)}"
         else:
-            line = _NUMBER.sub(_number, line)
+            line = _NEGATIVE_ZERO.sub("0", _NUMBER.sub(_number, line))
         lines.append(line)
     return lines
 
@@ -154,6 +177,52 @@ def preamble_part(module: Module, waypoints: frozenset[str]) -> Module:
         rest = program_part(module, waypoints).body
         return Module(items[:len(items) - len(rest)])
     return Module(())
+
+
+_PREAMBLE_KINDS = (
+    ("steps", re.compile(r"(step_count_ID\b|thread Step_Counter_Thread_ID|run Step_Counter)")),
+    ("safety", re.compile(r"set_safety_mode_transition_hardness\(")),
+    ("wrench", re.compile(r"tool_wrench_limit_\w+\(")),
+    ("motion", re.compile(r"motion_version_set\(")),
+    ("tool", re.compile(r"(set_tool_communication|set_tool_output_mode|"
+                        r"set_tool_digital_output_mode|set_tool_voltage)\(")),
+    ("gravity", re.compile(r"set_gravity\(")),
+    ("io", re.compile(r"(set_\w*analog_\w*domain|set_input_actions_to_default|"
+                      r"set_\w+_input_action|set_runstate_\w+)\(")),
+    ("modbus", re.compile(r"modbus_\w+\(")),
+    ("payload", re.compile(r"(set_payload|set_target_payload|set_payload_mass)\(")),
+    ("tcp", re.compile(r"set_tcp\(")),
+    ("verification", re.compile(r"global _hidden_verificationVariable\b")),
+    ("globals", re.compile(r"global ")),
+)
+"""Kinds of preamble statements: PolyScope writes each kind as one block."""
+
+
+def preamble_blocks(module: Module) -> list[tuple[str, tuple[str, ...]]]:
+    """The preamble's blocks in written order: (kind, canonical lines), a block being a run
+    of top-level statements of one kind (see ``_PREAMBLE_KINDS``; ``other`` for the rest)."""
+    blocks: list[tuple[str, list[str]]] = []
+    for item in module.body:
+        lines = canonical_lines(Module((item,)))
+        if not lines:
+            continue
+        kind = next((name for name, pattern in _PREAMBLE_KINDS if pattern.match(lines[0])),
+                    "other")
+        if blocks and blocks[-1][0] == kind:
+            blocks[-1][1].extend(lines)
+        else:
+            blocks.append((kind, list(lines)))
+    return [(kind, tuple(lines)) for kind, lines in blocks]
+
+
+def by_kind(blocks: list[tuple[str, tuple[str, ...]]]) -> dict[str, tuple[str, ...]]:
+    """Kind → its statements' lines in written order. PolyScope does not keep the order of
+    the blocks (the same installation saved twice gives two orders), and may write a block
+    between two globals: two preambles are equal in any block order when these are."""
+    out: dict[str, tuple[str, ...]] = {}
+    for kind, lines in blocks:
+        out[kind] = out.get(kind, ()) + lines
+    return out
 
 
 def program_part(module: Module, waypoints: frozenset[str]) -> Module:
@@ -184,6 +253,24 @@ def _walk_items(module: Module):
                 stack.extend(value)
         for elif_ in getattr(item, "elifs", ()) or ():
             stack.extend(elif_.body)
+
+
+def load_installation(gitdir: Path, commit: str, urp_path: str, name: str | None
+                      ) -> tuple[Installation | None, list[tuple[str, str]], str]:
+    """The installation a program names (read beside it), its variables, and why there is
+    none ("" when there is one)."""
+    if not name:
+        return None, [], "the program names no installation"
+    folder = PurePosixPath(urp_path).parent
+    data = git_show(gitdir, commit, str(folder / f"{name}.installation"))
+    if data is None:
+        return None, [], "the installation file is not in the repository"
+    try:
+        installation = parse_installation(data, f"{name}.installation")
+    except InstallationError:
+        return None, [], "the installation file does not read"
+    text = git_show(gitdir, commit, str(folder / f"{name}.variables"))
+    return installation, parse_variables(text) if text is not None else [], ""
 
 
 def compare(ours: list[str], theirs: list[str]) -> float:
@@ -217,9 +304,10 @@ def main(argv: list[str] | None = None) -> int:
         st = stats.setdefault(split, {"n": 0, "exact": 0, "exact_prog": 0, "share": 0.0,
                                       "share_prog": 0.0, "errors": collections.Counter(),
                                       "kinds": collections.Counter(), "missing": 0,
-                                      "not_polyscope": 0, "exact_any": 0, "pre_total": 0,
-                                      "pre_found": 0,
-                                      "pre_extra": 0})
+                                      "not_polyscope": 0, "exact_written": 0, "pre_total": 0,
+                                      "pre_found": 0, "pre_extra": 0, "with": 0,
+                                      "exact_with": 0, "no_installation": collections.Counter(),
+                                      "pre_kinds": collections.Counter()})
         gitdir = git_dir(args.repos, repo)
         urp = git_show(gitdir, commit, urp_path)
         script = git_show(gitdir, commit, script_path)
@@ -227,6 +315,18 @@ def main(argv: list[str] | None = None) -> int:
             st["missing"] += 1
             continue
         st["n"] += 1
+        try:
+            program = parse_urp(urp, urp_path)
+        except UrpError as error:
+            st["errors"][str(error).split("error: ", 1)[-1][:150]] += 1
+            st["no_installation"]["the .urp does not read"] += 1
+            continue
+        installation, variables, absent = load_installation(gitdir, commit, urp_path,
+                                                            program.installation)
+        if absent:
+            st["no_installation"][absent] += 1
+        else:
+            st["with"] += 1
         reference = script.decode("utf-8", "replace")
         by_text = True
         try:
@@ -241,28 +341,16 @@ def main(argv: list[str] | None = None) -> int:
         if not any(isinstance(item, Marker) for item in _walk_items(theirs_tree)):
             st["n"] -= 1
             st["not_polyscope"] += 1
+            if absent:
+                st["no_installation"][absent] -= 1
+            else:
+                st["with"] -= 1
             continue
         try:
-            program = parse_urp(urp, urp_path)
-            installation = None
-            variables: list[tuple[str, str]] = []
-            if program.installation:
-                folder = PurePosixPath(urp_path).parent
-                data = git_show(gitdir, commit, str(folder / f"{program.installation}"
-                                                             ".installation"))
-                if data is not None:
-                    try:
-                        installation = parse_installation(data, program.installation)
-                    except InstallationError:
-                        installation = None
-                text = git_show(gitdir, commit, str(folder / f"{program.installation}"
-                                                             ".variables"))
-                if installation is not None and text is not None:
-                    variables = parse_variables(text)
             compiled = compile_program(program, installation, variables)
             ours_tree = _clean(parse(strip_urcap_text(compiled.text), "compiled")
                                if by_text else compiled.module)
-        except (UrpError, CompileError) as error:
+        except CompileError as error:
             st["errors"][str(error).split("error: ", 1)[-1][:150]] += 1
             continue
         theirs = canonical_lines(theirs_tree)
@@ -271,30 +359,47 @@ def main(argv: list[str] | None = None) -> int:
                           if node.kind == "Waypoint" and node.name)
         theirs_prog = canonical_lines(program_part(theirs_tree, names))
         ours_prog = canonical_lines(program_part(ours_tree, names))
-        theirs_pre = collections.Counter(canonical_lines(preamble_part(theirs_tree, names)))
-        ours_pre = collections.Counter(canonical_lines(preamble_part(ours_tree, names)))
+        theirs_blocks = preamble_blocks(preamble_part(theirs_tree, names))
+        ours_blocks = preamble_blocks(preamble_part(ours_tree, names))
+        theirs_pre = collections.Counter(line for _k, lines in theirs_blocks for line in lines)
+        ours_pre = collections.Counter(line for _k, lines in ours_blocks for line in lines)
         st["pre_total"] += sum(theirs_pre.values())
         st["pre_found"] += sum((theirs_pre & ours_pre).values())
         st["pre_extra"] += sum((ours_pre - theirs_pre).values())
+        theirs_kinds, ours_kinds = by_kind(theirs_blocks), by_kind(ours_blocks)
+        for kind in sorted(set(theirs_kinds) | set(ours_kinds)):
+            if theirs_kinds.get(kind) != ours_kinds.get(kind):
+                st["pre_kinds"][kind] += 1
         share = compare(ours, theirs)
         share_prog = compare(ours_prog, theirs_prog)
         st["share"] += share
         st["share_prog"] += share_prog
-        st["exact"] += ours == theirs
+        exact = ours_prog == theirs_prog and ours_kinds == theirs_kinds
+        st["exact"] += exact
+        st["exact_written"] += ours == theirs
         st["exact_prog"] += ours_prog == theirs_prog
-        st["exact_any"] += ours_prog == theirs_prog and theirs_pre == ours_pre
+        if not absent:
+            st["exact_with"] += exact
         if ours_prog != theirs_prog:
             for kind in compiled.kinds_in_diff(ours_prog, theirs_prog):
                 st["kinds"][kind] += 1
-            if shown < args.show:
-                shown += 1
-                print(f"==== {repo} {urp_path} ({share_prog:.0%})")
-                diff = difflib.unified_diff(theirs_prog, ours_prog, "polyscope", "urdsl",
-                                            n=1, lineterm="")
-                for number, line in enumerate(diff):
-                    if number > 40:
-                        break
-                    print(line[:160])
+        if not exact and shown < args.show:
+            shown += 1
+            print(f"==== {repo} {urp_path} (program part {share_prog:.0%}"
+                  f"{'; ' + absent if absent else ''})")
+            diff = difflib.unified_diff(theirs_prog, ours_prog, "polyscope", "urdsl",
+                                        n=1, lineterm="")
+            for number, line in enumerate(diff):
+                if number > 40:
+                    break
+                print(line[:160])
+            for kind in sorted(set(theirs_kinds) | set(ours_kinds)):
+                if theirs_kinds.get(kind) != ours_kinds.get(kind):
+                    diff = difflib.unified_diff(theirs_kinds.get(kind, ()),
+                                                ours_kinds.get(kind, ()), n=0, lineterm="")
+                    for line in list(diff)[2:14]:
+                        if not line.startswith("@@"):
+                            print(f"{line[0]}[preamble {kind}] {line[1:140]}")
     for split, st in sorted(stats.items(), reverse=True):
         n = max(st["n"], 1)
         print(f"[{split}] {st['n']} programs ({st['missing']} missing, "
@@ -302,10 +407,18 @@ def main(argv: list[str] | None = None) -> int:
               f"exact {st['exact'] / n:.1%} whole, {st['exact_prog'] / n:.1%} program part; "
               f"mean matching lines {st['share'] / n:.1%} whole, "
               f"{st['share_prog'] / n:.1%} program part")
-        print(f"  exact with the preamble compared in any order: {st['exact_any'] / n:.1%}")
-        print(f"  preamble statements (any order; PolyScope's block order changes from save "
-              f"to save): {st['pre_found']} of {st['pre_total']} written "
-              f"({st['pre_found'] / max(st['pre_total'], 1):.1%}), {st['pre_extra']} extra")
+        with_ = max(st["with"], 1)
+        absent = sum(st["no_installation"].values())
+        print(f"  exact whole as written (preamble blocks in PolyScope's order of that save): "
+              f"{st['exact_written'] / n:.1%}")
+        print(f"  with their installation: {st['with']} programs, exact whole "
+              f"{st['exact_with'] / with_:.1%}; without: {absent} ("
+              + "; ".join(f"{k}: {v}" for k, v in st["no_installation"].most_common())
+              + "): no exact preamble possible")
+        print(f"  preamble statements (any order): {st['pre_found']} of {st['pre_total']} "
+              f"written ({st['pre_found'] / max(st['pre_total'], 1):.1%}), "
+              f"{st['pre_extra']} extra; differing blocks: "
+              + ", ".join(f"{k} {v}" for k, v in st["pre_kinds"].most_common()))
         if st["errors"]:
             print("  not compiled: " + "; ".join(f"{k} ({v})" for k, v in
                                                  st["errors"].most_common(5)))

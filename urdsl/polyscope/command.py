@@ -27,6 +27,10 @@ def _installation_for(program: Program, path: str | Path) -> Installation | None
     if candidate is None:
         candidate = find_installation(path)
     if candidate is None:
+        if program.installation:
+            print(f"warning: {folder / (program.installation + '.installation')}: the "
+                  "installation the program names is not there; compiled without its "
+                  "preamble", file=sys.stderr)
         return None
     try:
         return read_installation(candidate)

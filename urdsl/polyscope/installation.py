@@ -13,8 +13,9 @@ Three layouts are known:
   with ``<tcpTransform>`` (six ``<double>``), ``<toolPayload>``, ``<mountingTiltAngle>`` and
   ``<mountingBaseAngle>``.
 
-Everything else (safety settings, I/O names, features, URCap data) is ignored here; a later
-reader builds the full tree on this one. Lengths in m, angles in rad, masses in kg.
+Also read: the safety limits and planes, I/O names, point and plane features, Modbus
+signals and the raw attributes of the settings a program's preamble is written from
+(:mod:`.preamble`). URCap data is not read. Lengths in m, angles in rad, masses in kg.
 
 A file that is not an installation, is truncated, corrupt or not XML raises
 :class:`InstallationError` naming the file.
@@ -31,6 +32,7 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 __all__ = ["Installation", "InstallationError", "Tcp", "Payload", "read_installation",
+           "ModbusSignal",
            "Safety", "SafetyPlane", "parse_safety",
            "parse_installation", "find_installation", "GRAVITY"]
 
@@ -67,6 +69,24 @@ class Payload:
     name: str
     mass: float
     cog: tuple[float, float, float] | None = None
+
+
+@dataclass(frozen=True)
+class ModbusSignal:
+    """A Modbus signal of the installation's ``<ModbusUnits>``: the unit's ``ip`` address,
+    ``slave`` (unit id), ``address`` (register or coil number), ``kind`` as written
+    (``DIGITAL_INPUT``, ``DIGITAL_OUTPUT``, ``REGISTER_INPUT``, ``REGISTER_OUTPUT``),
+    ``name``, ``frequency`` (update frequency, Hz), ``choice`` (what an output does when the
+    program stops, PolyScope's number) and the unit's ``sequential`` mode."""
+
+    ip: str
+    slave: int
+    address: int
+    kind: str
+    name: str
+    frequency: float | None = None
+    choice: int | None = None
+    sequential: bool = False
 
 
 @dataclass(frozen=True)
@@ -190,14 +210,23 @@ class Installation:
     (``SmoothTransitionSettings``, ``ToolCommSettings``, and ``IOs/NAME`` for the I/O
     settings such as ``IOs/analogInputRange``) → attributes as written."""
     features: tuple[tuple[str, tuple[float, ...]], ...] = ()
-    """Named point features (``GeomPoseNode``): (name, pose in the base frame: x, y, z in m,
-    rotation vector in rad), in file order."""
+    """Named features a program sees as variables (point and plane features whose
+    ``isVariable`` is not ``false``): (name, pose in the base frame: x, y, z in m, rotation
+    vector in rad), in file order. A plane's pose is PolyScope's: origin at its first
+    point, y along the first point to the second, z along the plane's normal on the side
+    of the first point's tool z axis."""
     io_names: tuple[tuple[str, str], ...] = ()
     """The I/O names the user gave: (name, pin) pairs, pin as PolyScope refers to it
     (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``)."""
     safety: Safety | None = None
     """The safety configuration's normal-mode limits and planes (3.x and 5.x), when the
     file has them."""
+    modbus: tuple[ModbusSignal, ...] = ()
+    """The Modbus signals, in file order."""
+    urcaps: tuple[tuple[str, str, str], ...] = ()
+    """The URCaps contributing an installation node, in file order: (name, vendor, node
+    title). UR's own conveyor tracking, EtherNet/IP, PROFINET and screwdriving nodes are
+    left out: they write nothing before the program."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -313,7 +342,7 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
                         mounting, version, _settings(root), _features(root, path),
-                        _io_names(root), _safety(root))
+                        _io_names(root), _safety(root), _modbus(root, path), _urcaps(root))
 
 
 def _safety(root: ElementTree.Element) -> Safety | None:
@@ -331,25 +360,131 @@ _IO_BANKS = {
 """``<IOs>`` name lists (comma-separated, empty for an unnamed pin) and the pins they name."""
 
 
+def _point(element: ElementTree.Element, name: str, path: str) -> tuple[float, ...] | None:
+    """The pose (position m, rotation vector rad) of a ``GeomPoseNode``; None when it has
+    none."""
+    position, axis = element.find("toolPosition"), element.find("toolAxisAngle")
+    if position is None or axis is None:
+        return None
+    return (_numbers(position.get("value"), 3, f"feature {name!r}", path)
+            + _numbers(axis.get("value"), 3, f"feature {name!r}", path))
+
+
+def _rotation(rv: tuple[float, ...]) -> list[list[float]]:
+    angle = math.sqrt(sum(v * v for v in rv))
+    if angle < 1e-300:
+        return [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    x, y, z = (v / angle for v in rv)
+    c, s, t = math.cos(angle), math.sin(angle), 1 - math.cos(angle)
+    return [[t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+            [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+            [t * x * z - s * y, t * y * z + s * x, t * z * z + c]]
+
+
+def _rotvec(m: list[list[float]]) -> tuple[float, float, float]:
+    """The rotation vector (rad, angle in [0, π]) of a rotation matrix (rows)."""
+    axis = (m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1])
+    sin2 = math.sqrt(sum(v * v for v in axis))
+    angle = math.atan2(sin2 / 2.0, (m[0][0] + m[1][1] + m[2][2] - 1.0) / 2.0)
+    if angle < 1e-12:
+        return (0.0, 0.0, 0.0)
+    if math.pi - angle < 1e-6:
+        diag = [(m[i][i] + 1.0) / 2.0 for i in range(3)]
+        column = max(range(3), key=lambda i: diag[i])
+        vector = [(m[i][column] + (1.0 if i == column else 0.0)) / 2.0 for i in range(3)]
+        norm = math.sqrt(sum(v * v for v in vector))
+        vector = [v / norm for v in vector]
+        if sum(a * b for a, b in zip(vector, axis, strict=True)) < 0:
+            vector = [-v for v in vector]
+        return tuple(v * angle for v in vector)  # type: ignore[return-value]
+    return tuple(v / sin2 * angle for v in axis)  # type: ignore[return-value]
+
+
+def _plane(points: list[tuple[float, ...]]) -> tuple[float, ...] | None:
+    """PolyScope's pose of a plane feature taught by three points (each a pose): origin
+    at the first point, y towards the second, z along the normal on the side of the first
+    point's tool z axis, x = y × z. None for collinear points."""
+    p1, p2, p3 = (p[:3] for p in points)
+    u = [b - a for a, b in zip(p1, p2, strict=True)]
+    v = [b - a for a, b in zip(p1, p3, strict=True)]
+    normal = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+    nu, nn = math.sqrt(sum(c * c for c in u)), math.sqrt(sum(c * c for c in normal))
+    if nu < 1e-12 or nn < 1e-12:
+        return None
+    y = [c / nu for c in u]
+    z = [c / nn for c in normal]
+    tool_z = [row[2] for row in _rotation(points[0][3:])]
+    if sum(a * b for a, b in zip(z, tool_z, strict=True)) < 0:
+        z = [-c for c in z]
+    x = [y[1] * z[2] - y[2] * z[1], y[2] * z[0] - y[0] * z[2], y[0] * z[1] - y[1] * z[0]]
+    matrix = [[x[i], y[i], z[i]] for i in range(3)]
+    return tuple(p1) + _rotvec(matrix)
+
+
 def _features(root: ElementTree.Element, path: str) -> tuple[tuple[str, tuple[float, ...]], ...]:
-    features = []
+    features: list[tuple[str, tuple[float, ...]]] = []
     block = root.find("Features")
     if block is None:
         return ()
-    for element in block.iter("GeomPoseNode"):
-        name = element.get("name")
-        position, axis = element.find("toolPosition"), element.find("toolAxisAngle")
-        if not name or element.get("hiddenSubFeature") == "true" or position is None \
-                or axis is None:
-            continue
-        features.append((name, _numbers(position.get("value"), 3, f"feature {name!r}", path)
-                         + _numbers(axis.get("value"), 3, f"feature {name!r}", path)))
+    for wrapper in block:
+        for element in wrapper:
+            name = element.get("name")
+            if not name or element.get("hiddenSubFeature") == "true" \
+                    or element.get("isVariable") == "false":
+                continue
+            if element.tag == "GeomPoseNode":
+                pose = _point(element, name, path)
+            elif element.tag == "GeomPlaneNode":
+                points = []
+                for tag in ("firstPoint", "secondPoint", "thirdPoint"):
+                    point = element.find(f"{tag}/GeomPoseNode")
+                    value = _point(point, name, path) if point is not None else None
+                    if value is not None:
+                        points.append(value)
+                pose = _plane(points) if len(points) == 3 else None
+            else:
+                continue
+            if pose is not None:
+                features.append((name, pose))
     return tuple(features)
+
+
+_BUILT_IN = frozenset((
+    "ConveyorTracking", "EthernetIP", "com.ur.urcap.profinet",
+    "com.ur.polyscope.screwdriving.installation.ScrewdrivingInstallationNodeService"))
+"""Installation contributions PolyScope ships whose code is not in a program's preamble."""
+
+
+def _urcaps(root: ElementTree.Element) -> tuple[tuple[str, str, str], ...]:
+    return tuple((element.get("name", "?"), element.get("vendor", "?"),
+                  element.get("installationContributionTitle", element.get("name", "?")))
+                 for element in root.iterfind("Contributions/URCaps/Contributed")
+                 if element.get("id") not in _BUILT_IN)
+
+
+def _modbus(root: ElementTree.Element, path: str) -> tuple[ModbusSignal, ...]:
+    signals = []
+    for unit in root.iterfind("IOs/ModbusUnits/Unit"):
+        ip = unit.get("ipAddress", "")
+        sequential = unit.get("sequentialMode") == "true"
+        for element in unit.iter("ModbusSignal"):
+            name = element.get("name") or ""
+            what = f"Modbus signal {name!r}"
+            frequency = element.get("updateFrequency")
+            choice = element.get("modificationChoice")
+            signals.append(ModbusSignal(
+                ip, int(_number(element.get("slaveAddress", "255"), f"{what} slave", path)),
+                int(_number(element.get("signalAddress"), f"{what} address", path)),
+                element.get("type", ""), name,
+                _number(frequency, f"{what} frequency", path) if frequency else None,
+                int(_number(choice, f"{what} choice", path)) if choice else None, sequential))
+    return tuple(signals)
 
 
 def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
     settings: dict[str, dict[str, str]] = {}
-    for tag in ("SmoothTransitionSettings", "ToolCommSettings", "SafeHomeSettings"):
+    for tag in ("SmoothTransitionSettings", "ToolCommSettings", "SafeHomeSettings",
+                "ToolWrenchConfiguration", "MotionSettingsConfiguration"):
         element = root.find(tag)
         if element is not None:
             settings[tag] = dict(element.attrib)

@@ -1,0 +1,284 @@
+"""The preamble PolyScope writes before a program's tree, from the installation: each kind
+of block for PolyScope 3.x and 5.x, the order urdsl writes the blocks in, plane features,
+and a missing or corrupt installation."""
+
+from __future__ import annotations
+
+import gzip
+import math
+
+import pytest
+
+from urdsl.cli import main
+from urdsl.polyscope.compile import compile_program
+from urdsl.polyscope.installation import InstallationError, parse_installation
+from urdsl.polyscope.preamble import BLOCKS, preamble_blocks
+from urdsl.polyscope.urp import parse_urp
+from urdsl.script.printer import format as print_tree
+
+
+def _urp(version: str = "5.11.9.1010452", installation: str = "cell") -> bytes:
+    return (f'<URProgram name="pre" installation="{installation}" createdIn="{version}" '
+            f'lastSavedIn="{version}"><children><MainProgram runOnlyOnce="true"><children>'
+            '<Wait type="Sleep"><waitTime>0.1</waitTime></Wait></children></MainProgram>'
+            '</children></URProgram>').encode()
+
+
+_IOS = """<IOs>
+  <DigitalOutputNames value="lamp, , , , , , , "/>
+  <analogInputRange value="1, 0, 1, 1"/>
+  <analogOutputDomain value="0, 1"/>
+  <DigitalInputActions value="NONE, NONE, NONE, NONE, NONE, NONE, NONE, NONE"/>
+  <ToolDigitalInputActions value="FREEDRIVE, NONE"/>
+  <DigitalOutputActions value="LOW_WHEN_PROGRAM_STOPPED, NONE, NONE, LOW_WHEN_PROGRAM_STOPPED,
+    NONE, NONE, NONE, NONE"/>
+  <ConfigurableOutputActions value="NONE, NONE, LOW_WHEN_PROGRAM_STOPPED, NONE"/>
+  <ModbusUnits>
+    <Unit ipAddress="10.0.0.7" sequentialMode="false">
+      <ModbusSignal name="ready" type="DIGITAL_INPUT" slaveAddress="255" updateFrequency="10"
+        signalAddress="8195" modificationChoice="0"/>
+      <ModbusSignal name="go" type="DIGITAL_OUTPUT" slaveAddress="1" updateFrequency="5"
+        signalAddress="12" modificationChoice="2"/>
+    </Unit>
+  </ModbusUnits>
+</IOs>"""
+
+_PLANE_POINTS = ((0.1, 0.2, 0.0), (0.1, 0.5, 0.0), (-0.3, 0.2, 0.0))
+"""A horizontal plane: origin (0.1, 0.2, 0), its y axis along +y, taught pointing down."""
+
+
+def _point(tag: str, position, axis=(0.0, math.pi, 0.0)) -> str:
+    return (f'<{tag}><GeomPoseNode name="hidden_{tag}" hiddenSubFeature="true" '
+            f'isVariable="false"><toolPosition value="{", ".join(map(str, position))}"/>'
+            f'<toolAxisAngle value="{", ".join(map(str, axis))}"/></GeomPoseNode></{tag}>')
+
+
+def _features() -> str:
+    plane = "".join(_point(tag, p) for tag, p in zip(
+        ("firstPoint", "secondPoint", "thirdPoint"), _PLANE_POINTS, strict=True))
+    return f"""<Features>
+  <CameraView><worldTransform><WorldtoMarshal baseAngle="0.0" tiltAngle="0.0"/>
+  </worldTransform></CameraView>
+  <BaseView><BaseView isVariable="false"/></BaseView>
+  <GeomPoseNode><GeomPoseNode name="pick" isVariable="true">
+    <toolPosition value="0.4, -0.1, 0.25"/><toolAxisAngle value="0.0, 3.14, 0.0"/>
+  </GeomPoseNode></GeomPoseNode>
+  <GeomPoseNode><GeomPoseNode name="hidden" isVariable="false">
+    <toolPosition value="0.0, 0.0, 0.0"/><toolAxisAngle value="0.0, 0.0, 0.0"/>
+  </GeomPoseNode></GeomPoseNode>
+  <GeomPlaneNode><GeomPlaneNode name="Table" isVariable="true">{plane}</GeomPlaneNode>
+  </GeomPlaneNode>
+</Features>"""
+
+
+def _installation5(extra: str = "") -> bytes:
+    return f"""<Installation>
+  {_IOS}
+  <Version major="5" minor="24" bugfix="0"/>
+  <ToolCommSettings enabled="true" baudRate="BAUD_1000000" parity="EVEN" stopBits="ONE"
+    rxIdleChars="1.5" txIdleChars="3.5" toolOutputMode="OUTPUT" toolDigitalOutput0="SINKING"
+    toolDigitalOutput1="PUSH_PULL" toolOutputVoltage="TWENTY_FOUR"/>
+  {_features()}
+  <PayloadSettings><Payload name="box" mass="1.5" centerOfGravity="0.0, 0.0, 0.05"
+    defaultPayload="true"/></PayloadSettings>
+  <TCPSettings activePose="gripper"><availablePoses>
+    <tcp name="flange" offset="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
+    <tcp name="gripper" offset="0.0, 0.0, 0.15, 0.0, 0.0, 0.0"/>
+  </availablePoses></TCPSettings>
+  <SmoothTransitionSettings transitionHardness="HARD"/>
+  <ToolWrenchConfiguration forceLimitEnabled="false" momentLimitEnabled="false"/>
+  <MotionSettingsConfiguration motionVersion="JERK_LIMITED"/>
+  <Contributions><URCaps>
+    <Contributed id="ConveyorTracking" name="Conveyor Tracking" vendor="Universal Robots"
+      installationContributionTitle="Conveyor Tracking"/>
+    <Contributed id="com.acme.GripperService" name="Acme Gripper" vendor="Acme Inc."
+      installationContributionTitle="Gripper"/>
+  </URCaps></Contributions>
+  {extra}
+</Installation>""".encode()
+
+
+_INSTALLATION3 = b"""<Installation>
+  <IOs><analogInputRange value="1, 1, 1, 1"/><analogOutputDomain value="0, 0"/>
+    <DigitalInputActions value="NONE"/></IOs>
+  <Version major="3" minor="15" bugfix="8"/>
+  <ToolCommSettings toolOutputVoltage="TWELVE"/>
+  <Features><CameraView><worldTransform>
+    <WorldtoMarshal baseAngle="0.0" tiltAngle="3.141592653589793"/></worldTransform>
+  </CameraView></Features>
+  <TCPSettings activePose="TCP" toolPayload="1.2">
+    <availablePoses><tcp name="TCP" offset="0.0, 0.0, 0.1, 0.0, 0.0, 0.0"/></availablePoses>
+  </TCPSettings>
+  <SmoothTransitionSettings transitionHardness="SOFT"/>
+</Installation>"""
+
+
+def _blocks(urp: bytes, installation: bytes | None, variables=()):
+    program = parse_urp(urp, "pre.urp")
+    parsed = parse_installation(installation, "cell.installation") if installation else None
+    return {kind: [print_tree(item).strip() for item in items]
+            for kind, items in preamble_blocks(program, parsed, list(variables))}
+
+
+@pytest.fixture(scope="module")
+def five():
+    return _blocks(_urp("5.24.0"), _installation5(), [("count", "3"), ("home", "p[0,0,0,0,0,0]")])
+
+
+def test_polyscope_5_safety_tool_gravity_payload_and_tcp(five):
+    assert five["safety"] == ["set_safety_mode_transition_hardness(0)"]
+    assert five["wrench"] == ["tool_wrench_limit_disable()"]
+    assert five["motion"] == ["motion_version_set(2)"]
+    assert five["tool"] == ["set_tool_communication(True, 1000000, 2, 1, 1.5, 3.5)",
+                            "set_tool_output_mode(0)", "set_tool_digital_output_mode(0, 1)",
+                            "set_tool_digital_output_mode(1, 3)", "set_tool_voltage(24)"]
+    assert five["gravity"] == ["set_gravity([0.0, 0.0, 9.82])"]
+    assert five["payload"] == ["set_payload(1.5, [0.0, 0.0, 0.05])"]
+    assert five["tcp"] == ["set_tcp(p[0.0, 0.0, 0.15, 0.0, 0.0, 0.0])"]  # the active one
+
+
+def test_polyscope_5_io_block(five):
+    assert five["io"] == [
+        "set_standard_analog_input_domain(0, 1)", "set_standard_analog_input_domain(1, 0)",
+        "set_tool_analog_input_domain(0, 1)", "set_tool_analog_input_domain(1, 1)",
+        "set_analog_outputdomain(0, 0)", "set_analog_outputdomain(1, 1)",
+        "set_input_actions_to_default()", 'set_tool_digital_input_action(0, "freedrive")',
+        "set_runstate_standard_digital_outputs([0, 3])",
+        "set_runstate_configurable_digital_outputs([2])",
+        "set_runstate_standard_digital_output_to_value(0, 1)",
+        "set_runstate_standard_digital_output_to_value(3, 1)",
+        "set_runstate_configurable_digital_output_to_value(2, 1)"]
+
+
+def test_modbus_signals(five):
+    assert five["modbus"] == [
+        'modbus_add_signal("10.0.0.7", 255, 8195, 0, "ready", False)',
+        'modbus_set_signal_update_frequency("ready", 10)',
+        'modbus_add_signal("10.0.0.7", 1, 12, 1, "go", False)',
+        'modbus_set_signal_update_frequency("go", 5)',
+        'modbus_set_runstate_dependent_choice("go", 2)']  # outputs only
+
+
+def test_the_step_counter_and_the_verification_global_of_recent_versions(five):
+    assert five["verification"] == ["global _hidden_verificationVariable = 0"]  # 5.13 on
+    assert five["steps"][0].startswith("step_count_")
+    older = _blocks(_urp("5.11.9.1010452"), _installation5())
+    assert "verification" not in older and "steps" in older
+    assert "steps" not in _blocks(_urp("5.7.0.90932"), _installation5())  # before 5.8
+
+
+def test_variables_then_features_by_name_without_hidden_ones(five):
+    assert five["variables"] == ["global count = 3", "global home = p[0, 0, 0, 0, 0, 0]"]
+    names = [line.split("=")[0].split()[1] for line in five["features"]]
+    assert names == ["Table", "pick"]  # sorted as PolyScope does: capitals first
+
+
+def test_a_plane_feature_is_placed_as_polyscope_places_it(five):
+    installation = parse_installation(_installation5(), "cell.installation")
+    pose = dict(installation.features)["Table"]
+    assert pose[:3] == pytest.approx(_PLANE_POINTS[0])
+    # y along the first point to the second (+y), z along the normal on the side of the
+    # taught tool's z (down), x = y × z (-x): a half turn about y
+    assert pose[3:] == pytest.approx((0.0, math.pi, 0.0), abs=1e-9)
+
+
+def test_urcap_installation_nodes_are_marked_empty_blocks(five):
+    """Their code only the URCap can generate; UR's built-in contributions write none."""
+    assert five["urcaps"] == ["# begin: URCap Installation Node",
+                              "#   Source: Acme Gripper, Acme Inc.", "#   Type: Gripper",
+                              "# end: URCap Installation Node"]
+
+
+def test_polyscope_3_preamble():
+    blocks = _blocks(_urp("3.15.8.106339"), _INSTALLATION3)
+    assert blocks["tool"] == ["set_tool_voltage(12)"]  # no tool communication on CB3
+    gravity = blocks["gravity"][0].removeprefix("set_gravity([").removesuffix("])")
+    assert [float(v) for v in gravity.split(",")] == pytest.approx([0, 0, -9.82])  # ceiling
+    assert blocks["payload"] == ["set_payload(1.2)"]  # no centre of gravity: mass only
+    assert blocks["safety"] == ["set_safety_mode_transition_hardness(1)"]
+    assert blocks["io"][-1] == "set_input_actions_to_default()"
+    assert "steps" in blocks and "verification" not in blocks
+
+
+def test_the_blocks_come_in_one_fixed_order():
+    """PolyScope's order of these blocks changes from save to save; urdsl's does not."""
+    program = parse_urp(_urp("5.24.0"), "pre.urp")
+    installation = parse_installation(_installation5(), "cell.installation")
+    kinds = [kind for kind, _ in preamble_blocks(program, installation, [("n", "1")])]
+    movable = [kind for kind in kinds if kind in BLOCKS]
+    assert kinds[0] == "verification" and kinds[-3:] == ["variables", "features", "urcaps"]
+    assert movable == [kind for kind in BLOCKS if kind in movable]
+    first = compile_program(program, installation).text
+    assert compile_program(program, installation).text == first
+    assert first.index("set_tcp(") < first.index("global Table")
+
+
+def test_no_installation_gives_only_what_the_version_writes():
+    assert list(_blocks(_urp("5.24.0"), None)) == ["verification", "steps"]
+
+
+def test_an_enabled_tool_wrench_limit_is_said_not_written():
+    extra = _installation5().replace(b'forceLimitEnabled="false"', b'forceLimitEnabled="true"')
+    assert _blocks(_urp("5.24.0"), extra)["wrench"] == [
+        "# urdsl: the tool wrench limit is not written"]
+
+
+@pytest.mark.parametrize("data, reason", [
+    (gzip.compress(_installation5())[:40], "truncated"),
+    (b"<Installation><IOs>", "not well-formed XML"),
+    (b"<Installation><IOs><ModbusUnits><Unit><ModbusSignal name='x' signalAddress='lots'/>"
+     b"</Unit></ModbusUnits></IOs></Installation>", "Modbus signal 'x' address"),
+])
+def test_a_corrupt_installation_is_named(data, reason):
+    with pytest.raises(InstallationError) as error:
+        parse_installation(data, "cell.installation")
+    assert str(error.value).startswith("cell.installation: ") and reason in str(error.value)
+
+
+def test_compile_names_a_missing_or_corrupt_installation(tmp_path, capsys):
+    program = tmp_path / "pre.urp"
+    program.write_bytes(_urp("5.11.9.1010452"))
+    out = tmp_path / "pre.script"
+    assert main(["compile", str(program), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'cell.installation'}: the installation the program names is not " \
+           "there" in err and "Traceback" not in err
+    assert "set_tcp" not in out.read_text()
+    (tmp_path / "cell.installation").write_bytes(gzip.compress(_installation5())[:60])
+    assert main(["compile", str(program), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'cell.installation'}: the gzip data is" in err
+    assert "Traceback" not in err
+    (tmp_path / "cell.installation").write_bytes(gzip.compress(_installation5()))
+    assert main(["compile", str(program), "-o", str(out)]) == 0
+    text = out.read_text()
+    assert "modbus_add_signal(" in text and "global Table = p[" in text
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_initial_values_of_the_variables_setup_and_of_urcap_variables():
+    urp = (b'<URProgram name="pre" installation="cell" createdIn="5.11.9" lastSavedIn="5.11.9">'
+           b'<children><InitVariablesNode><variables>'
+           b'<variable name="ready"><expression><ExpressionToken token=" False "/>'
+           b'</expression></variable>'
+           b'<variable name="count"><expression><ExpressionChar character="1"/>'
+           b'<ExpressionChar character="2"/></expression></variable>'
+           b'<variable name="twice"><expression><ExpressionVariable><variable name="count"/>'
+           b'</ExpressionVariable><ExpressionChar character="*"/><ExpressionChar character="2"/>'
+           b'</expression></variable>'
+           b'<variable name="bad"><expression><ExpressionVariable/></expression></variable>'
+           b'</variables></InitVariablesNode>'
+           b'<MainProgram runOnlyOnce="true"><children>'
+           b'<Contributed strategyURCapName="Gripper"><dataModel><Variable key="v">'
+           b'<variable name="part"><initializeExpression><ExpressionToken token="True"/>'
+           b'</initializeExpression></variable></Variable></dataModel></Contributed>'
+           b'<Contributed strategyURCapName="Gripper"><dataModel><Variable key="v">'
+           b'<variable name="part"><initializeExpression><ExpressionToken token="True"/>'
+           b'</initializeExpression></variable></Variable></dataModel></Contributed>'
+           b'</children></MainProgram></children></URProgram>')
+    blocks = _blocks(urp, None)
+    assert blocks["initial"] == ["global ready = False", "global count = 12",
+                                 "global twice = count * 2",
+                                 "# urdsl: the initial value of bad is not compiled",
+                                 "global part = True"]  # each name once
+    assert list(blocks)[-1] == "initial"  # after the installation's blocks

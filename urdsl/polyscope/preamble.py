@@ -1,0 +1,377 @@
+"""The preamble PolyScope writes before a program's tree: what the installation (and the
+program's PolyScope version) generate.
+
+:func:`preamble` builds it as URScript tree nodes; :mod:`.compile` puts it at the top of the
+program's ``def``.
+"""
+
+from __future__ import annotations
+
+import uuid
+from xml.etree import ElementTree
+
+from ..script import parse
+from ..script.build import literal
+from ..script.diagnostics import ScriptError
+from ..script.nodes import (
+    Assign,
+    BinOp,
+    Bool,
+    Call,
+    Comment,
+    Declare,
+    Expr,
+    ExprStmt,
+    Item,
+    Keyword,
+    List,
+    Name,
+    Number,
+    Paren,
+    Pose,
+    Run,
+    String,
+    ThreadDef,
+    While,
+)
+from .installation import Installation
+from .urp import Expression, Program
+
+__all__ = ["BLOCKS", "initial_values", "preamble", "preamble_blocks", "step_counter"]
+
+
+def _call(name: str, *args: Expr, **keywords: Expr) -> Call:
+    return Call(Name(name), tuple(args), tuple(Keyword(k, v) for k, v in keywords.items()))
+
+
+def _stmt(name: str, *args: Expr, **keywords: Expr) -> ExprStmt:
+    return ExprStmt(_call(name, *args, **keywords))
+
+
+def _num(value: float) -> Expr:
+    return literal(float(value))
+
+
+def _value(text: str) -> Expr:
+    """The expression of an installation variable's value; ValueError if it is not one
+    URScript expression."""
+    try:
+        module = parse(text, "<variables>")
+    except ScriptError:
+        raise ValueError(text) from None
+    items = [item for item in module.body if not isinstance(item, Comment)]
+    if len(items) != 1 or not isinstance(items[0], ExprStmt):
+        raise ValueError(text)
+    return items[0].expr
+
+
+def _generated_id(name: str, purpose: str) -> str:
+    """A UUID in PolyScope's identifier form (``3f89b84f_1daa_4dd7_9152_f27885b7ee6c``),
+    fixed for a program name and purpose."""
+    return str(uuid.uuid5(uuid.NAMESPACE_URL, f"urdsl:{purpose}:{name}")).replace("-", "_")
+
+
+def _ints(text: str | None) -> list[int]:
+    try:
+        return [int(v) for v in (text or "").split(",") if v.strip()]
+    except ValueError:
+        return []
+
+
+_BAUD = {"BAUD_9600": 9600, "BAUD_19200": 19200, "BAUD_38400": 38400, "BAUD_57600": 57600,
+         "BAUD_115200": 115200, "BAUD_1M": 1000000, "BAUD_2M": 2000000, "BAUD_5M": 5000000}
+_PARITY = {"NONE": 0, "ODD": 1, "EVEN": 2}
+_STOP_BITS = {"ONE": 1, "TWO": 2}
+_OUTPUT_MODE = {"SINKING": 1, "SOURCING": 2, "PUSH_PULL": 3}
+_VOLTAGE = {"ZERO": 0, "TWELVE": 12, "TWENTY_FOUR": 24}
+
+
+def _baud(text: str) -> int:
+    """Bit/s of PolyScope's ``BAUD_115200``, ``BAUD_1M`` or ``BAUD_1000000`` (115200 if
+    unreadable)."""
+    if text in _BAUD:
+        return _BAUD[text]
+    digits = text.removeprefix("BAUD_")
+    return int(digits) if digits.isdigit() else 115200
+
+
+def _tool_communication(attrs: dict[str, str] | None) -> list[Item]:
+    """The tool connector's settings as PolyScope writes them (baud rate in bit/s, idle
+    times in characters, voltage in V)."""
+    if not attrs:
+        return []
+    voltage = attrs.get("toolOutputVoltage")
+    if "enabled" not in attrs:  # PolyScope 3.x: the tool output voltage only
+        return [_stmt("set_tool_voltage", Number(_VOLTAGE[voltage]))] \
+            if voltage in _VOLTAGE else []
+    items: list[Item] = [_stmt(
+        "set_tool_communication", Bool(attrs.get("enabled") == "true"),
+        Number(_baud(attrs.get("baudRate", ""))),
+        Number(_PARITY.get(attrs.get("parity", ""), 0)),
+        Number(_STOP_BITS.get(attrs.get("stopBits", ""), 1)),
+        _num(float(attrs.get("rxIdleChars", "1.5"))), _num(float(attrs.get("txIdleChars", "3.5"))))]
+    items.append(_stmt("set_tool_output_mode",
+                       Number(0 if attrs.get("toolOutputMode", "OUTPUT") == "OUTPUT" else 1)))
+    for index in range(2):
+        mode = attrs.get(f"toolDigitalOutput{index}")
+        if mode in _OUTPUT_MODE:
+            items.append(_stmt("set_tool_digital_output_mode", Number(index),
+                               Number(_OUTPUT_MODE[mode])))
+    if voltage in _VOLTAGE:
+        items.append(_stmt("set_tool_voltage", Number(_VOLTAGE[voltage])))
+    return items
+
+
+def _version(text: str | None) -> tuple[int, int]:
+    """(major, minor) of a ``"5.11.9.1010452"``-like version; (0, 0) when unknown."""
+    parts = [int(p) if p.isdigit() else 0 for p in (text or "").split(".")[:2]] + [0, 0]
+    return parts[0], parts[1]
+
+
+_RUNSTATE = {"LOW_WHEN_PROGRAM_STOPPED": 1, "HIGH_WHEN_PROGRAM_STOPPED": 2,
+             "HIGH_WHEN_PROGRAM_RUNNING_LOW_WHEN_STOPPED": 3}
+"""Output actions when the program stops → the state number of ``set_runstate_*`` (1 seen;
+2 and 3 as the URScript manual numbers them [U])."""
+_RUNSTATE_BANKS = (("DigitalOutputActions", "standard"),
+                   ("ConfigurableOutputActions", "configurable"),
+                   ("ToolDigitalOutputActions", "tool"))
+_MODBUS_KINDS = {"DIGITAL_INPUT": 0, "DIGITAL_OUTPUT": 1, "REGISTER_INPUT": 2,
+                 "REGISTER_OUTPUT": 3}
+_MOTION_VERSIONS = {"JERK_LIMITED": 2}
+"""``MotionSettingsConfiguration motionVersion`` → ``motion_version_set`` (5.22 on; only
+JERK_LIMITED seen)."""
+
+BLOCKS = ("steps", "safety", "wrench", "motion", "tool", "gravity", "io", "modbus", "payload",
+          "tcp")
+"""The kinds of the preamble blocks whose order PolyScope does not keep: the same
+installation saved twice gives them in two orders (a Java hash set's order). urdsl writes
+them in this order."""
+
+
+def preamble_blocks(program: Program, installation: Installation | None,
+                    variables: list[tuple[str, str]]) -> list[tuple[str, list[Item]]]:
+    """The preamble as (kind, statements) blocks in the order urdsl writes them. Kinds:
+    ``verification`` (PolyScope 5.13 on: a hidden global, always first), the movable
+    blocks of :data:`BLOCKS`, then ``variables`` (the installation variables) and
+    ``features`` (feature poses, by name), ``urcaps`` (a marked block per URCap
+    installation node: its code only the URCap can generate, so the block is empty), then
+    ``initial`` (the program's initial variable values, see :func:`initial_values`).
+    Modbus signals' input/output actions are not written."""
+    blocks: list[tuple[str, list[Item]]] = []
+    saved = _version(program.saved_in or program.created_in)
+    major = program.major_version or saved[0] or 5
+    if saved >= (5, 13):
+        blocks.append(("verification", [Declare("global", "_hidden_verificationVariable",
+                                                Number(0))]))
+    movable: dict[str, list[Item]] = {"steps": step_counter(program)}
+    if installation is not None:
+        movable.update(_installation_blocks(installation, major))
+    for kind in BLOCKS:
+        if movable.get(kind):
+            blocks.append((kind, movable[kind]))
+    values: list[Item] = []
+    for name, value in variables if installation is not None else ():
+        try:
+            values.append(Declare("global", name, _value(value)))
+        except ValueError:  # not a value URScript reads: PolyScope would not run it
+            values.append(Comment(f" urdsl: installation variable {name} is not URScript"))
+    if values:
+        blocks.append(("variables", values))
+    features = [Declare("global", name, Pose(tuple(_num(v) for v in pose)))
+                for name, pose in sorted(installation.features if installation else ())]
+    if features:
+        blocks.append(("features", features))
+    urcaps: list[Item] = []
+    for name, vendor, title in installation.urcaps if installation else ():
+        urcaps.extend((Comment(" begin: URCap Installation Node"),
+                       Comment(f"   Source: {name}, {vendor}"), Comment(f"   Type: {title}"),
+                       Comment(" end: URCap Installation Node")))
+    if urcaps:
+        blocks.append(("urcaps", urcaps))
+    initial = initial_values(program)
+    if initial:
+        blocks.append(("initial", initial))
+    return blocks
+
+
+def _expression(element: ElementTree.Element) -> str | None:
+    """The URScript text of an expression element of characters, tokens and named variables;
+    None when it refers to anything else (a variable by reference, an I/O, a waypoint)."""
+    parts = []
+    for piece in element:
+        if piece.tag == "ExpressionChar":
+            parts.append(("char", piece.get("character", "")))
+        elif piece.tag == "ExpressionToken":
+            parts.append(("token", piece.get("token", "")))
+        elif piece.tag == "ExpressionVariable" and len(piece) and piece[0].get("name"):
+            parts.append(("var", piece[0].get("name", "")))
+        else:
+            return None
+    return Expression(tuple(parts)).script
+
+
+def initial_values(program: Program) -> list[Item]:
+    """The globals PolyScope writes after the installation's code: each variable of the
+    program's variables setup (``InitVariablesNode``) with its value, in file order, then
+    each variable declared elsewhere with an initial value (``<initializeExpression>``, as
+    URCap nodes declare them), in file order, each name once."""
+    items: list[Item] = []
+    seen: set[str] = set()
+
+    def declare(name: str | None, expression: ElementTree.Element | None) -> None:
+        if not name or name in seen or expression is None or not len(expression):
+            return
+        seen.add(name)
+        text = _expression(expression)
+        try:
+            if text is None:
+                raise ValueError(name)
+            items.append(Declare("global", name, _value(text)))
+        except ValueError:
+            items.append(Comment(f" urdsl: the initial value of {name} is not compiled"))
+
+    init = program.init_variables
+    if init is not None and init.element is not None:
+        for variable in init.element.iterfind("variables/variable"):
+            declare(variable.get("name"), variable.find("expression"))
+    for root in program.top:
+        if root.element is None or root is init:
+            continue
+        for variable in root.element.iter("variable"):
+            declare(variable.get("name"), variable.find("initializeExpression"))
+    return items
+
+
+def preamble(program: Program, installation: Installation | None,
+             variables: list[tuple[str, str]]) -> list[Item]:
+    """What PolyScope 3.x and 5.x write before the program tree, from the installation
+    (and the program's PolyScope version): the blocks of :func:`preamble_blocks` in
+    order."""
+    return [item for _kind, items in preamble_blocks(program, installation, variables)
+            for item in items]
+
+
+def _installation_blocks(installation: Installation, major: int) -> dict[str, list[Item]]:
+    settings = installation.settings or {}
+    blocks: dict[str, list[Item]] = {}
+    safety: list[Item] = []
+    hardness = settings.get("SmoothTransitionSettings", {}).get("transitionHardness")
+    if hardness:
+        safety.append(_stmt("set_safety_mode_transition_hardness",
+                            Number(1 if hardness == "SOFT" else 0)))
+    blocks["safety"] = safety
+    wrench = settings.get("ToolWrenchConfiguration")
+    if wrench is not None:
+        if wrench.get("forceLimitEnabled") != "true" and wrench.get("momentLimitEnabled") \
+                != "true":
+            blocks["wrench"] = [_stmt("tool_wrench_limit_disable")]
+        else:  # the call PolyScope writes for an enabled limit is not known
+            blocks["wrench"] = [Comment(" urdsl: the tool wrench limit is not written")]
+    motion = settings.get("MotionSettingsConfiguration", {}).get("motionVersion")
+    if motion:
+        blocks["motion"] = [_stmt("motion_version_set", Number(_MOTION_VERSIONS.get(motion, 1)))]
+    blocks["tool"] = _tool_communication(settings.get("ToolCommSettings"))
+    gravity = installation.gravity
+    if gravity is not None:
+        blocks["gravity"] = [_stmt("set_gravity", List(tuple(_num(v) for v in gravity)))]
+    blocks["io"] = _io(settings)
+    blocks["modbus"] = _modbus(installation)
+    payload = installation.payload
+    if payload is not None:
+        raw = settings.get(f"Payload/{payload.name}")
+        if raw is not None and raw.get("inertiaParameters"):
+            inertia = tuple(float(v) for v in raw["inertiaParameters"].split(","))
+            blocks["payload"] = [_stmt("set_target_payload", _num(payload.mass),
+                                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))),
+                                       List(tuple(_num(v) for v in inertia)))]
+        elif payload.cog is None and major < 5:
+            blocks["payload"] = [_stmt("set_payload", _num(payload.mass))]
+        else:
+            blocks["payload"] = [_stmt("set_payload", _num(payload.mass),
+                                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))))]
+    tcp = installation.tcp
+    if tcp is not None:
+        blocks["tcp"] = [_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset)))]
+    return blocks
+
+
+def _io(settings: dict[str, dict[str, str]]) -> list[Item]:
+    """Analog domains (0: current, 1: voltage), input actions and the outputs' states
+    when the program stops."""
+    items: list[Item] = []
+    ranges = _ints(settings.get("IOs/analogInputRange", {}).get("value"))
+    if len(ranges) == 4:
+        for index in range(2):
+            items.append(_stmt("set_standard_analog_input_domain", Number(index),
+                               Number(ranges[index])))
+        for index in range(2):
+            items.append(_stmt("set_tool_analog_input_domain", Number(index),
+                               Number(ranges[2 + index])))
+    domains = _ints(settings.get("IOs/analogOutputDomain", {}).get("value"))
+    for index, domain in enumerate(domains):
+        items.append(_stmt("set_analog_outputdomain", Number(index), Number(domain)))
+    if "IOs/DigitalInputActions" in settings:
+        items.append(_stmt("set_input_actions_to_default"))
+        # only the tool inputs' actions are written (seen: "freedrive"); the controller
+        # keeps the standard and configurable inputs' actions itself
+        actions = settings.get("IOs/ToolDigitalInputActions", {}).get("value", "").split(",")
+        for index, action in enumerate(a.strip() for a in actions):
+            if action and action != "NONE":
+                items.append(_stmt("set_tool_digital_input_action", Number(index),
+                                   String(action.lower().replace("_", " "))))
+    states: list[tuple[str, int, int]] = []
+    for key, bank in _RUNSTATE_BANKS:
+        actions = settings.get(f"IOs/{key}", {}).get("value", "").split(",")
+        pins = [(index, _RUNSTATE[a.strip()]) for index, a in enumerate(actions)
+                if a.strip() in _RUNSTATE]
+        if pins:
+            items.append(_stmt(f"set_runstate_{bank}_digital_outputs",
+                               List(tuple(Number(index) for index, _ in pins))))
+            states.extend((bank, index, state) for index, state in pins)
+    for bank, index, state in states:
+        items.append(_stmt(f"set_runstate_{bank}_digital_output_to_value", Number(index),
+                           Number(state)))
+    return items
+
+
+def _modbus(installation: Installation) -> list[Item]:
+    """Each Modbus signal: added, its update frequency (Hz) set, and for an output what it
+    does when the program stops."""
+    items: list[Item] = []
+    for signal in installation.modbus:
+        if signal.kind not in _MODBUS_KINDS:
+            items.append(Comment(f" urdsl: Modbus signal {signal.name} of type "
+                                 f"{signal.kind} is not written"))
+            continue
+        name = String(signal.name)
+        items.append(_stmt("modbus_add_signal", String(signal.ip), Number(signal.slave),
+                           Number(signal.address), Number(_MODBUS_KINDS[signal.kind]), name,
+                           Bool(signal.sequential)))
+        if signal.frequency is not None:
+            frequency = signal.frequency
+            items.append(_stmt("modbus_set_signal_update_frequency", name,
+                               Number(int(frequency)) if frequency == int(frequency)
+                               else _num(frequency)))
+        if signal.kind.endswith("OUTPUT") and signal.choice is not None:
+            items.append(_stmt("modbus_set_runstate_dependent_choice", name,
+                               Number(signal.choice)))
+    return items
+
+
+def step_counter(program: Program) -> list[Item]:
+    """The thread PolyScope (3.15 and 5.8 on) starts in every program to count its
+    controller steps; its names carry a generated id (here derived from the program's
+    name, so that compiling twice gives the same text)."""
+    version = program.saved_in or program.created_in or ""
+    parts = [int(p) if p.isdigit() else 0 for p in version.split(".")[:2]] + [0, 0]
+    major, minor = parts[0], parts[1]
+    if not ((major == 3 and minor >= 15) or (major == 5 and minor >= 8) or major > 5):
+        return []
+    count = "step_count_" + _generated_id(program.name, "count")
+    thread = "Step_Counter_Thread_" + _generated_id(program.name, "thread")
+    return [
+        Assign(Name(count), _num(0.0)),
+        ThreadDef(thread, (While(Paren(Bool(True)), (
+            Assign(Name(count), BinOp("+", Name(count), _num(1.0))),
+            _stmt("sync"))),)),
+        ExprStmt(Run(thread))]
