@@ -11,9 +11,19 @@ Both scripts are parsed and printed canonically, statement by statement: comment
 blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare to
 1e-9, PolyScope's generated ids (``_3f89b84f_1daa_...``) are masked, and ``$`` markers
 compare by number and flag (their label text is in the language PolyScope ran in, which the
-.urp does not record). Two views: the whole program, and the program part (the top-level
-statements from the first waypoint global, definition or marker on: what the program tree,
-not the installation, generates).
+.urp does not record). For the same reason a ``popup`` title that is PolyScope's own title
+of a Popup node in another language ("Erreur", "Meldung": see ``POPUP_TITLES``, the
+languages seen) compares as its English one ("Error", "Message") when the popup's
+warning/error flags are that type's; a title the user wrote is compared as written. Two
+views: the whole program, and the program part (the top-level statements from the first
+waypoint global, definition or marker on: what the program tree, not the installation,
+generates).
+
+The installation is the one the program names (``installationRelativePath``). A Script
+node's file is read from the repository as it was in the last commit that changed the
+.script (PolyScope compiles the file's contents when it saves, not the copy the .urp keeps;
+``--script-files cache`` takes that copy instead). A script file edited after the save but
+committed with it makes a pair differ: that is stale data, not a compiler error.
 
 Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back),
 the share of programs exact, the mean share of matching lines and the node types whose lines
@@ -25,6 +35,7 @@ from __future__ import annotations
 import argparse
 import collections
 import difflib
+import posixpath
 import re
 import subprocess
 import sys
@@ -56,6 +67,32 @@ from urdsl.script.printer import format as print_tree  # noqa: E402
 _ID = re.compile(r"_[0-9a-f]{8}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{12}")
 _NUMBER = re.compile(r"(?<![\w.])(\d+\.\d*|\.\d+|\d+)(e-?\d+)?(?![\w.])", re.IGNORECASE)
 _MARKER = re.compile(r'^(\s*)\$ (\d+) "(?:[^"]*)"(.*)$')
+_POPUP = re.compile(r'^(\s*popup\(.*, )"([^"]*)"(, (True|False), (True|False))')
+
+POPUP_TITLES = {
+    # French (seen: "Erreur")
+    "Erreur": "Error", "Avertissement": "Warning",
+    # German (seen: "Meldung")
+    "Fehler": "Error", "Warnung": "Warning", "Meldung": "Message",
+}
+"""PolyScope's own Popup titles in the languages seen in real programs → the English title
+urdsl writes. A Popup node has no title of its own: PolyScope titles it with its type
+(Message, Warning, Error) in the language it runs in."""
+_POPUP_FLAGS = {"Message": ("False", "False"), "Warning": ("True", "False"),
+                "Error": ("False", "True")}
+
+
+def popup_title(line: str) -> str:
+    """``line`` with a ``popup(...)`` title that is PolyScope's default title in another
+    language (and whose warning/error flags are that type's) written in English; any other
+    title (a user's own, in a script) is kept."""
+    match = _POPUP.match(line)
+    if not match:
+        return line
+    english = POPUP_TITLES.get(match.group(2))
+    if english is None or _POPUP_FLAGS[english] != (match.group(4), match.group(5)):
+        return line
+    return f'{match.group(1)}"{english}"{line[match.end(2) + 1:]}'
 
 
 def git_dir(repos: Path, repo: str) -> Path:
@@ -67,6 +104,20 @@ def git_show(gitdir: Path, commit: str, path: str) -> bytes | None:
     result = subprocess.run(["git", f"--git-dir={gitdir}", "show", f"{commit}:{path}"],
                             capture_output=True)
     return result.stdout if result.returncode == 0 else None
+
+
+def last_commit(gitdir: Path, commit: str, path: str) -> str:
+    """The last commit up to ``commit`` that changed ``path``: the script files a program
+    names are read as they were then (when PolyScope wrote the .script), not as later
+    edited."""
+    result = subprocess.run(["git", f"--git-dir={gitdir}", "log", "-1", "--format=%H", commit,
+                             "--", path], capture_output=True, text=True)
+    return result.stdout.strip() or commit
+
+
+def _join(folder: PurePosixPath, relative: str) -> str:
+    """``folder/relative`` with ``..`` resolved (a path inside the repository)."""
+    return posixpath.normpath(str(folder / relative))
 
 
 def strip_urcap_text(text: str) -> str:
@@ -141,7 +192,7 @@ def canonical_lines(module: Module) -> list[str]:
         if marker:
             line = f"{marker.group(1)}$ {marker.group(2)}{marker.group(3)}"
         else:
-            line = _NUMBER.sub(_number, line)
+            line = _NUMBER.sub(_number, popup_title(line))
         lines.append(line)
     return lines
 
@@ -202,6 +253,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
     parser.add_argument("--split", choices=("tune", "held", "all"), default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
+    parser.add_argument("--script-files", choices=("file", "cache"), default="file",
+                        help="a Script node's file: read it from the repository as of the "
+                             "commit that last wrote the .script (file), or take the copy "
+                             "the .urp keeps (cache)")
     parser.add_argument("--only", default="", help="only pairs whose .urp path contains this")
     args = parser.parse_args(argv)
 
@@ -246,20 +301,26 @@ def main(argv: list[str] | None = None) -> int:
             program = parse_urp(urp, urp_path)
             installation = None
             variables: list[tuple[str, str]] = []
-            if program.installation:
-                folder = PurePosixPath(urp_path).parent
-                data = git_show(gitdir, commit, str(folder / f"{program.installation}"
-                                                             ".installation"))
+            folder = PurePosixPath(urp_path).parent
+            named = program.installation_path or program.installation
+            if named:
+                data = git_show(gitdir, commit, _join(folder, f"{named}.installation"))
                 if data is not None:
                     try:
                         installation = parse_installation(data, program.installation)
                     except InstallationError:
                         installation = None
-                text = git_show(gitdir, commit, str(folder / f"{program.installation}"
-                                                             ".variables"))
+                text = git_show(gitdir, commit, _join(folder, f"{named}.variables"))
                 if installation is not None and text is not None:
                     variables = parse_variables(text)
-            compiled = compile_program(program, installation, variables)
+
+            saved = last_commit(gitdir, commit, script_path)
+
+            def files(relative: str, folder=folder, gitdir=gitdir, saved=saved):
+                return git_show(gitdir, saved, _join(folder, relative))
+
+            compiled = compile_program(program, installation, variables,
+                                       files if args.script_files == "file" else None)
             ours_tree = _clean(parse(strip_urcap_text(compiled.text), "compiled")
                                if by_text else compiled.module)
         except (UrpError, CompileError) as error:

@@ -15,15 +15,17 @@ __all__ = ["add_commands", "compile_urp", "load", "load_all"]
 
 
 def _installation_for(program: Program, path: str | Path) -> Installation | None:
-    """The installation the program names, from its folder (``NAME.installation``), else the
-    only installation there; ``None`` when there is none. A broken installation is reported on
+    """The installation the program names (``installationRelativePath``, e.g.
+    ``../default.installation``, else ``NAME.installation`` in its folder), else the only
+    installation there; ``None`` when there is none. A broken installation is reported on
     standard error and left out."""
     folder = Path(path).parent
     candidate: Path | None = None
-    if program.installation:
-        named = folder / f"{program.installation}.installation"
-        if named.is_file():
+    for name in (program.installation_path, program.installation):
+        named = folder / f"{name}.installation" if name else None
+        if named is not None and named.is_file():
             candidate = named
+            break
     if candidate is None:
         candidate = find_installation(path)
     if candidate is None:
@@ -54,7 +56,13 @@ def load_all(path: str | Path) -> tuple[Program, Installation | None, Compiled]:
             variables = parse_variables(file.read_bytes())
         except OSError:
             variables = []
-    return program, installation, compile_program(program, installation, variables)
+    folder = Path(path).parent
+
+    def files(relative: str) -> bytes | None:
+        file = folder / relative
+        return file.read_bytes() if file.is_file() else None
+
+    return program, installation, compile_program(program, installation, variables, files)
 
 
 def compile_urp(path: str, output: str | None) -> int:

@@ -29,9 +29,11 @@ from __future__ import annotations
 
 import gzip
 import math
+import posixpath
 import re
 import uuid
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from xml.etree import ElementTree
 
@@ -80,7 +82,12 @@ from ..script.printer import format as print_tree
 from .installation import Installation
 from .urp import Expression, Kinematics, Node, Program
 
-__all__ = ["CompileError", "Compiled", "compile_program", "parse_variables", "waypoint_pose"]
+__all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "parse_variables",
+           "script_file_candidates", "waypoint_pose"]
+
+FileReader = Callable[[str], "bytes | None"]
+"""Reads a file by its path relative to the program's folder (``/``-separated, ``..``
+allowed); ``None`` when there is no such file."""
 
 
 class CompileError(Exception):
@@ -319,12 +326,37 @@ def _num(value: float) -> Expr:
 
 
 def compile_program(program: Program, installation: Installation | None = None,
-                    variables: list[tuple[str, str]] | None = None) -> Compiled:
+                    variables: list[tuple[str, str]] | None = None,
+                    files: FileReader | None = None) -> Compiled:
     """Compile ``program`` as PolyScope does, with its installation and the installation's
     variables (``NAME.variables`` beside it: (name, value as written) pairs, see
-    :func:`parse_variables`). Raises :class:`CompileError` naming the file and node for a
-    node it cannot compile."""
-    return _Compiler(program, installation, variables or []).run()
+    :func:`parse_variables`). ``files`` reads the script files the program's Script nodes
+    name (see :func:`script_file_candidates`): PolyScope compiles a script file's current
+    contents, and the copy the ``.urp`` keeps (``cachedContents``) only stands in when the
+    file is not found. Raises :class:`CompileError` naming the file and node for a node it
+    cannot compile."""
+    return _Compiler(program, installation, variables or [], files).run()
+
+
+def script_file_candidates(program: Program, file: str) -> list[str]:
+    """Where a script file a Script node names (``file``: its path on the robot, e.g.
+    ``/programs/cell/scripts/init.script``) may be, as paths relative to the program's
+    folder, most likely first: its path relative to the folder the program was saved in
+    (``directory``), then ever shorter tails of its path beside the program (a copy of the
+    robot's programs is often laid out differently: ``scripts/init.script``,
+    ``init.script``)."""
+    out: list[str] = []
+    file = file.replace("\\", "/").strip()
+    if not file:
+        return out
+    if program.directory and file.startswith("/") and program.directory.startswith("/"):
+        out.append(posixpath.relpath(file, program.directory))
+    parts = [part for part in file.split("/") if part and part not in (".", "..")]
+    for index in range(len(parts)):
+        tail = "/".join(parts[index:])
+        if tail not in out:
+            out.append(tail)
+    return out
 
 
 def parse_variables(data: bytes) -> list[tuple[str, str]]:
@@ -355,8 +387,9 @@ def parse_variables(data: bytes) -> list[tuple[str, str]]:
 
 class _Compiler:
     def __init__(self, program: Program, installation: Installation | None,
-                 variables: list[tuple[str, str]]) -> None:
+                 variables: list[tuple[str, str]], files: FileReader | None = None) -> None:
         self.program = program
+        self.files = files
         self.installation = installation
         self.variables = variables
         self.numbers: dict[int, Node] = {}
@@ -722,7 +755,35 @@ class _Compiler:
             if feature and feature not in _BASE_FEATURES:
                 target = _call("pose_trans", Name(str(feature)), target)
             return target
-        return self.fixed_values(node)[0]
+        return self.in_variable_feature(node, move, self.fixed_values(node)[0])
+
+    def variable_feature(self, move: Node) -> str | None:
+        """The name of the move's feature when it is a variable one (a program may move it):
+        named, not the base or the tool, and variable in the installation (taken as
+        variable when the installation is unknown: every feature seen in a move's feature
+        reference in real programs was)."""
+        feature = move.fields.get("feature")
+        if not feature or feature in _BASE_FEATURES or feature in _TOOL_FEATURES:
+            return None
+        known = dict(getattr(self.installation, "feature_variable", ()) or ())
+        if known.get(str(feature), True) is False:
+            return None
+        return str(feature)
+
+    def in_variable_feature(self, node: Node, move: Node, pose: Expr) -> Expr:
+        """A fixed waypoint's pose under a move in a variable feature, as PolyScope writes
+        it: ``pose_trans(F, pose_trans(p[inverse of the feature's pose when taught], W_p))``,
+        so that the waypoint follows the feature (``BaseToFeature``: the feature's pose in
+        the base frame when the waypoint was taught; m, rad)."""
+        feature = self.variable_feature(move)
+        taught = node.fields.get("base_to_feature")
+        if feature is None or not taught or len(taught) != 6:
+            return pose
+        rotation = _rotvec_to_matrix(taught[3:])
+        inverse = tuple(-(rotation.T @ np.asarray(taught[:3], dtype=float))) + \
+            tuple(_matrix_to_rotvec(rotation.T))
+        return _call("pose_trans", Name(feature),
+                     _call("pose_trans", Pose(tuple(_num(float(v)) for v in inverse)), pose))
 
     def fixed_values(self, node: Node) -> tuple[Expr, Expr]:
         """The pose and joints of a fixed waypoint: its globals (PolyScope 5), or literals
@@ -829,11 +890,26 @@ class _Compiler:
                     *self.code(self.script_of(expression, node), node)]
         contents = str(node.fields.get("contents", ""))
         if kind == "File":
-            file = str(node.fields.get("file", "")).rsplit("/", 1)[-1]
-            label = f"Script: {file}"
+            path = str(node.fields.get("file", ""))
+            contents = self.script_file(path) or contents
+            label = f"Script: {path.rsplit('/', 1)[-1]}"
         else:
             label = "Script"
         return [self.marker(node, label), *self.code(contents, node)]
+
+    def script_file(self, path: str) -> str | None:
+        """The current contents of the script file at ``path`` (on the robot), when the
+        file reader finds it."""
+        if self.files is None:
+            return None
+        for candidate in script_file_candidates(self.program, path):
+            try:
+                data = self.files(candidate)
+            except OSError:
+                data = None
+            if data is not None:
+                return data.decode("utf-8", "replace")
+        return None
 
     def n_Popup(self, node: Node) -> list[Item]:
         kind = str(node.fields.get("type", "Message"))
@@ -1102,6 +1178,8 @@ class _Compiler:
             frame = Name(str(feature))
         kind = {"Point": 1, "Motion": 3}.get(str(node.fields.get("type")), 2)
         limits = [speeds[i] if selection[i] else deviations[i] for i in range(6)]
+        if all(child.kind == "Placeholder" or child.suppressed for child in node.children):
+            return []  # PolyScope writes nothing for a Force node with an empty body
         body = self.block(node.children)
         for index in range(len(body) - 1, -1, -1):
             item = body[index]
@@ -1143,6 +1221,7 @@ class _Compiler:
         elif kind == "Fixed":
             label = name
             pose_expr, q_expr = self.fixed_values(node)
+            pose_expr = self.in_variable_feature(node, move, pose_expr)
             if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
                 target = q_expr
             elif motion == "MoveJ":

@@ -198,6 +198,9 @@ class Installation:
     safety: Safety | None = None
     """The safety configuration's normal-mode limits and planes (3.x and 5.x), when the
     file has them."""
+    feature_variable: tuple[tuple[str, bool], ...] = ()
+    """Every named feature (point, line, plane) and whether it is variable (a program may
+    move it; PolyScope writes waypoints taught in it relative to it)."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -313,7 +316,17 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
                         mounting, version, _settings(root), _features(root, path),
-                        _io_names(root), _safety(root))
+                        _io_names(root), _safety(root), _feature_variable(root))
+
+
+def _feature_variable(root: ElementTree.Element) -> tuple[tuple[str, bool], ...]:
+    block = root.find("Features")
+    if block is None:
+        return ()
+    return tuple((element.get("name", ""), element.get("isVariable") == "true")
+                 for element in block.iter() if element.get("name")
+                 and element.get("isVariable") is not None
+                 and element.get("hiddenSubFeature") != "true")
 
 
 def _safety(root: ElementTree.Element) -> Safety | None:

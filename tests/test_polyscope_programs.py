@@ -1,0 +1,163 @@
+"""PolyScope behaviour learned from real program/script pairs, on small programs written
+here: script files read as PolyScope reads them, waypoints in a variable feature, an empty
+Force node, the installation a program names by relative path."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from urdsl.cli import main
+from urdsl.polyscope.compile import compile_program, script_file_candidates
+from urdsl.polyscope.installation import parse_installation
+from urdsl.polyscope.urp import parse_urp
+from urdsl.script import parse
+from urdsl.script.printer import format as print_tree
+
+KINEMATICS = """
+  <kinematics status="LINEARIZED" validChecksum="true">
+    <deltaTheta value="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
+    <a value="0.0, -0.425, -0.3922, 0.0, 0.0, 0.0"/>
+    <d value="0.1625, 0.0, 0.0, 0.1333, 0.0997, 0.0996"/>
+    <alpha value="1.5707963267948966, 0.0, 0.0, 1.5707963267948966, -1.5707963267948966, 0.0"/>
+  </kinematics>"""
+
+
+def program(body: str, *, name: str = "prog", directory: str = "/programs/cell",
+            installation: str = "default", relative: str | None = None) -> bytes:
+    """A PolyScope 5 program whose Robot Program holds ``body`` (XML)."""
+    relative_attr = f' installationRelativePath="{relative}"' if relative else ""
+    return (f'<URProgram name="{name}" installation="{installation}"{relative_attr} '
+            f'directory="{directory}" createdIn="5.11.0" lastSavedIn="5.11.0">{KINEMATICS}'
+            f'<children><MainProgram runOnlyOnce="true"><children>{body}</children>'
+            f'</MainProgram></children></URProgram>').encode()
+
+
+def lines_of(data: bytes, **options) -> list[str]:
+    text = compile_program(parse_urp(data, "prog.urp"), **options).text
+    assert print_tree(parse(text)) == text
+    return [line.strip() for line in text.splitlines()]
+
+
+SCRIPT_FILE = """<Script type="File">
+  <cachedContents>def helper():
+  return 1
+end
+</cachedContents>
+  <file>/programs/cell/scripts/helper.script</file>
+</Script>"""
+
+
+def test_a_script_file_is_compiled_from_the_file_as_it_is_now():
+    files = {"scripts/helper.script": b"def helper():\r\n  sync()\r\n  return 2\r\nend\r\n"}
+    lines = lines_of(program(SCRIPT_FILE), files=files.get)
+    assert lines[lines.index('$ 2 "Script: helper.script"') + 1:][:4] == [
+        "def helper():", "sync()", "return 2", "end"]
+
+
+def test_a_script_file_not_found_falls_back_to_the_copy_in_the_program():
+    lines = lines_of(program(SCRIPT_FILE), files=lambda _path: None)
+    assert "return 1" in lines and "return 2" not in lines
+    assert "return 1" in lines_of(program(SCRIPT_FILE))  # no file reader at all
+
+
+def test_script_files_are_looked_for_relative_to_the_saved_folder_then_by_their_tail():
+    prog = parse_urp(program(SCRIPT_FILE, directory="/programs/cell/v2"), "p.urp")
+    assert script_file_candidates(prog, "/programs/cell/scripts/helper.script") == [
+        "../scripts/helper.script", "programs/cell/scripts/helper.script",
+        "cell/scripts/helper.script", "scripts/helper.script", "helper.script"]
+    # a copy laid out differently: the file beside the program
+    lines = lines_of(program(SCRIPT_FILE, directory="/programs/cell/v2"),
+                     files={"helper.script": b"def helper():\n  return 3\nend\n"}.get)
+    assert "return 3" in lines
+
+
+def test_the_compile_command_reads_script_files_beside_the_program(tmp_path, capsys):
+    (tmp_path / "scripts").mkdir()
+    (tmp_path / "scripts" / "helper.script").write_text("def helper():\n  return 7\nend\n")
+    (tmp_path / "prog.urp").write_bytes(program(SCRIPT_FILE))
+    assert main(["compile", str(tmp_path / "prog.urp")]) == 0
+    assert "return 7" in capsys.readouterr().out
+
+
+FEATURE_MOVE = """<Move motionType="{motion}" speed="1.0" acceleration="1.4" useActiveTCP="true"
+      positionType="CartesianPose">
+  <feature class="GeomFeatureReference" referencedName="{feature}"/>
+  <children>
+    <Waypoint type="Fixed" name="corner" kinematicsFlags="3">
+      <motionParameters/>
+      <position>
+        <JointAngles angles="0.0, -1.5, 1.5, -1.5, -1.5, 0.0"/>
+        <TCPOffset pose="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
+      </position>
+      <BaseToFeature pose="-0.5, -0.1, 0.07, 2.221441469079183, 2.221441469079183, 0.0"/>
+    </Waypoint>
+  </children>
+</Move>"""
+
+
+def _pose_numbers(text: str) -> list[float]:
+    return [float(v) for v in text.split("p[", 1)[1].split("]", 1)[0].split(",")]
+
+
+def test_a_waypoint_in_a_variable_feature_follows_the_feature():
+    lines = lines_of(program(FEATURE_MOVE.format(motion="MoveJ", feature="table")))
+    move = next(line for line in lines if line.startswith("movej("))
+    assert move.startswith("movej(get_inverse_kin(pose_trans(table, pose_trans(p[")
+    assert move.endswith(", corner_p)), qnear=corner_q), a=1.4, v=1.0)")
+    # the literal is the inverse of the feature's pose when the waypoint was taught: a half
+    # turn about (1, 1, 0) maps x to y, y to x and z to -z
+    inverse = _pose_numbers(move)
+    assert np.allclose(inverse[:3], [0.1, 0.5, 0.07], atol=1e-9)
+    assert math.isclose(np.linalg.norm(inverse[3:]), math.pi, abs_tol=1e-9)
+    linear = lines_of(program(FEATURE_MOVE.format(motion="MoveL", feature="table")))
+    assert any(line.startswith("movel(pose_trans(table, pose_trans(p[") and
+               line.endswith(", corner_p)), a=1.4, v=1.0)") for line in linear)
+
+
+INSTALLATION = """<Installation name="default"><Features>
+  <GeomPlaneNode name="table" isVariable="{variable}"/>
+</Features></Installation>"""
+
+
+def test_a_waypoint_in_a_fixed_feature_or_the_base_is_written_as_taught():
+    fixed = parse_installation(INSTALLATION.format(variable="false").encode(), "d")
+    lines = lines_of(program(FEATURE_MOVE.format(motion="MoveL", feature="table")),
+                     installation=fixed)
+    assert "movel(corner_p, a=1.4, v=1.0)" in lines
+    base = lines_of(program(FEATURE_MOVE.format(motion="MoveL", feature="Joint_0_name")))
+    assert "movel(corner_p, a=1.4, v=1.0)" in base
+    variable = parse_installation(INSTALLATION.format(variable="true").encode(), "d")
+    lines = lines_of(program(FEATURE_MOVE.format(motion="MoveL", feature="table")),
+                     installation=variable)
+    assert any(line.startswith("movel(pose_trans(table, ") for line in lines)
+
+
+def test_a_force_node_with_an_empty_body_writes_nothing():
+    force = """<Force type="Frame">
+      <feature referencedName="Joint_6_name"/>
+      <selection value="0, 0, 1, 0, 0, 0"/>
+      <wrench value="0.0, 0.0, 3.0, 0.0, 0.0, 0.0"/>
+      <limitsForce value="0.1, 0.1, 0.1, 1.0, 1.0, 1.0"/>
+      <limitsMotion value="0.1, 0.1, 0.1, 0.3, 0.3, 0.3"/>
+      <children><Placeholder/></children>
+    </Force>"""
+    lines = lines_of(program(force))
+    assert not any("force_mode" in line or "zero_ftsensor" in line for line in lines)
+    assert lines_of(program(force.replace("<Placeholder/>", '<Wait type="Sleep">'
+                                          "<waitTime>1.0</waitTime></Wait>")))[-5:-1] == [
+        '$ 3 "Wait: 1.0" "noBreak"', "sleep(1.0)", "end_force_mode()", "stopl(5.0)"]
+
+
+def test_the_installation_named_by_relative_path_is_read(tmp_path: Path, capsys):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "shared.installation").write_text(
+        '<Installation name="shared"><IOs><DigitalOutputNames value="lamp,,,,,,,"/></IOs>'
+        "</Installation>")
+    (tmp_path / "sub" / "prog.urp").write_bytes(program(
+        '<Set type="DigitalOutput"><pin referencedName="lamp"/><digitalValue>1</digitalValue>'
+        "</Set>", installation="shared", relative="../shared"))
+    assert main(["compile", str(tmp_path / "sub" / "prog.urp")]) == 0
+    assert "set_standard_digital_out(0, True)" in capsys.readouterr().out
