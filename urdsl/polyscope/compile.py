@@ -269,7 +269,8 @@ def _tool_communication(attrs: dict[str, str] | None) -> list[Item]:
 
 def _blend_kept(move: Node, motion: Node) -> bool:
     """Whether a process move (MoveP) keeps the blend of ``motion``: not at its last motion
-    unless the next node is another MoveP, into which it can blend."""
+    unless the next node is another MoveP, into which it can blend (after the Robot
+    Program's last node comes its first one again when the program loops)."""
     if move.fields.get("motion_type") != "MoveP":
         return True
     motions = [child for child in move.children
@@ -283,8 +284,12 @@ def _blend_kept(move: Node, motion: Node) -> bool:
     index = siblings.index(move) if move in siblings else -1
     if 0 <= index < len(siblings) - 1:
         following = siblings[index + 1]
-        return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
-    return False
+    elif index >= 0 and parent.kind == "MainProgram" and \
+            parent.attrs.get("runOnlyOnce") != "true":
+        following = siblings[0]
+    else:
+        return False
+    return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
 
 
 def _direction_helper() -> list[Item]:
