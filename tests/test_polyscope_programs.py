@@ -161,3 +161,40 @@ def test_the_installation_named_by_relative_path_is_read(tmp_path: Path, capsys)
         "</Set>", installation="shared", relative="../shared"))
     assert main(["compile", str(tmp_path / "sub" / "prog.urp")]) == 0
     assert "set_standard_digital_out(0, True)" in capsys.readouterr().out
+
+
+def _folder_with_programs(tmp_path: Path) -> Path:
+    cell = tmp_path / "cell"
+    cell.mkdir()
+    (cell / "pick.urp").write_bytes(program('<Wait type="Sleep"><waitTime>0.1</waitTime>'
+                                            "</Wait>", name="pick"))
+    (cell / "pick.script").write_text("def pick():\n  sleep(0.1)\nend\n")  # PolyScope's
+    (cell / "tool.script").write_text("def tool():\n  sleep(0.2)\nend\n")
+    return cell
+
+
+def test_lint_of_a_folder_takes_its_urp_programs_and_skips_polyscopes_scripts(tmp_path,
+                                                                             capsys):
+    cell = _folder_with_programs(tmp_path)
+    assert main(["lint", "--format", "json", str(cell)]) == 0
+    captured = capsys.readouterr()
+    assert "Found" not in captured.out
+    assert f"note: {cell / 'pick.script'} skipped: PolyScope wrote it beside pick.urp, " \
+           "which is linted instead" in captured.err
+    assert "tool.script" not in captured.err
+    # the .urp is really linted: a program PolyScope could not run is an error naming it
+    (cell / "pick.urp").write_bytes(program('<Set type="DigitalOutput"><pin '
+                                            'referencedName="nowhere"/></Set>', name="pick"))
+    assert main(["lint", str(cell)]) == 1
+    out = capsys.readouterr().out
+    assert "pick.urp:1:1: URS001" in out and "'nowhere' is not named" in out
+
+
+def test_check_of_a_folder_checks_each_program_once(tmp_path, capsys):
+    cell = _folder_with_programs(tmp_path)
+    main(["check", "--json", str(cell)])
+    captured = capsys.readouterr()
+    assert "pick.script skipped" in captured.err
+    import json
+    names = [Path(document["file"]).name for document in json.loads(captured.out)]
+    assert sorted(names) == ["pick.urp (compiled)", "tool.script"]

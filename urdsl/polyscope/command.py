@@ -11,7 +11,40 @@ from .compile import Compiled, CompileError, compile_program, parse_variables
 from .installation import Installation, InstallationError, find_installation, read_installation
 from .urp import Node, Program, UrpError, read_urp
 
-__all__ = ["add_commands", "compile_urp", "load", "load_all"]
+__all__ = ["add_commands", "collect_programs", "compile_urp", "load", "load_all"]
+
+SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
+
+
+def collect_programs(folder: str | Path) -> tuple[list[str], list[tuple[str, str]]]:
+    """The programs in ``folder`` and its subfolders (hidden ones left out), sorted:
+    PolyScope programs (``.urp``) and URScript files, except a ``.script`` PolyScope wrote
+    beside a ``.urp`` of the same name (the program is the ``.urp``; its ``.script`` is a
+    copy PolyScope writes on saving, often stale). Returns ``(files, skipped)``, ``skipped``
+    holding ``(script, urp)`` pairs."""
+    root = Path(folder)
+    found = sorted(
+        path for path in root.rglob("*")
+        if path.suffix.lower() in (*SCRIPT_SUFFIXES, ".urp") and path.is_file()
+        and not any(part.startswith(".") for part in path.parts[len(root.parts):]))
+    programs = {path.with_suffix("") for path in found if path.suffix.lower() == ".urp"}
+    files: list[str] = []
+    skipped: list[tuple[str, str]] = []
+    for path in found:
+        if path.suffix.lower() == ".script" and path.with_suffix("") in programs:
+            urp = next(p for p in found if p.suffix.lower() == ".urp"
+                       and p.with_suffix("") == path.with_suffix(""))
+            skipped.append((str(path), str(urp)))
+        else:
+            files.append(str(path))
+    return files, skipped
+
+
+def report_skipped(skipped: list[tuple[str, str]], verb: str) -> None:
+    """Say on standard error which ``.script`` files were left out for their ``.urp``."""
+    for script, urp in skipped:
+        print(f"note: {script} skipped: PolyScope wrote it beside {Path(urp).name}, "
+              f"which is {verb} instead", file=sys.stderr)
 
 
 def _installation_for(program: Program, path: str | Path) -> Installation | None:
