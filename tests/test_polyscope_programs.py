@@ -198,3 +198,90 @@ def test_check_of_a_folder_checks_each_program_once(tmp_path, capsys):
     import json
     names = [Path(document["file"]).name for document in json.loads(captured.out)]
     assert sorted(names) == ["pick.urp (compiled)", "tool.script"]
+
+
+WAYPOINT_UNTIL = """<Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true"
+      positionType="CartesianPose">
+  <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+  <children>
+    <Waypoint type="Fixed" name="Press" kinematicsFlags="3">
+      <motionParameters/>
+      <position>
+        <JointAngles angles="0.0, -1.5, 1.5, -1.5, -1.5, 0.0"/>
+        <TCPOffset pose="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
+      </position>
+      <children>
+        {untils}
+      </children>
+    </Waypoint>
+  </children>
+</Move>"""
+
+REACHED = '<Until type="REACHED_WAYPOINT"/>'
+EXPRESSION = """<Until type="EXPRESSION" deceleration="2.5">
+  <expression><ExpressionToken token="get_standard_digital_in"/>
+    <ExpressionChar character="("/><ExpressionChar character="2"/>
+    <ExpressionChar character=")"/></expression>
+  <children><Popup type="Message" haltProgram="false" message="pressed"
+    inputType="Text"/></children>
+</Until>"""
+
+
+def test_a_waypoint_with_until_moves_in_a_thread_until_it_is_reached():
+    # as PolyScope 5 writes a waypoint with "Until (reached_waypoint)"
+    lines = lines_of(program(WAYPOINT_UNTIL.format(untils=REACHED)))
+    at = lines.index('$ 3 "Press" "breakAfter"')
+    assert lines[at + 1:at + 21] == [
+        "global move_thread_flag_3 = 0", "thread move_thread_3():", "enter_critical",
+        "move_thread_flag_3 = 1", "movel(Press_p, a=1.2, v=0.25)", "move_thread_flag_3 = 2",
+        "exit_critical", "end", "move_thread_flag_3 = 0",
+        "move_thread_han_3 = run move_thread_3()", "while (True):", "sleep(1e-10)",
+        "if (move_thread_flag_3 > 1):", "join move_thread_han_3",
+        '$ 4 "Until (reached_waypoint)"', "break", "end", "sync()", "end", "end"]
+
+
+def test_an_until_condition_stops_the_move_when_it_holds():
+    lines = lines_of(program(WAYPOINT_UNTIL.format(untils=EXPRESSION + REACHED)))
+    loop = lines.index("move_thread_han_3 = run move_thread_3()") + 1
+    assert lines[loop + 1:loop + 8] == [
+        "if (get_standard_digital_in(2)):", "kill move_thread_han_3", "stopl(2.5)",
+        '$ 4 "Until (expression)"', '$ 5 "Popup: pressed"',
+        'popup("pressed", "Message", False, False, blocking=True)', "break"]
+    # then the end of the move, then the next cycle
+    assert '$ 6 "Until (reached_waypoint)"' in lines
+    assert not any("not compiled" in line for line in lines)
+
+
+def test_a_direction_until_a_condition():
+    direction = f"""<gui.program.direction.MoveDirectionNode selectedDirection="ZMinus"
+        toolParams="0.05, 1.0">
+      <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+      <children>{EXPRESSION}</children>
+    </gui.program.direction.MoveDirectionNode>"""
+    move = WAYPOINT_UNTIL.format(untils="").replace(
+        "</Waypoint>", f"</Waypoint>{direction}")
+    lines = lines_of(program(move))
+    # no distance: the move heads 1000 m away and the condition ends it
+    assert "local towardsPos = calculate_point_to_move_towards(p[0.0, 0.0, 0.0, 0.0, 0.0, " \
+           "0.0], [0.0, 0.0, -1.0], 1000.0)" in lines
+    assert "movel(towardsPos, a=1.0, v=0.05)" in lines
+    at = lines.index("if (get_standard_digital_in(2)):")
+    assert lines[at + 1:at + 4] == ["kill move_thread_han_4", "stopl(2.5)",
+                                    '$ 5 "Until (expression)"']
+
+
+def test_a_process_move_blends_into_itself_when_the_program_loops():
+    move = """<Move motionType="MoveP" speed="0.25" acceleration="1.2" blendRadius="0.025"
+        useActiveTCP="true" positionType="CartesianPose">
+      <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+      <children>
+        <Waypoint type="Variable" name="Waypoint" kinematicsFlags="-1">
+          <variable name="a"/></Waypoint>
+        <Waypoint type="Variable" name="Waypoint" kinematicsFlags="-1">
+          <variable name="b"/></Waypoint>
+      </children>
+    </Move>"""
+    once = lines_of(program(move))
+    assert "movep(b, a=1.2, v=0.25, r=0.0)" in once  # the program ends: stop there
+    looping = lines_of(program(move).replace(b'runOnlyOnce="true"', b'runOnlyOnce="false"'))
+    assert "movep(b, a=1.2, v=0.25, r=0.025)" in looping  # the next motion is its first

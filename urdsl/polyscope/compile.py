@@ -1087,26 +1087,45 @@ class _Compiler:
             Assign(Name(flag), Number(0)),
             Assign(Name(handle), Run(thread)),
         ]
+        items.append(self.until_loop(untils, flag, handle, accel))
+        others = [child for child in node.children if child.kind != "Until"]
+        items.extend(self.block(others))
+        return items
+
+    def until_loop(self, untils: list[Node], flag: str, handle: str,
+                   accel: float | None) -> While:
+        """The loop that waits, while a move thread runs, for the first of its Until
+        conditions: tool contact (checked first, whatever the order), a condition (an
+        expression: the move stops at the Until's ``deceleration``, m/s², else the move's
+        acceleration; the form is inferred, not yet seen in a PolyScope script [U]), and the
+        end of the move (distance, reached waypoint), in the node order."""
         loop: list[Item] = []
-        # PolyScope checks tool contact before the other conditions, whatever their order
-        for until in sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION"):
+        ordered = sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION")
+        for until in ordered:
             kind = until.attrs.get("type", "")
+            label = f"Until ({kind.lower()})"
             if kind == "TOOL_CONTACT_DETECTION":
                 loop.extend(self._tool_contact(until, handle, accel))
                 continue
+            expression = until.fields.get("expression")
+            if isinstance(expression, Expression) and expression:
+                decel = _floats_or_none(until.attrs.get("deceleration"))
+                stop = decel[0] if decel else (accel if accel is not None else 1.2)
+                test = self.expr(self.script_of(expression, until), until)
+                loop.append(If(Paren(test), (
+                    Kill(Name(handle)), _stmt("stopl", _num(stop)),
+                    self.marker(until, label), *self.block(until.children), Break())))
+                continue
             done: list[Item] = [Join(Name(handle))]
-            if kind != "DISTANCE":
-                done.append(Comment(f" urdsl: Until ({kind.lower()}) is not compiled"))
-            done.append(self.marker(until, f"Until ({kind.lower()})"))
+            if kind not in ("DISTANCE", "REACHED_WAYPOINT"):
+                done.append(Comment(f" urdsl: {label} is not compiled"))
+            done.append(self.marker(until, label))
             done.extend(self.block(until.children))
             done.append(Break())
             loop.append(_stmt("sleep", _num(1e-10)))
             loop.append(If(Paren(BinOp(">", Name(flag), Number(1))), tuple(done)))
         loop.append(_stmt("sync"))
-        items.append(While(Paren(Bool(True)), tuple(loop)))
-        others = [child for child in node.children if child.kind != "Until"]
-        items.extend(self.block(others))
-        return items
+        return While(Paren(Bool(True)), tuple(loop))
 
     def _tool_contact(self, until: Node, handle: str, accel: float | None) -> list[Item]:
         """The wait of a Direction that stops on tool contact: back off along the way it
@@ -1241,9 +1260,25 @@ class _Compiler:
             return [self.marker(node, name, "breakAfter")]
         keywords = self.motion_keywords(move, node)
         function = {"MoveJ": "movej", "MoveL": "movel", "MoveP": "movep"}.get(motion, "movel")
+        motion_call = ExprStmt(Call(Name(function), (target,),
+                                    tuple(Keyword(k, v) for k, v in keywords)))
+        untils = [child for child in node.children
+                  if child.kind == "Until" and not child.suppressed]
+        if not untils:
+            return [self.marker(node, label, "breakAfter"), motion_call]
+        # a waypoint with Until conditions: the move runs in a thread the conditions end
+        number = self.number(node)
+        flag, thread, handle = (f"move_thread_flag_{number}", f"move_thread_{number}",
+                                f"move_thread_han_{number}")
+        accel = dict(keywords).get("a")
         return [self.marker(node, label, "breakAfter"),
-                ExprStmt(Call(Name(function), (target,),
-                              tuple(Keyword(k, v) for k, v in keywords)))]
+                Declare("global", flag, Number(0)),
+                ThreadDef(thread, (EnterCritical(), Assign(Name(flag), Number(1)), motion_call,
+                                   Assign(Name(flag), Number(2)), ExitCritical())),
+                Assign(Name(flag), Number(0)),
+                Assign(Name(handle), Run(thread)),
+                self.until_loop(untils, flag, handle,
+                                accel.value if isinstance(accel, Number) else None)]
 
     def motion_keywords(self, move: Node, waypoint: Node) -> list[tuple[str, Expr]]:
         params = waypoint.fields.get("params") or {}
