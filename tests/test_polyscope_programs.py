@@ -285,3 +285,17 @@ def test_a_process_move_blends_into_itself_when_the_program_loops():
     assert "movep(b, a=1.2, v=0.25, r=0.0)" in once  # the program ends: stop there
     looping = lines_of(program(move).replace(b'runOnlyOnce="true"', b'runOnlyOnce="false"'))
     assert "movep(b, a=1.2, v=0.25, r=0.025)" in looping  # the next motion is its first
+
+
+def test_a_variable_waypoint_is_the_variable_in_the_moves_feature():
+    move = """<Move motionType="MoveL" speed="0.64" acceleration="0.32" useActiveTCP="true"
+        positionType="CartesianPose">
+      <feature class="GeomFeatureReference" referencedName="{feature}"/>
+      <children><Waypoint type="Variable" name="Waypoint" kinematicsFlags="-1">
+        <variable name="pick_pose"/></Waypoint></children>
+    </Move>"""
+    lines = lines_of(program(move.format(feature="pallet")))
+    assert lines[-3:-1] == ['$ 3 "pick_pose" "breakAfter"',
+                            "movel(pose_trans(pallet, pick_pose), a=0.32, v=0.64)"]
+    assert "movel(pick_pose, a=0.32, v=0.64)" in lines_of(program(move.format(
+        feature="Joint_0_name")))
