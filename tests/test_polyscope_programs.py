@@ -299,3 +299,20 @@ def test_a_variable_waypoint_is_the_variable_in_the_moves_feature():
                             "movel(pose_trans(pallet, pick_pose), a=0.32, v=0.64)"]
     assert "movel(pick_pose, a=0.32, v=0.64)" in lines_of(program(move.format(
         feature="Joint_0_name")))
+
+
+def test_inside_force_mode_every_marker_is_no_break():
+    # as a PolyScope 5 script shows a Force around a MoveL whose waypoint has an Until
+    force = f"""<Force type="Frame">
+      <feature referencedName="Joint_6_name"/>
+      <selection value="1, 0, 0, 0, 0, 0"/>
+      <wrench value="-50.0, 50.0, 0.0, 0.0, 0.0, 0.0"/>
+      <limitsForce value="0.15, 0.1, 0.1, 0.35, 0.35, 0.35"/>
+      <limitsMotion value="0.1, 0.1, 0.1, 0.35, 0.35, 0.35"/>
+      <children>{WAYPOINT_UNTIL.format(untils=REACHED)}</children>
+    </Force>"""
+    lines = lines_of(program(force))
+    markers = [line for line in lines if line.startswith("$ ") and int(line.split()[1]) > 2]
+    assert markers == ['$ 3 "MoveL" "noBreak"', '$ 4 "Press" "noBreak"',
+                       '$ 5 "Until (reached_waypoint)" "noBreak"']
+    assert lines[-4:-1] == ["end", "end_force_mode()", "stopl(5.0)"]

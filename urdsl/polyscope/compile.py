@@ -292,6 +292,23 @@ def _blend_kept(move: Node, motion: Node) -> bool:
     return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
 
 
+def _no_break(item: Item) -> Item:
+    """``item`` with each ``$`` marker in it (nested blocks too) flagged ``noBreak``."""
+    from dataclasses import fields, replace
+
+    if isinstance(item, Marker):
+        return Marker(item.number, item.text, "noBreak")
+    changes: dict[str, object] = {}
+    for f in fields(item):  # type: ignore[arg-type]
+        value = getattr(item, f.name)
+        if f.name in ("body", "orelse") and isinstance(value, tuple):
+            changes[f.name] = tuple(_no_break(inner) for inner in value)
+        elif f.name == "elifs" and isinstance(value, tuple):
+            changes[f.name] = tuple(replace(e, body=tuple(_no_break(i) for i in e.body))
+                                    for e in value)
+    return replace(item, **changes) if changes else item  # type: ignore[type-var]
+
+
 def _direction_helper() -> list[Item]:
     """The function PolyScope defines for Direction nodes: the waypoint ``position_distance``
     (m) from the target along ``direction`` given in ``feature``."""
@@ -1204,12 +1221,8 @@ class _Compiler:
         limits = [speeds[i] if selection[i] else deviations[i] for i in range(6)]
         if all(child.kind == "Placeholder" or child.suppressed for child in node.children):
             return []  # PolyScope writes nothing for a Force node with an empty body
-        body = self.block(node.children)
-        for index in range(len(body) - 1, -1, -1):
-            item = body[index]
-            if isinstance(item, Marker):
-                body[index] = Marker(item.number, item.text, "noBreak")
-                break
+        # in force mode the program may not stop at a node: every marker inside is noBreak
+        body = [_no_break(item) for item in self.block(node.children)]
         return [self.marker(node, "Force"), _stmt("sleep", _num(0.02)), _stmt("zero_ftsensor"),
                 _stmt("force_mode", frame, List(tuple(Number(int(v)) for v in selection)),
                       List(tuple(_num(v) for v in wrench)), Number(kind),
