@@ -11,9 +11,19 @@ Both scripts are parsed and printed canonically, statement by statement: comment
 blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare to
 1e-9, PolyScope's generated ids (``_3f89b84f_1daa_...``) are masked, and ``$`` markers
 compare by number and flag (their label text is in the language PolyScope ran in, which the
-.urp does not record). Two views: the whole program, and the program part (the top-level
-statements from the first waypoint global, definition or marker on: what the program tree,
-not the installation, generates).
+.urp does not record). For the same reason a ``popup`` title that is PolyScope's own title
+of a Popup node in another language ("Erreur", "Meldung": see ``POPUP_TITLES``, the
+languages seen) compares as its English one ("Error", "Message") when the popup's
+warning/error flags are that type's; a title the user wrote is compared as written. Two
+views: the whole program, and the program part (the top-level statements from the first
+waypoint global, definition or marker on: what the program tree, not the installation,
+generates).
+
+The installation is the one the program names (``installationRelativePath``). A Script
+node's file is read from the repository as it was in the last commit that changed the
+.script (PolyScope compiles the file's contents when it saves, not the copy the .urp keeps;
+``--script-files cache`` takes that copy instead). A script file edited after the save but
+committed with it makes a pair differ: that is stale data, not a compiler error.
 
 The preamble (what the installation generates before the program tree) is compared block
 by block in any order, each block's statements in order (blocks: the step-counter thread,
@@ -41,6 +51,7 @@ from __future__ import annotations
 import argparse
 import collections
 import difflib
+import posixpath
 import re
 import subprocess
 import sys
@@ -79,6 +90,32 @@ _NEGATIVE_ZERO = re.compile(r"(?<![\w.)\]])-0(?![\w.])")
 """A number that rounds to zero keeps no sign (PolyScope writes -1.2E-16 where urdsl
 computes 3.4E-17)."""
 _MARKER = re.compile(r'^(\s*)\$ (\d+) "(?:[^"]*)"(.*)$')
+_POPUP = re.compile(r'^(\s*popup\(.*, )"([^"]*)"(, (True|False), (True|False))')
+
+POPUP_TITLES = {
+    # French (seen: "Erreur")
+    "Erreur": "Error", "Avertissement": "Warning",
+    # German (seen: "Meldung")
+    "Fehler": "Error", "Warnung": "Warning", "Meldung": "Message",
+}
+"""PolyScope's own Popup titles in the languages seen in real programs → the English title
+urdsl writes. A Popup node has no title of its own: PolyScope titles it with its type
+(Message, Warning, Error) in the language it runs in."""
+_POPUP_FLAGS = {"Message": ("False", "False"), "Warning": ("True", "False"),
+                "Error": ("False", "True")}
+
+
+def popup_title(line: str) -> str:
+    """``line`` with a ``popup(...)`` title that is PolyScope's default title in another
+    language (and whose warning/error flags are that type's) written in English; any other
+    title (a user's own, in a script) is kept."""
+    match = _POPUP.match(line)
+    if not match:
+        return line
+    english = POPUP_TITLES.get(match.group(2))
+    if english is None or _POPUP_FLAGS[english] != (match.group(4), match.group(5)):
+        return line
+    return f'{match.group(1)}"{english}"{line[match.end(2) + 1:]}'
 
 
 def git_dir(repos: Path, repo: str) -> Path:
@@ -90,6 +127,20 @@ def git_show(gitdir: Path, commit: str, path: str) -> bytes | None:
     result = subprocess.run(["git", f"--git-dir={gitdir}", "show", f"{commit}:{path}"],
                             capture_output=True)
     return result.stdout if result.returncode == 0 else None
+
+
+def last_commit(gitdir: Path, commit: str, path: str) -> str:
+    """The last commit up to ``commit`` that changed ``path``: the script files a program
+    names are read as they were then (when PolyScope wrote the .script), not as later
+    edited."""
+    result = subprocess.run(["git", f"--git-dir={gitdir}", "log", "-1", "--format=%H", commit,
+                             "--", path], capture_output=True, text=True)
+    return result.stdout.strip() or commit
+
+
+def _join(folder: PurePosixPath, relative: str) -> str:
+    """``folder/relative`` with ``..`` resolved (a path inside the repository)."""
+    return posixpath.normpath(str(folder / relative))
 
 
 def strip_urcap_text(text: str) -> str:
@@ -164,7 +215,7 @@ def canonical_lines(module: Module) -> list[str]:
         if marker:
             line = f"{marker.group(1)}$ {marker.group(2)}{marker.group(3)}"
         else:
-            line = _NEGATIVE_ZERO.sub("0", _NUMBER.sub(_number, line))
+            line = _NEGATIVE_ZERO.sub("0", _NUMBER.sub(_number, popup_title(line)))
         lines.append(line)
     return lines
 
@@ -262,14 +313,14 @@ def load_installation(gitdir: Path, commit: str, urp_path: str, name: str | None
     if not name:
         return None, [], "the program names no installation"
     folder = PurePosixPath(urp_path).parent
-    data = git_show(gitdir, commit, str(folder / f"{name}.installation"))
+    data = git_show(gitdir, commit, _join(folder, f"{name}.installation"))
     if data is None:
         return None, [], "the installation file is not in the repository"
     try:
         installation = parse_installation(data, f"{name}.installation")
     except InstallationError:
         return None, [], "the installation file does not read"
-    text = git_show(gitdir, commit, str(folder / f"{name}.variables"))
+    text = git_show(gitdir, commit, _join(folder, f"{name}.variables"))
     return installation, parse_variables(text) if text is not None else [], ""
 
 
@@ -289,6 +340,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
     parser.add_argument("--split", choices=("tune", "held", "all"), default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
+    parser.add_argument("--script-files", choices=("file", "cache"), default="file",
+                        help="a Script node's file: read it from the repository as of the "
+                             "commit that last wrote the .script (file), or take the copy "
+                             "the .urp keeps (cache)")
     parser.add_argument("--only", default="", help="only pairs whose .urp path contains this")
     args = parser.parse_args(argv)
 
@@ -321,8 +376,8 @@ def main(argv: list[str] | None = None) -> int:
             st["errors"][str(error).split("error: ", 1)[-1][:150]] += 1
             st["no_installation"]["the .urp does not read"] += 1
             continue
-        installation, variables, absent = load_installation(gitdir, commit, urp_path,
-                                                            program.installation)
+        installation, variables, absent = load_installation(
+            gitdir, commit, urp_path, program.installation_path or program.installation)
         if absent:
             st["no_installation"][absent] += 1
         else:
@@ -347,7 +402,14 @@ def main(argv: list[str] | None = None) -> int:
                 st["with"] -= 1
             continue
         try:
-            compiled = compile_program(program, installation, variables)
+            folder = PurePosixPath(urp_path).parent
+            saved = last_commit(gitdir, commit, script_path)
+
+            def files(relative: str, folder=folder, gitdir=gitdir, saved=saved):
+                return git_show(gitdir, saved, _join(folder, relative))
+
+            compiled = compile_program(program, installation, variables,
+                                       files if args.script_files == "file" else None)
             ours_tree = _clean(parse(strip_urcap_text(compiled.text), "compiled")
                                if by_text else compiled.module)
         except CompileError as error:

@@ -123,7 +123,8 @@ def add_commands(commands) -> None:
 
 
 def _expand(names: list[str]) -> list[str]:
-    """Files named on the command line; folders are searched for URScript files."""
+    """Files named on the command line; folders are searched for URScript files and
+    PolyScope programs."""
     return [file for file, _root in _expand_with_roots(names)]
 
 
@@ -131,17 +132,16 @@ def _expand_with_roots(names: list[str]) -> list[tuple[str, str | None]]:
     """Each file with the folder named on the command line it was found in (None for a
     file named itself): a folder named on the command line is one project."""
     from .._cli import UsageError
+    from ..polyscope.command import collect_programs, report_skipped
 
     files: list[tuple[str, str | None]] = []
     for name in names:
         if name != "-" and os.path.isdir(name):
-            found = sorted(
-                str(path) for path in Path(name).rglob("*")
-                if path.suffix in _SUFFIXES and path.is_file()
-                and not any(part.startswith(".") for part in path.parts[len(Path(name).parts):])
-            )
+            found, skipped = collect_programs(name)
+            report_skipped(skipped, "linted")
             if not found:
-                raise UsageError(f"no URScript files (*.script, *.urscript) in {name}")
+                raise UsageError(f"no URScript files (*.script, *.urscript) or PolyScope "
+                                 f"programs (*.urp) in {name}")
             files.extend((file, name) for file in found)
         else:
             files.append((name, None))

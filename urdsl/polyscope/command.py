@@ -11,19 +11,54 @@ from .compile import Compiled, CompileError, compile_program, parse_variables
 from .installation import Installation, InstallationError, find_installation, read_installation
 from .urp import Node, Program, UrpError, read_urp
 
-__all__ = ["add_commands", "compile_urp", "load", "load_all"]
+__all__ = ["add_commands", "collect_programs", "compile_urp", "load", "load_all"]
+
+SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
+
+
+def collect_programs(folder: str | Path) -> tuple[list[str], list[tuple[str, str]]]:
+    """The programs in ``folder`` and its subfolders (hidden ones left out), sorted:
+    PolyScope programs (``.urp``) and URScript files, except a ``.script`` PolyScope wrote
+    beside a ``.urp`` of the same name (the program is the ``.urp``; its ``.script`` is a
+    copy PolyScope writes on saving, often stale). Returns ``(files, skipped)``, ``skipped``
+    holding ``(script, urp)`` pairs."""
+    root = Path(folder)
+    found = sorted(
+        path for path in root.rglob("*")
+        if path.suffix.lower() in (*SCRIPT_SUFFIXES, ".urp") and path.is_file()
+        and not any(part.startswith(".") for part in path.parts[len(root.parts):]))
+    programs = {path.with_suffix("") for path in found if path.suffix.lower() == ".urp"}
+    files: list[str] = []
+    skipped: list[tuple[str, str]] = []
+    for path in found:
+        if path.suffix.lower() == ".script" and path.with_suffix("") in programs:
+            urp = next(p for p in found if p.suffix.lower() == ".urp"
+                       and p.with_suffix("") == path.with_suffix(""))
+            skipped.append((str(path), str(urp)))
+        else:
+            files.append(str(path))
+    return files, skipped
+
+
+def report_skipped(skipped: list[tuple[str, str]], verb: str) -> None:
+    """Say on standard error which ``.script`` files were left out for their ``.urp``."""
+    for script, urp in skipped:
+        print(f"note: {script} skipped: PolyScope wrote it beside {Path(urp).name}, "
+              f"which is {verb} instead", file=sys.stderr)
 
 
 def _installation_for(program: Program, path: str | Path) -> Installation | None:
-    """The installation the program names, from its folder (``NAME.installation``), else the
-    only installation there; ``None`` when there is none. A broken installation is reported on
+    """The installation the program names (``installationRelativePath``, e.g.
+    ``../default.installation``, else ``NAME.installation`` in its folder), else the only
+    installation there; ``None`` when there is none. A broken installation is reported on
     standard error and left out."""
     folder = Path(path).parent
     candidate: Path | None = None
-    if program.installation:
-        named = folder / f"{program.installation}.installation"
-        if named.is_file():
+    for name in (program.installation_path, program.installation):
+        named = folder / f"{name}.installation" if name else None
+        if named is not None and named.is_file():
             candidate = named
+            break
     if candidate is None:
         candidate = find_installation(path)
     if candidate is None:
@@ -58,7 +93,13 @@ def load_all(path: str | Path) -> tuple[Program, Installation | None, Compiled]:
             variables = parse_variables(file.read_bytes())
         except OSError:
             variables = []
-    return program, installation, compile_program(program, installation, variables)
+    folder = Path(path).parent
+
+    def files(relative: str) -> bytes | None:
+        file = folder / relative
+        return file.read_bytes() if file.is_file() else None
+
+    return program, installation, compile_program(program, installation, variables, files)
 
 
 def compile_urp(path: str, output: str | None) -> int:

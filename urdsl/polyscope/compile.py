@@ -29,8 +29,10 @@ from __future__ import annotations
 
 import gzip
 import math
+import posixpath
 import re
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from xml.etree import ElementTree
 
@@ -80,7 +82,12 @@ from .installation import Installation
 from .preamble import preamble
 from .urp import Expression, Kinematics, Node, Program
 
-__all__ = ["CompileError", "Compiled", "compile_program", "parse_variables", "waypoint_pose"]
+__all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "parse_variables",
+           "script_file_candidates", "waypoint_pose"]
+
+FileReader = Callable[[str], "bytes | None"]
+"""Reads a file by its path relative to the program's folder (``/``-separated, ``..``
+allowed); ``None`` when there is no such file."""
 
 
 class CompileError(Exception):
@@ -217,7 +224,8 @@ def _floats_or_none(text: str | None) -> tuple[float, ...] | None:
 
 def _blend_kept(move: Node, motion: Node) -> bool:
     """Whether a process move (MoveP) keeps the blend of ``motion``: not at its last motion
-    unless the next node is another MoveP, into which it can blend."""
+    unless the next node is another MoveP, into which it can blend (after the Robot
+    Program's last node comes its first one again when the program loops)."""
     if move.fields.get("motion_type") != "MoveP":
         return True
     motions = [child for child in move.children
@@ -231,8 +239,29 @@ def _blend_kept(move: Node, motion: Node) -> bool:
     index = siblings.index(move) if move in siblings else -1
     if 0 <= index < len(siblings) - 1:
         following = siblings[index + 1]
-        return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
-    return False
+    elif index >= 0 and parent.kind == "MainProgram" and \
+            parent.attrs.get("runOnlyOnce") != "true":
+        following = siblings[0]
+    else:
+        return False
+    return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
+
+
+def _no_break(item: Item) -> Item:
+    """``item`` with each ``$`` marker in it (nested blocks too) flagged ``noBreak``."""
+    from dataclasses import fields, replace
+
+    if isinstance(item, Marker):
+        return Marker(item.number, item.text, "noBreak")
+    changes: dict[str, object] = {}
+    for f in fields(item):  # type: ignore[arg-type]
+        value = getattr(item, f.name)
+        if f.name in ("body", "orelse") and isinstance(value, tuple):
+            changes[f.name] = tuple(_no_break(inner) for inner in value)
+        elif f.name == "elifs" and isinstance(value, tuple):
+            changes[f.name] = tuple(replace(e, body=tuple(_no_break(i) for i in e.body))
+                                    for e in value)
+    return replace(item, **changes) if changes else item  # type: ignore[type-var]
 
 
 def _direction_helper() -> list[Item]:
@@ -274,12 +303,37 @@ def _num(value: float) -> Expr:
 
 
 def compile_program(program: Program, installation: Installation | None = None,
-                    variables: list[tuple[str, str]] | None = None) -> Compiled:
+                    variables: list[tuple[str, str]] | None = None,
+                    files: FileReader | None = None) -> Compiled:
     """Compile ``program`` as PolyScope does, with its installation and the installation's
     variables (``NAME.variables`` beside it: (name, value as written) pairs, see
-    :func:`parse_variables`). Raises :class:`CompileError` naming the file and node for a
-    node it cannot compile."""
-    return _Compiler(program, installation, variables or []).run()
+    :func:`parse_variables`). ``files`` reads the script files the program's Script nodes
+    name (see :func:`script_file_candidates`): PolyScope compiles a script file's current
+    contents, and the copy the ``.urp`` keeps (``cachedContents``) only stands in when the
+    file is not found. Raises :class:`CompileError` naming the file and node for a node it
+    cannot compile."""
+    return _Compiler(program, installation, variables or [], files).run()
+
+
+def script_file_candidates(program: Program, file: str) -> list[str]:
+    """Where a script file a Script node names (``file``: its path on the robot, e.g.
+    ``/programs/cell/scripts/init.script``) may be, as paths relative to the program's
+    folder, most likely first: its path relative to the folder the program was saved in
+    (``directory``), then ever shorter tails of its path beside the program (a copy of the
+    robot's programs is often laid out differently: ``scripts/init.script``,
+    ``init.script``)."""
+    out: list[str] = []
+    file = file.replace("\\", "/").strip()
+    if not file:
+        return out
+    if program.directory and file.startswith("/") and program.directory.startswith("/"):
+        out.append(posixpath.relpath(file, program.directory))
+    parts = [part for part in file.split("/") if part and part not in (".", "..")]
+    for index in range(len(parts)):
+        tail = "/".join(parts[index:])
+        if tail not in out:
+            out.append(tail)
+    return out
 
 
 def parse_variables(data: bytes) -> list[tuple[str, str]]:
@@ -310,8 +364,9 @@ def parse_variables(data: bytes) -> list[tuple[str, str]]:
 
 class _Compiler:
     def __init__(self, program: Program, installation: Installation | None,
-                 variables: list[tuple[str, str]]) -> None:
+                 variables: list[tuple[str, str]], files: FileReader | None = None) -> None:
         self.program = program
+        self.files = files
         self.installation = installation
         self.variables = variables
         self.numbers: dict[int, Node] = {}
@@ -599,7 +654,35 @@ class _Compiler:
             if feature and feature not in _BASE_FEATURES:
                 target = _call("pose_trans", Name(str(feature)), target)
             return target
-        return self.fixed_values(node)[0]
+        return self.in_variable_feature(node, move, self.fixed_values(node)[0])
+
+    def variable_feature(self, move: Node) -> str | None:
+        """The name of the move's feature when it is a variable one (a program may move it):
+        named, not the base or the tool, and variable in the installation (taken as
+        variable when the installation is unknown: every feature seen in a move's feature
+        reference in real programs was)."""
+        feature = move.fields.get("feature")
+        if not feature or feature in _BASE_FEATURES or feature in _TOOL_FEATURES:
+            return None
+        known = dict(getattr(self.installation, "feature_variable", ()) or ())
+        if known.get(str(feature), True) is False:
+            return None
+        return str(feature)
+
+    def in_variable_feature(self, node: Node, move: Node, pose: Expr) -> Expr:
+        """A fixed waypoint's pose under a move in a variable feature, as PolyScope writes
+        it: ``pose_trans(F, pose_trans(p[inverse of the feature's pose when taught], W_p))``,
+        so that the waypoint follows the feature (``BaseToFeature``: the feature's pose in
+        the base frame when the waypoint was taught; m, rad)."""
+        feature = self.variable_feature(move)
+        taught = node.fields.get("base_to_feature")
+        if feature is None or not taught or len(taught) != 6:
+            return pose
+        rotation = _rotvec_to_matrix(taught[3:])
+        inverse = tuple(-(rotation.T @ np.asarray(taught[:3], dtype=float))) + \
+            tuple(_matrix_to_rotvec(rotation.T))
+        return _call("pose_trans", Name(feature),
+                     _call("pose_trans", Pose(tuple(_num(float(v)) for v in inverse)), pose))
 
     def fixed_values(self, node: Node) -> tuple[Expr, Expr]:
         """The pose and joints of a fixed waypoint: its globals (PolyScope 5), or literals
@@ -706,11 +789,26 @@ class _Compiler:
                     *self.code(self.script_of(expression, node), node)]
         contents = str(node.fields.get("contents", ""))
         if kind == "File":
-            file = str(node.fields.get("file", "")).rsplit("/", 1)[-1]
-            label = f"Script: {file}"
+            path = str(node.fields.get("file", ""))
+            contents = self.script_file(path) or contents
+            label = f"Script: {path.rsplit('/', 1)[-1]}"
         else:
             label = "Script"
         return [self.marker(node, label), *self.code(contents, node)]
+
+    def script_file(self, path: str) -> str | None:
+        """The current contents of the script file at ``path`` (on the robot), when the
+        file reader finds it."""
+        if self.files is None:
+            return None
+        for candidate in script_file_candidates(self.program, path):
+            try:
+                data = self.files(candidate)
+            except OSError:
+                data = None
+            if data is not None:
+                return data.decode("utf-8", "replace")
+        return None
 
     def n_Popup(self, node: Node) -> list[Item]:
         kind = str(node.fields.get("type", "Message"))
@@ -883,26 +981,45 @@ class _Compiler:
             Assign(Name(flag), Number(0)),
             Assign(Name(handle), Run(thread)),
         ]
+        items.append(self.until_loop(untils, flag, handle, accel))
+        others = [child for child in node.children if child.kind != "Until"]
+        items.extend(self.block(others))
+        return items
+
+    def until_loop(self, untils: list[Node], flag: str, handle: str,
+                   accel: float | None) -> While:
+        """The loop that waits, while a move thread runs, for the first of its Until
+        conditions: tool contact (checked first, whatever the order), a condition (an
+        expression: the move stops at the Until's ``deceleration``, m/s², else the move's
+        acceleration; the form is inferred, not yet seen in a PolyScope script [U]), and the
+        end of the move (distance, reached waypoint), in the node order."""
         loop: list[Item] = []
-        # PolyScope checks tool contact before the other conditions, whatever their order
-        for until in sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION"):
+        ordered = sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION")
+        for until in ordered:
             kind = until.attrs.get("type", "")
+            label = f"Until ({kind.lower()})"
             if kind == "TOOL_CONTACT_DETECTION":
                 loop.extend(self._tool_contact(until, handle, accel))
                 continue
+            expression = until.fields.get("expression")
+            if isinstance(expression, Expression) and expression:
+                decel = _floats_or_none(until.attrs.get("deceleration"))
+                stop = decel[0] if decel else (accel if accel is not None else 1.2)
+                test = self.expr(self.script_of(expression, until), until)
+                loop.append(If(Paren(test), (
+                    Kill(Name(handle)), _stmt("stopl", _num(stop)),
+                    self.marker(until, label), *self.block(until.children), Break())))
+                continue
             done: list[Item] = [Join(Name(handle))]
-            if kind != "DISTANCE":
-                done.append(Comment(f" urdsl: Until ({kind.lower()}) is not compiled"))
-            done.append(self.marker(until, f"Until ({kind.lower()})"))
+            if kind not in ("DISTANCE", "REACHED_WAYPOINT"):
+                done.append(Comment(f" urdsl: {label} is not compiled"))
+            done.append(self.marker(until, label))
             done.extend(self.block(until.children))
             done.append(Break())
             loop.append(_stmt("sleep", _num(1e-10)))
             loop.append(If(Paren(BinOp(">", Name(flag), Number(1))), tuple(done)))
         loop.append(_stmt("sync"))
-        items.append(While(Paren(Bool(True)), tuple(loop)))
-        others = [child for child in node.children if child.kind != "Until"]
-        items.extend(self.block(others))
-        return items
+        return While(Paren(Bool(True)), tuple(loop))
 
     def _tool_contact(self, until: Node, handle: str, accel: float | None) -> list[Item]:
         """The wait of a Direction that stops on tool contact: back off along the way it
@@ -979,12 +1096,10 @@ class _Compiler:
             frame = Name(str(feature))
         kind = {"Point": 1, "Motion": 3}.get(str(node.fields.get("type")), 2)
         limits = [speeds[i] if selection[i] else deviations[i] for i in range(6)]
-        body = self.block(node.children)
-        for index in range(len(body) - 1, -1, -1):
-            item = body[index]
-            if isinstance(item, Marker):
-                body[index] = Marker(item.number, item.text, "noBreak")
-                break
+        if all(child.kind == "Placeholder" or child.suppressed for child in node.children):
+            return []  # PolyScope writes nothing for a Force node with an empty body
+        # in force mode the program may not stop at a node: every marker inside is noBreak
+        body = [_no_break(item) for item in self.block(node.children)]
         return [self.marker(node, "Force"), _stmt("sleep", _num(0.02)), _stmt("zero_ftsensor"),
                 _stmt("force_mode", frame, List(tuple(Number(int(v)) for v in selection)),
                       List(tuple(_num(v) for v in wrench)), Number(kind),
@@ -1020,6 +1135,7 @@ class _Compiler:
         elif kind == "Fixed":
             label = name
             pose_expr, q_expr = self.fixed_values(node)
+            pose_expr = self.in_variable_feature(node, move, pose_expr)
             if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
                 target = q_expr
             elif motion == "MoveJ":
@@ -1034,9 +1150,25 @@ class _Compiler:
             return [self.marker(node, name, "breakAfter")]
         keywords = self.motion_keywords(move, node)
         function = {"MoveJ": "movej", "MoveL": "movel", "MoveP": "movep"}.get(motion, "movel")
+        motion_call = ExprStmt(Call(Name(function), (target,),
+                                    tuple(Keyword(k, v) for k, v in keywords)))
+        untils = [child for child in node.children
+                  if child.kind == "Until" and not child.suppressed]
+        if not untils:
+            return [self.marker(node, label, "breakAfter"), motion_call]
+        # a waypoint with Until conditions: the move runs in a thread the conditions end
+        number = self.number(node)
+        flag, thread, handle = (f"move_thread_flag_{number}", f"move_thread_{number}",
+                                f"move_thread_han_{number}")
+        accel = dict(keywords).get("a")
         return [self.marker(node, label, "breakAfter"),
-                ExprStmt(Call(Name(function), (target,),
-                              tuple(Keyword(k, v) for k, v in keywords)))]
+                Declare("global", flag, Number(0)),
+                ThreadDef(thread, (EnterCritical(), Assign(Name(flag), Number(1)), motion_call,
+                                   Assign(Name(flag), Number(2)), ExitCritical())),
+                Assign(Name(flag), Number(0)),
+                Assign(Name(handle), Run(thread)),
+                self.until_loop(untils, flag, handle,
+                                accel.value if isinstance(accel, Number) else None)]
 
     def motion_keywords(self, move: Node, waypoint: Node) -> list[tuple[str, Expr]]:
         params = waypoint.fields.get("params") or {}

@@ -227,6 +227,9 @@ class Installation:
     """The URCaps contributing an installation node, in file order: (name, vendor, node
     title). UR's own conveyor tracking, EtherNet/IP, PROFINET and screwdriving nodes are
     left out: they write nothing before the program."""
+    feature_variable: tuple[tuple[str, bool], ...] = ()
+    """Every named feature (point, line, plane) and whether it is variable (a program may
+    move it; PolyScope writes waypoints taught in it relative to it)."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -342,7 +345,18 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
         version = ".".join(element.get(k, "0") for k in ("major", "minor", "bugfix"))
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
                         mounting, version, _settings(root), _features(root, path),
-                        _io_names(root), _safety(root), _modbus(root, path), _urcaps(root))
+                        _io_names(root), _safety(root), _modbus(root, path), _urcaps(root),
+                        _feature_variable(root))
+
+
+def _feature_variable(root: ElementTree.Element) -> tuple[tuple[str, bool], ...]:
+    block = root.find("Features")
+    if block is None:
+        return ()
+    return tuple((element.get("name", ""), element.get("isVariable") == "true")
+                 for element in block.iter() if element.get("name")
+                 and element.get("isVariable") is not None
+                 and element.get("hiddenSubFeature") != "true")
 
 
 def _safety(root: ElementTree.Element) -> Safety | None:

@@ -166,6 +166,12 @@ class Program:
     others: list[Node] = field(default_factory=list)
     top: list[Node] = field(default_factory=list)
     """Every top-level node in the order the file lists them (PolyScope numbers them so)."""
+    installation_path: str | None = None
+    """The installation's path relative to the program's folder, without ``.installation``
+    (``installationRelativePath``: ``../default`` for one in the parent folder)."""
+    directory: str | None = None
+    """The folder the program was saved in on the robot (``directory``: ``/programs/LE``);
+    script files the program names are found relative to it."""
 
     @property
     def major_version(self) -> int | None:
@@ -323,7 +329,8 @@ class _Reader:
         return Program(self.path, root.get("name", Path(self.path).stem),
                        root.get("installation"), root.get("createdIn"),
                        root.get("lastSavedIn"), kinematics, main, before, init, threads, subs,
-                       others, top)
+                       others, top, root.get("installationRelativePath") or None,
+                       root.get("directory") or None)
 
     def node(self, element: ElementTree.Element, parent: Node | None) -> Node:
         element = self.resolve(element)

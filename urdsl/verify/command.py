@@ -153,7 +153,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
     reports = []
     failed = False
-    for name in args.files:
+    for name in _expand_folders(args.files):
         if name.endswith(".py"):
             try:
                 report = _check_program(name, options)
@@ -182,6 +182,28 @@ def cmd_check(args: argparse.Namespace) -> int:
         reports[0].plot(args.plot)
         print(f"plot written to {args.plot}", file=sys.stderr)
     return EXIT_PROBLEMS if failed or any(r.has_errors for r in reports) else EXIT_OK
+
+
+def _expand_folders(names: list[str]) -> list[str]:
+    """The files named, a folder standing for its programs (``.urp`` and URScript files; a
+    ``.script`` PolyScope wrote beside a ``.urp`` is left out, with a note)."""
+    import os
+
+    from .._cli import UsageError
+    from ..polyscope.command import collect_programs, report_skipped
+
+    files: list[str] = []
+    for name in names:
+        if name != "-" and os.path.isdir(name):
+            found, skipped = collect_programs(name)
+            report_skipped(skipped, "checked")
+            if not found:
+                raise UsageError(f"no URScript files (*.script, *.urscript) or PolyScope "
+                                 f"programs (*.urp) in {name}")
+            files.extend(found)
+        else:
+            files.append(name)
+    return files
 
 
 def _check_script(source, args: argparse.Namespace, options):
