@@ -362,7 +362,8 @@ def main(argv: list[str] | None = None) -> int:
                                       "not_polyscope": 0, "exact_written": 0, "pre_total": 0,
                                       "pre_found": 0, "pre_extra": 0, "with": 0,
                                       "exact_with": 0, "no_installation": collections.Counter(),
-                                      "pre_kinds": collections.Counter()})
+                                      "pre_kinds": collections.Counter(), "projects": {}})
+        project = st["projects"].setdefault(repo, [0, 0, 0])  # programs, exact part, whole
         gitdir = git_dir(args.repos, repo)
         urp = git_show(gitdir, commit, urp_path)
         script = git_show(gitdir, commit, script_path)
@@ -440,6 +441,9 @@ def main(argv: list[str] | None = None) -> int:
         st["exact"] += exact
         st["exact_written"] += ours == theirs
         st["exact_prog"] += ours_prog == theirs_prog
+        project[0] += 1
+        project[1] += ours_prog == theirs_prog
+        project[2] += exact
         if not absent:
             st["exact_with"] += exact
         if ours_prog != theirs_prog:
@@ -486,6 +490,14 @@ def main(argv: list[str] | None = None) -> int:
                                                  st["errors"].most_common(5)))
         print("  node types in differing lines: " + ", ".join(
             f"{k} {v}" for k, v in st["kinds"].most_common(8)))
+        # one project with many programs can carry a split: its share per project, and the
+        # mean over projects
+        projects = {k: v for k, v in st["projects"].items() if v[0]}
+        print("  per project (exact program part / whole, of programs): " + "; ".join(
+            f"{k} {v[1]}/{v[2]} of {v[0]}" for k, v in sorted(projects.items())))
+        if projects:
+            mean = sum(v[1] / v[0] for v in projects.values()) / len(projects)
+            print(f"  mean over the {len(projects)} projects: program part exact {mean:.1%}")
     return 0
 
 
