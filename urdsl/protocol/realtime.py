@@ -202,9 +202,24 @@ class RealtimeLayout:
             "    if n != i:\n"
             "        raise int_error(layout, f)\n"
             f"    return new(State, ({', '.join(items)}))\n")
+        # the encoder: every field of the table by name, vectors spread, in one pack call;
+        # None (some value is missing, of the wrong type or length) leaves the diagnosis to
+        # encode_realtime's field-by-field path
+        vectors = [item.name for item in self.table if item.count > 1]
+        lengths = tuple(item.count for item in self.table if item.count > 1)
+        spread = ", ".join(f"*s.{item.name}" if item.count > 1 else f"s.{item.name}"
+                           for item in self.table)
+        source += (
+            "\ndef write(s):\n"
+            f"    if ({', '.join(f'len(s.{name})' for name in vectors)},) != {lengths}:\n"
+            "        return None\n"
+            "    tail = s.tail\n"
+            f"    return pack({self.size} + len(tail), {spread}) + tail\n")
+        namespace["pack"] = struct.Struct(f">i{self.doubles}d").pack
         exec(source, namespace)  # noqa: S102 - generated from the layout table above
         self._read = namespace["read"]
-        self._read_source = source
+        self._write = namespace["write"]
+        self._source = source
 
     def slot(self, name: str) -> slice:
         """Where field ``name`` sits in the packet's array of doubles (after the size field);
@@ -472,6 +487,12 @@ def encode_realtime(state: RealtimeState, version: str | None = None) -> bytes:
     counted in the size field.
     """
     layout = layout_for_version(version or state.version)
+    try:
+        data = layout._write(state)
+    except (TypeError, OverflowError, struct.error):
+        data = None
+    if data is not None and len(data) <= MAX_SIZE:
+        return data
     values: list[float] = []
     for item in layout.table:
         value = getattr(state, item.name)

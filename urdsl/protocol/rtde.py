@@ -39,6 +39,7 @@ import struct
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from typing import ClassVar, NamedTuple
 
 from ._binary import read_text, text_bytes
@@ -125,6 +126,7 @@ class Recipe:
     _plan: tuple[tuple[str, int, int], ...] = field(default=(), init=False, repr=False,
                                                     compare=False)
     _readers: tuple | None = field(default=None, init=False, repr=False, compare=False)
+    _packers: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if len(self.names) != len(self.types):
@@ -147,6 +149,11 @@ class Recipe:
         # indexed by "has a recipe id" (False: a v1 output package)
         object.__setattr__(self, "_readers", (_reader(plan, body, False),
                                               _reader(plan, body, True)))
+        # whole data packages from the values (recipe id first when there is one): the
+        # header's size and type are constants of the recipe
+        object.__setattr__(self, "_packers", tuple(
+            partial(whole.pack, whole.size, DataPackage.CODE)
+            for whole in (struct.Struct(">HB" + body), struct.Struct(">HBB" + body))))
 
     @property
     def not_found(self) -> tuple[str, ...]:
@@ -966,14 +973,14 @@ class RtdeServer:
         flattened (the simulator's fast path: no dict, no dataclass). Raises
         :class:`ProtocolError` without a usable output recipe or for values that do not fit."""
         recipe = self.output_recipe
-        if recipe is None or recipe._struct is None:
+        if recipe is None or recipe._packers is None:
             raise _error("no usable output recipe")
         try:
-            body = recipe._struct.pack(*values)
+            if recipe.id is None:  # a v1 output package carries no recipe id
+                return recipe._packers[0](*values)
+            return recipe._packers[1](recipe.id, *values)
         except struct.error as exc:
             raise _error(f"data package for recipe {recipe.id}: {exc}") from None
-        head = b"" if recipe.id is None else bytes((recipe.id,))
-        return _HEADER.pack(_HEADER.size + len(head) + len(body), DataPackage.CODE) + head + body
 
     def outputs(self, values: Mapping[str, object], cycle: int) -> bytes | None:
         """The output data package for control cycle ``cycle`` (counting from 0), or
