@@ -325,7 +325,8 @@ class RealtimeState(NamedTuple):
 
     Immutable and tuple-backed (a named tuple): a decoder builds it in one step, and reading
     a field is an index into the tuple. The tuple's order is ``version``, ``size``, the
-    measured values, the integer fields, ``tail``; use the names.
+    measured values, the integer fields, ``tail``; use the names. Equal only to another
+    :class:`RealtimeState` with the same fields.
     """
 
     version: str = "5.10"
@@ -376,6 +377,14 @@ class RealtimeState(NamedTuple):
     program_state: int | None = None
     safety_status: int | None = None
     tail: bytes = b""
+
+    def __eq__(self, other: object) -> bool:
+        return type(other) is RealtimeState and tuple.__eq__(self, other)
+
+    def __ne__(self, other: object) -> bool:
+        return not self.__eq__(other)
+
+    __hash__ = tuple.__hash__
 
     @property
     def tcp_pose(self) -> Vector | None:

@@ -343,14 +343,10 @@ class DataPackage(_DataPackageFields):
         return tuple.__new__(cls, (recipe_id, {} if values is None else values))
 
     def __eq__(self, other: object) -> bool:
-        if type(other) is not DataPackage:
-            return NotImplemented
-        return tuple.__eq__(self, other)
+        return type(other) is DataPackage and tuple.__eq__(self, other)
 
     def __ne__(self, other: object) -> bool:
-        if type(other) is not DataPackage:
-            return NotImplemented
-        return tuple.__ne__(self, other)
+        return not self.__eq__(other)
 
     def __hash__(self) -> int:
         return hash((self.recipe_id,))  # the values (a dict) are not hashed
