@@ -513,10 +513,13 @@ def decode_rtde(package: bytes, *, sender: str, protocol: int = 2,
         with_id = True
     else:
         raise ValueError(f"sender must be 'client' or 'server', not {sender!r}")
-    if recipes and len(package) > 3:  # a data package of a known recipe: the fast path
-        recipe = recipes.get(package[3] if with_id else None)
-        if recipe is not None and recipe._readers is not None:
-            message = recipe._readers[with_id](package)
+    if recipes:  # a data package of a known recipe: the fast path
+        try:
+            read = recipes[package[3] if with_id else None]._readers[with_id]  # type: ignore
+        except (KeyError, IndexError, TypeError):  # no such recipe, too short, unusable
+            read = None
+        if read is not None:
+            message = read(package)
             if message is not None:
                 return message
     if len(package) < _HEADER.size:
