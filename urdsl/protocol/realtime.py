@@ -107,6 +107,108 @@ _V5_10 = _V3_10 + (
 )
 
 
+Vector = tuple[float, ...]
+
+
+class RealtimeState(NamedTuple):
+    """One realtime packet, every field by name (SI units: rad, rad/s, m, N, A, V, °C, s).
+
+    Fields a version does not send are ``None``. Modes and bit masks are ``int``; vectors are
+    tuples (joint vectors base … wrist 3; poses x, y, z, rx, ry, rz in the Base frame).
+    ``version`` names the layout (or the version the decoder was told); ``size`` is the
+    packet's size field; ``tail`` holds the bytes after the known layout, undecoded.
+
+    Immutable and tuple-backed (a named tuple): a decoder builds it in one step, and reading
+    a field is an index into the tuple. The tuple's order is ``version``, ``size``, the
+    measured values, the integer fields, ``tail``; use the names. Equal only to another
+    :class:`RealtimeState` with the same fields.
+    """
+
+    version: str = "5.10"
+    size: int = 0
+    # the measured values (doubles), in packet order
+    time: float | None = None
+    q_target: Vector | None = None
+    qd_target: Vector | None = None
+    qdd_target: Vector | None = None
+    i_target: Vector | None = None
+    m_target: Vector | None = None
+    q_actual: Vector | None = None
+    qd_actual: Vector | None = None
+    i_actual: Vector | None = None
+    i_control: Vector | None = None
+    tool_vector_actual: Vector | None = None
+    tcp_speed_actual: Vector | None = None
+    tcp_force: Vector | None = None
+    tool_vector_target: Vector | None = None
+    tcp_speed_target: Vector | None = None
+    motor_temperatures: Vector | None = None
+    controller_timer: float | None = None
+    test_value: float | None = None
+    reserved_820: Vector | None = None
+    tool_accelerometer_values: Vector | None = None
+    reserved_892: Vector | None = None
+    speed_scaling: float | None = None
+    linear_momentum_norm: float | None = None
+    reserved_956: float | None = None
+    reserved_964: float | None = None
+    v_main: float | None = None
+    v_robot: float | None = None
+    i_robot: float | None = None
+    v_actual: Vector | None = None
+    elbow_position: Vector | None = None
+    elbow_velocity: Vector | None = None
+    reserved_1116: Vector | None = None
+    payload_mass: float | None = None
+    payload_cog: Vector | None = None
+    payload_inertia: Vector | None = None
+    reserved_420: Vector | None = None
+    # the integers the controller sends as doubles (modes, bit masks), in packet order
+    digital_input_bits: int | None = None
+    robot_mode: int | None = None
+    joint_modes: tuple[int, ...] | None = None
+    safety_mode: int | None = None
+    digital_outputs: int | None = None
+    program_state: int | None = None
+    safety_status: int | None = None
+    tail: bytes = b""
+
+    def __eq__(self, other: object) -> bool:
+        return type(other) is RealtimeState and tuple.__eq__(self, other)
+
+    def __ne__(self, other: object) -> bool:
+        return not self.__eq__(other)
+
+    __hash__ = tuple.__hash__
+
+    @property
+    def tcp_pose(self) -> Vector | None:
+        """The actual TCP pose (x, y, z, rx, ry, rz) [m, rad] in the Base frame."""
+        return self.tool_vector_actual
+
+    @property
+    def layout(self) -> RealtimeLayout:
+        """The layout of this packet's known fields."""
+        return LAYOUTS[self.version] if self.version in LAYOUTS else \
+            layout_for_version(self.version)
+
+
+def _int_error(layout: RealtimeLayout, values: tuple[float, ...]) -> ProtocolError:
+    """The error for the first integer field of ``values`` that holds no integer."""
+    for name, begin, end in layout._ints:
+        for index in range(begin, end):
+            value = values[index]
+            if value != value or value in (_INF, -_INF) or int(value) != value:
+                offset = _HEADER.size + 8 * index
+                return ProtocolError(f"field {name} at offset {offset} should hold an "
+                                     f"integer, got {value!r}", interface="realtime",
+                                     offset=offset)
+    raise AssertionError("no bad integer field")  # pragma: no cover
+
+
+_INF = float("inf")
+
+
 class RealtimeLayout:
     """A packet layout: its table, total size in bytes and the offset of every field."""
 
@@ -131,6 +233,7 @@ class RealtimeLayout:
         self._ints = tuple(span for span, item in zip(spans, table, strict=True)
                            if item.kind == "int")
         self.names = tuple(f.name for f in table)
+        self._compile()
 
     def _compile(self) -> None:
         """Build ``_read``, this layout's decoder: one ``unpack_from`` of all doubles, one
@@ -266,6 +369,12 @@ rejected at once instead of making the decoder wait for megabytes that never com
 """
 
 
+for _layout in LAYOUTS.values():  # every table row must be a field of RealtimeState
+    assert set(_layout.names) <= set(RealtimeState._fields), \
+        set(_layout.names) - set(RealtimeState._fields)
+del _layout
+
+
 def layout_for_size(size: int) -> RealtimeLayout:
     """The layout for a packet of ``size`` bytes: exact match, else the longest that fits."""
     layout = SIZES.get(size)
@@ -310,114 +419,6 @@ def layout_for_version(version: str) -> RealtimeLayout:
         return LAYOUTS["5.10"]
     raise ProtocolError(f"no known realtime layout for controller version {version!r} "
                         "(known: 1.6–1.8, 3.x, 5.x)", interface="realtime")
-
-
-Vector = tuple[float, ...]
-
-
-class RealtimeState(NamedTuple):
-    """One realtime packet, every field by name (SI units: rad, rad/s, m, N, A, V, °C, s).
-
-    Fields a version does not send are ``None``. Modes and bit masks are ``int``; vectors are
-    tuples (joint vectors base … wrist 3; poses x, y, z, rx, ry, rz in the Base frame).
-    ``version`` names the layout (or the version the decoder was told); ``size`` is the
-    packet's size field; ``tail`` holds the bytes after the known layout, undecoded.
-
-    Immutable and tuple-backed (a named tuple): a decoder builds it in one step, and reading
-    a field is an index into the tuple. The tuple's order is ``version``, ``size``, the
-    measured values, the integer fields, ``tail``; use the names. Equal only to another
-    :class:`RealtimeState` with the same fields.
-    """
-
-    version: str = "5.10"
-    size: int = 0
-    # the measured values (doubles), in packet order
-    time: float | None = None
-    q_target: Vector | None = None
-    qd_target: Vector | None = None
-    qdd_target: Vector | None = None
-    i_target: Vector | None = None
-    m_target: Vector | None = None
-    q_actual: Vector | None = None
-    qd_actual: Vector | None = None
-    i_actual: Vector | None = None
-    i_control: Vector | None = None
-    tool_vector_actual: Vector | None = None
-    tcp_speed_actual: Vector | None = None
-    tcp_force: Vector | None = None
-    tool_vector_target: Vector | None = None
-    tcp_speed_target: Vector | None = None
-    motor_temperatures: Vector | None = None
-    controller_timer: float | None = None
-    test_value: float | None = None
-    reserved_820: Vector | None = None
-    tool_accelerometer_values: Vector | None = None
-    reserved_892: Vector | None = None
-    speed_scaling: float | None = None
-    linear_momentum_norm: float | None = None
-    reserved_956: float | None = None
-    reserved_964: float | None = None
-    v_main: float | None = None
-    v_robot: float | None = None
-    i_robot: float | None = None
-    v_actual: Vector | None = None
-    elbow_position: Vector | None = None
-    elbow_velocity: Vector | None = None
-    reserved_1116: Vector | None = None
-    payload_mass: float | None = None
-    payload_cog: Vector | None = None
-    payload_inertia: Vector | None = None
-    reserved_420: Vector | None = None
-    # the integers the controller sends as doubles (modes, bit masks), in packet order
-    digital_input_bits: int | None = None
-    robot_mode: int | None = None
-    joint_modes: tuple[int, ...] | None = None
-    safety_mode: int | None = None
-    digital_outputs: int | None = None
-    program_state: int | None = None
-    safety_status: int | None = None
-    tail: bytes = b""
-
-    def __eq__(self, other: object) -> bool:
-        return type(other) is RealtimeState and tuple.__eq__(self, other)
-
-    def __ne__(self, other: object) -> bool:
-        return not self.__eq__(other)
-
-    __hash__ = tuple.__hash__
-
-    @property
-    def tcp_pose(self) -> Vector | None:
-        """The actual TCP pose (x, y, z, rx, ry, rz) [m, rad] in the Base frame."""
-        return self.tool_vector_actual
-
-    @property
-    def layout(self) -> RealtimeLayout:
-        """The layout of this packet's known fields."""
-        return LAYOUTS[self.version] if self.version in LAYOUTS else \
-            layout_for_version(self.version)
-
-
-def _int_error(layout: RealtimeLayout, values: tuple[float, ...]) -> ProtocolError:
-    """The error for the first integer field of ``values`` that holds no integer."""
-    for name, begin, end in layout._ints:
-        for index in range(begin, end):
-            value = values[index]
-            if value != value or value in (_INF, -_INF) or int(value) != value:
-                offset = _HEADER.size + 8 * index
-                return ProtocolError(f"field {name} at offset {offset} should hold an "
-                                     f"integer, got {value!r}", interface="realtime",
-                                     offset=offset)
-    raise AssertionError("no bad integer field")  # pragma: no cover
-
-
-_INF = float("inf")
-
-_STATE_FIELDS = RealtimeState._fields
-for _layout in LAYOUTS.values():  # every table row must be a field of RealtimeState
-    assert set(_layout.names) <= set(_STATE_FIELDS), set(_layout.names) - set(_STATE_FIELDS)
-    _layout._compile()
-del _layout
 
 
 def _decode_at(data: bytes | bytearray | memoryview, start: int, size: int,
