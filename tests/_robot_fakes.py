@@ -142,7 +142,8 @@ class FakeController:
     of ``("run", ticks)`` (program running for that many state ticks), ``("text", s)``,
     ``("exception", line, column, text)``, ``("safety", mode)``. ``programs`` collects the
     programs received, cut from the stream by the virtual controller's
-    :class:`~urdsl.sim.framing.ScriptFramer`. States go out every ``period`` s (the real controller: 0.1 s).
+    :class:`~urdsl.sim.framing.ScriptFramer`. States go out every ``period`` s (the real
+    controller: 0.1 s).
     """
 
     def __init__(self, behaviour, period: float = 0.02, lifetime: float = 10.0) -> None:
