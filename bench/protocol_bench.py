@@ -40,7 +40,7 @@ from urdsl.protocol.primary import (
     ToolData,
     decode_primary,
 )
-from urdsl.protocol.realtime import RealtimeDecoder, encode_realtime, realtime_state
+from urdsl.protocol.realtime import LAYOUTS, RealtimeDecoder, encode_realtime, realtime_state
 from urdsl.protocol.rtde import DataPackage, Recipe, decode_rtde, encode_rtde
 
 Q = (0.1, -1.2, 1.3, -1.7, -1.5, 0.4)
@@ -149,7 +149,10 @@ def main() -> int:
     # --- realtime ---
     packet = realtime_packet()
     decoder = RealtimeDecoder()
-    assert decoder.feed(packet)[0].q_actual == Q
+    state = decoder.feed(packet)[0]
+    assert state.q_actual == Q
+    # decoded eagerly: the state holds every field of the layout as a value (no lazy views)
+    assert all(getattr(state, name) is not None for name in LAYOUTS["5.10"].names)
     plain_struct = struct.Struct(">i")
     six = struct.Struct(">6d")
 
