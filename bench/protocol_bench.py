@@ -14,6 +14,12 @@ Side by side in one run, on the same bytes, no network:
   into a dict of name → value (what UR's ``rtde/serialize.py`` does, written out here because
   that library is not on PyPI).
 
+The candidates of a row group are timed in turns (best of ``--repeat``), so that other load
+on the machine hits them alike. python-urx's realtime parser is shown as installed and, on a
+second line, with ``notify_all`` for its deprecated ``notifyAll`` (which warns, ignored but
+paid for, on every packet under Python 3.10+). urdsl's results are complete values (every
+field decoded, nothing lazy).
+
 Prints µs per packet, packets/s and ratios (> 1: urdsl is faster), plus the CPU share a
 500 Hz recorder would use for decoding. Run: ``.venv/bin/python bench/protocol_bench.py``.
 Not part of the test run.
