@@ -25,8 +25,10 @@ A name the controller does not know comes back with the type ``NOT_FOUND``; an i
 another client already controls comes back as ``IN_USE``. Either makes the recipe unusable:
 an output recipe with a NOT_FOUND name streams nothing at all.
 
-This module has the packages as frozen dataclasses (requests, replies, :class:`DataPackage`,
-:class:`RtdeTextMessage`), :class:`Recipe` (encode/decode data by recipe), and two state
+This module has the packages as immutable values (requests, replies and
+:class:`RtdeTextMessage` frozen dataclasses; :class:`DataPackage`, the streamed one, a named
+tuple), :class:`Recipe` (encode/decode data by recipe, each with its own generated reader and
+packer), and two state
 machines without sockets: :class:`RtdeClient` (what to send, what replies mean) and
 :class:`RtdeServer` (the virtual controller: parse requests, produce replies, track
 recipes, refuse inputs another client owns via a shared :class:`InputOwnership`).
