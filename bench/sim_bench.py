@@ -20,13 +20,14 @@ import multiprocessing
 import os
 import shutil
 import socket
-import struct
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+
+from urdsl.protocol.rtde import DataPackage, RtdeClient
 
 OFFSET = int(os.environ.get("SIM_BENCH_OFFSET", "3100"))
 PROGRAM = """def bench():
@@ -50,44 +51,37 @@ def _cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
-def _recv(sock: socket.socket, count: int) -> bytes:
-    data = b""
-    while len(data) < count:
-        chunk = sock.recv(count - len(data))
-        if not chunk:
+def _exchange(sock: socket.socket, client: RtdeClient, request: bytes) -> list:
+    """Send one request of the protocol's RTDE client; the events until its reply."""
+    sock.sendall(request)
+    events: list = []
+    while client.awaiting:
+        data = sock.recv(65536)
+        if not data:
             raise ConnectionError("closed")
-        data += chunk
-    return data
-
-
-def _package(sock: socket.socket) -> tuple[int, bytes]:
-    size, kind = struct.unpack(">HB", _recv(sock, 3))
-    return kind, _recv(sock, size - 3)
-
-
-def _ask(sock: socket.socket, kind: str, payload: bytes = b"") -> bytes:
-    sock.sendall(struct.pack(">HB", len(payload) + 3, ord(kind)) + payload)
-    while True:
-        got, data = _package(sock)
-        if got == ord(kind):
-            return data
+        events += client.receive_data(data)
+    return events
 
 
 def record(port: int, seconds: float, out) -> None:
-    """One recording client (its own process): arrival times (s, perf_counter) and
-    controller timestamps, put on the queue ``out``."""
+    """One recording client (its own process), on :class:`urdsl.protocol.rtde.RtdeClient`:
+    arrival times (s, perf_counter) and controller timestamps, put on the queue ``out``."""
     sock = socket.create_connection(("127.0.0.1", port), timeout=5)
-    _ask(sock, "V", struct.pack(">H", 2))
-    recipe = _ask(sock, "O", struct.pack(">d", 500.0) + b"timestamp,actual_q")[0]
-    _ask(sock, "S")
-    layout = struct.Struct(">Bd6d")
+    client = RtdeClient()
+    _exchange(sock, client, client.request_protocol_version(2))
+    _exchange(sock, client, client.setup_outputs(["timestamp", "actual_q"], 500.0))
+    _exchange(sock, client, client.start())
     arrivals, stamps = [], []
     end = time.perf_counter() + seconds
     while time.perf_counter() < end:
-        kind, data = _package(sock)
-        if kind == ord("U") and data[0] == recipe:
-            arrivals.append(time.perf_counter())
-            stamps.append(layout.unpack(data)[1])
+        data = sock.recv(65536)
+        if not data:
+            break
+        now = time.perf_counter()
+        for event in client.receive_data(data):
+            if isinstance(event, DataPackage):
+                arrivals.append(now)
+                stamps.append(event.values["timestamp"])
     sock.close()
     out.put({"arrivals": np.array(arrivals), "stamps": np.array(stamps)})
 

@@ -16,6 +16,7 @@ import time
 from collections.abc import Callable
 
 from urdsl.protocol import primary as p
+from urdsl.sim.framing import ScriptFramer
 
 LOOPBACK = "127.0.0.1"
 IO_TIMEOUT = 10.0  # s: no fake server socket blocks longer than this
@@ -140,7 +141,9 @@ class FakeController:
     ``behaviour(program_text)`` returns the events that running the program causes, each one
     of ``("run", ticks)`` (program running for that many state ticks), ``("text", s)``,
     ``("exception", line, column, text)``, ``("safety", mode)``. ``programs`` collects the
-    texts received. States go out every ``period`` s (the real controller: 0.1 s).
+    programs received, cut from the stream by the virtual controller's
+    :class:`~urdsl.sim.framing.ScriptFramer`. States go out every ``period`` s (the real
+    controller: 0.1 s).
     """
 
     def __init__(self, behaviour, period: float = 0.02, lifetime: float = 10.0) -> None:
@@ -150,17 +153,17 @@ class FakeController:
         self.programs: list[str] = []
         self.inbox: queue.Queue[str] = queue.Queue()
 
-    def _take_program(self, buffer: bytearray) -> None:
-        text = buffer.decode("utf-8", "replace")
-        if text.endswith("end\n"):
-            self.programs.append(text)
-            self.inbox.put(text)
-            buffer.clear()
+    def _take_programs(self, framer: ScriptFramer, data: bytes) -> None:
+        """Programs completed by ``data``, cut as the virtual controller cuts them (a
+        ``def``/``sec`` block up to its ``end``; bare lines run as they come)."""
+        for chunk in framer.feed(data):
+            self.programs.append(chunk.text)
+            self.inbox.put(chunk.text)
 
     def primary(self, sock, index) -> None:
         """Serve the primary interface (also takes scripts, as 30001 does)."""
         sock.sendall(version_message())
-        buffer = bytearray()
+        framer = ScriptFramer()
         events: list = []
         running_ticks = 0
         safety_mode = 1
@@ -174,8 +177,7 @@ class FakeController:
                 data = sock.recv(65536)
                 if not data:
                     return
-                buffer += data
-                self._take_program(buffer)
+                self._take_programs(framer, data)
             if time.monotonic() < next_tick:
                 continue
             next_tick += self.period
@@ -206,7 +208,7 @@ class FakeController:
     def script_port(self, sock, index) -> None:
         """Serve a secondary-like port: state now and then, takes scripts, no messages."""
         sock.sendall(version_message() + robot_state(False))
-        buffer = bytearray()
+        framer = ScriptFramer()
         end = time.monotonic() + self.lifetime
         while time.monotonic() < end:
             ready, _, _ = select.select([sock], [], [], 0.05)
@@ -214,8 +216,7 @@ class FakeController:
                 data = sock.recv(65536)
                 if not data:
                     return
-                buffer += data
-                self._take_program(buffer)
+                self._take_programs(framer, data)
 
 
 # ---- a fake RTDE server ------------------------------------------------------------------

@@ -179,3 +179,11 @@ def test_server_echoes_odd_arguments():
     server = DashboardServer()
     (command,) = server.receive_data(b"load a\rb.urp\n")
     assert server.reply(command) == b"Loading program: a\rb.urp\n"
+
+
+def test_decode_command_ignoring_case_gives_the_documented_name():
+    assert not decode_command("PROGRAMSTATE").known  # the real server is case-sensitive
+    assert decode_command("Load Installation My.installation", ignore_case=True) == \
+        DashboardCommand("load installation", "My.installation")
+    assert decode_command("PROGRAMSTATE", ignore_case=True) == DashboardCommand("programState")
+    assert not decode_command("fly", ignore_case=True).known

@@ -261,3 +261,30 @@ def test_slot_is_where_a_field_sits_among_the_doubles():
     assert layout.slot("time") == slice(0, 1)
     with pytest.raises(KeyError):
         LAYOUTS["3.0"].slot("payload_mass")
+
+
+def test_encode_refuses_vectors_of_the_wrong_length_even_when_the_total_fits():
+    # q_target one short, qd_target one long: the count of doubles is right, the fields not
+    state = realtime_state("3.10")._replace(q_target=(0.0,) * 5, qd_target=(0.0,) * 7)
+    with pytest.raises(ProtocolError, match="field q_target needs 6 values, got 5"):
+        encode_realtime(state)
+
+
+@pytest.mark.parametrize(("value", "whole"), [
+    (math.inf, False), (-math.inf, False), (-2.5, False), (2.0**51 + 0.5, False),
+    (1e300, True), (-0.0, True)])
+def test_integer_fields_hold_integers_or_the_packet_is_refused(value, whole):
+    data = packet(1116, {756: (value,)})
+    if whole:
+        assert decode_realtime(data).robot_mode == int(value)  # huge, but a whole number
+    else:
+        with pytest.raises(ProtocolError, match="robot_mode at offset 756 should hold an integer"):
+            decode_realtime(data)
+
+
+def test_states_compare_as_states_and_keep_their_field_names():
+    state = realtime_state("5.10", q_actual=Q)
+    assert state == realtime_state("5.10", q_actual=Q) and state != tuple(state)
+    assert hash(state) == hash(realtime_state("5.10", q_actual=Q))
+    assert state._replace(robot_mode=3).robot_mode == 3
+    assert decode_realtime(encode_realtime(state)).q_actual == Q

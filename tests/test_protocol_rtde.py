@@ -410,3 +410,38 @@ def test_output_package_is_the_data_package_of_the_recipe():
     fast = server.output_package([2.5, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 7])
     assert fast == server.outputs(values, 0)
     assert client.receive_data(fast) == [DataPackage(1, values)]
+
+
+def test_a_data_package_whose_size_field_lies_is_refused():
+    recipe = Recipe(1, ("timestamp",), ("DOUBLE",))
+    data = bytearray(encode_rtde(DataPackage(1, {"timestamp": 1.5}), recipe=recipe))
+    data[1] += 1  # the size field says one byte more than the package has
+    with pytest.raises(ProtocolError, match="size field says 13 bytes but the package has 12"):
+        decode_rtde(bytes(data), sender="server", recipes={1: recipe})
+
+
+def test_only_data_packages_take_the_recipe_path():
+    # a text message as long as a data package of recipe 3, its first payload byte 3
+    recipe = Recipe(3, ("robot_mode", "flag"), ("INT32", "BOOL"))
+    text = encode_rtde(RtdeTextMessage("abc", "", 3), protocol=2)
+    assert len(text) == 3 + 1 + recipe.size and text[3] == 3
+    assert decode_rtde(text, sender="server", recipes={3: recipe}) == RtdeTextMessage("abc", "", 3)
+
+
+def test_data_packages_compare_and_hash_as_packages():
+    sample = DataPackage(1, {"timestamp": 1.0})
+    assert sample == DataPackage(1, {"timestamp": 1.0}) and sample != DataPackage(2, sample.values)
+    assert sample != (1, {"timestamp": 1.0})  # not equal to a plain tuple
+    assert hash(sample) == hash(DataPackage(1, {})) and DataPackage().values == {}
+    assert DataPackage().values is not DataPackage().values
+
+
+def test_v1_output_package_has_no_recipe_id_and_bad_values_are_refused():
+    client, server = RtdeClient(), RtdeServer((3, 10, 0, 0))
+    talk(client, server, client.setup_outputs(["timestamp", "robot_mode"]))
+    talk(client, server, client.start())
+    data = server.output_package([1.5, 7])
+    assert data == struct.pack(">HBdi", 15, ord("U"), 1.5, 7)
+    assert client.receive_data(data) == [DataPackage(None, {"timestamp": 1.5, "robot_mode": 7})]
+    with pytest.raises(ProtocolError, match="data package for recipe None"):
+        server.output_package([1.5, 2**40])

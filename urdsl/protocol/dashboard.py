@@ -30,7 +30,7 @@ from .errors import ProtocolError
 __all__ = [
     "WELCOME", "PORT", "CommandSpec", "COMMANDS", "DashboardCommand", "DashboardReply",
     "DashboardWelcome", "encode_command", "decode_command", "parse_reply", "format_reply",
-    "LineBuffer", "DashboardClient", "DashboardServer", "MAX_LINE",
+    "LineBuffer", "DashboardClient", "DashboardServer", "MAX_LINE", "UNKNOWN_COMMAND",
 ]
 
 PORT = 29999
@@ -253,18 +253,23 @@ def encode_command(name: str, argument: str | None = None) -> bytes:
     return (line + "\n").encode("utf-8")
 
 
-def decode_command(line: str) -> DashboardCommand:
+def decode_command(line: str, ignore_case: bool = False) -> DashboardCommand:
     """What a received command line asks for (the server's side).
 
     Unknown lines give a :class:`DashboardCommand` whose ``known`` is false; the server
     answers those with :data:`UNKNOWN_COMMAND`, it does not drop the connection.
+    ``ignore_case`` matches the command words in any case (``PROGRAMSTATE``) — the virtual
+    controller is lenient so — and still returns the documented name; the argument keeps
+    its case.
     """
     text = line.rstrip("\r\n")
+    key = text.lower() if ignore_case else text
     for spec in _BY_LENGTH:
-        if text == spec.name:
+        name = spec.name.lower() if ignore_case else spec.name
+        if key == name:
             return DashboardCommand(spec.name, None)
-        if spec.argument is not None and text.startswith(spec.name + " "):
-            return DashboardCommand(spec.name, text[len(spec.name) + 1:])
+        if spec.argument is not None and key.startswith(name + " "):
+            return DashboardCommand(spec.name, text[len(name) + 1:])
     return DashboardCommand(text, None)
 
 

@@ -35,8 +35,9 @@ from __future__ import annotations
 
 import operator
 import struct
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from types import MappingProxyType
+from typing import NamedTuple
 
 from ..versions import ControllerVersion
 from .errors import ProtocolError
@@ -51,6 +52,7 @@ PORT = 30003
 READ_ONLY_PORT = 30013
 
 _HEADER = struct.Struct(">i")
+_unpack_size = _HEADER.unpack_from
 
 
 @dataclass(frozen=True)
@@ -105,6 +107,108 @@ _V5_10 = _V3_10 + (
 )
 
 
+Vector = tuple[float, ...]
+
+
+class RealtimeState(NamedTuple):
+    """One realtime packet, every field by name (SI units: rad, rad/s, m, N, A, V, °C, s).
+
+    Fields a version does not send are ``None``. Modes and bit masks are ``int``; vectors are
+    tuples (joint vectors base … wrist 3; poses x, y, z, rx, ry, rz in the Base frame).
+    ``version`` names the layout (or the version the decoder was told); ``size`` is the
+    packet's size field; ``tail`` holds the bytes after the known layout, undecoded.
+
+    Immutable and tuple-backed (a named tuple): a decoder builds it in one step, and reading
+    a field is an index into the tuple. The tuple's order is ``version``, ``size``, the
+    measured values, the integer fields, ``tail``; use the names. Equal only to another
+    :class:`RealtimeState` with the same fields.
+    """
+
+    version: str = "5.10"
+    size: int = 0
+    # the measured values (doubles), in packet order
+    time: float | None = None
+    q_target: Vector | None = None
+    qd_target: Vector | None = None
+    qdd_target: Vector | None = None
+    i_target: Vector | None = None
+    m_target: Vector | None = None
+    q_actual: Vector | None = None
+    qd_actual: Vector | None = None
+    i_actual: Vector | None = None
+    i_control: Vector | None = None
+    tool_vector_actual: Vector | None = None
+    tcp_speed_actual: Vector | None = None
+    tcp_force: Vector | None = None
+    tool_vector_target: Vector | None = None
+    tcp_speed_target: Vector | None = None
+    motor_temperatures: Vector | None = None
+    controller_timer: float | None = None
+    test_value: float | None = None
+    reserved_820: Vector | None = None
+    tool_accelerometer_values: Vector | None = None
+    reserved_892: Vector | None = None
+    speed_scaling: float | None = None
+    linear_momentum_norm: float | None = None
+    reserved_956: float | None = None
+    reserved_964: float | None = None
+    v_main: float | None = None
+    v_robot: float | None = None
+    i_robot: float | None = None
+    v_actual: Vector | None = None
+    elbow_position: Vector | None = None
+    elbow_velocity: Vector | None = None
+    reserved_1116: Vector | None = None
+    payload_mass: float | None = None
+    payload_cog: Vector | None = None
+    payload_inertia: Vector | None = None
+    reserved_420: Vector | None = None
+    # the integers the controller sends as doubles (modes, bit masks), in packet order
+    digital_input_bits: int | None = None
+    robot_mode: int | None = None
+    joint_modes: tuple[int, ...] | None = None
+    safety_mode: int | None = None
+    digital_outputs: int | None = None
+    program_state: int | None = None
+    safety_status: int | None = None
+    tail: bytes = b""
+
+    def __eq__(self, other: object) -> bool:
+        return type(other) is RealtimeState and tuple.__eq__(self, other)
+
+    def __ne__(self, other: object) -> bool:
+        return not self.__eq__(other)
+
+    __hash__ = tuple.__hash__
+
+    @property
+    def tcp_pose(self) -> Vector | None:
+        """The actual TCP pose (x, y, z, rx, ry, rz) [m, rad] in the Base frame."""
+        return self.tool_vector_actual
+
+    @property
+    def layout(self) -> RealtimeLayout:
+        """The layout of this packet's known fields."""
+        return LAYOUTS[self.version] if self.version in LAYOUTS else \
+            layout_for_version(self.version)
+
+
+def _int_error(layout: RealtimeLayout, values: tuple[float, ...]) -> ProtocolError:
+    """The error for the first integer field of ``values`` that holds no integer."""
+    for name, begin, end in layout._ints:
+        for index in range(begin, end):
+            value = values[index]
+            if value != value or value in (_INF, -_INF) or int(value) != value:
+                offset = _HEADER.size + 8 * index
+                return ProtocolError(f"field {name} at offset {offset} should hold an "
+                                     f"integer, got {value!r}", interface="realtime",
+                                     offset=offset)
+    raise AssertionError("no bad integer field")  # pragma: no cover
+
+
+_INF = float("inf")
+
+
 class RealtimeLayout:
     """A packet layout: its table, total size in bytes and the offset of every field."""
 
@@ -115,34 +219,110 @@ class RealtimeLayout:
         self.size = _HEADER.size + 8 * self.doubles
         self.struct = struct.Struct(f">{self.doubles}d")
         self._offsets: dict[str, int] = {}
-        # The decode plan: every field's key into the unpacked tuple (an index for a scalar,
-        # a slice for a vector), so that one C-level map over the keys builds all values;
-        # integer fields are then converted and checked.
-        keys: list[int | slice] = []
-        ints, int_vectors = [], []
+        # (name, first, end) index into the packet's doubles of every field, and of the
+        # integer fields alone (modes and bit masks sent as doubles)
+        self._spans: tuple[tuple[str, int, int], ...] = ()
+        self._ints: tuple[tuple[str, int, int], ...] = ()
+        spans = []
         index = 0
         for item in table:
             self._offsets[item.name] = _HEADER.size + 8 * index
-            keys.append(index if item.count == 1 else slice(index, index + item.count))
-            if item.kind == "int":
-                (ints if item.count == 1 else int_vectors).append(
-                    (item.name, index, index + item.count))
+            spans.append((item.name, index, index + item.count))
             index += item.count
-        self._keys = tuple(keys)
-        self._ints = tuple(ints)
-        self._int_vectors = tuple(int_vectors)
+        self._spans = tuple(spans)
+        self._ints = tuple(span for span, item in zip(spans, table, strict=True)
+                           if item.kind == "int")
         self.names = tuple(f.name for f in table)
-        # one C-level call each: every field's value, the integer scalars, the integer
-        # vectors (the decoder's hot path)
-        self._get_all = operator.itemgetter(*keys)
-        self._int_names = tuple(name for name, _, _ in ints)
-        starts = [begin for _, begin, _ in ints]
-        # the first index once more: itemgetter of one key would return a bare value
-        self._get_ints = (operator.itemgetter(*starts, starts[0]) if starts
-                          else lambda values: ())
-        self._int_vector_names = tuple(name for name, _, _ in int_vectors)
-        self._get_int_vectors = operator.itemgetter(
-            *(slice(begin, end) for _, begin, end in int_vectors), slice(0, 0))
+        self._compile()
+
+    def _compile(self) -> None:
+        """Build ``_read``, this layout's decoder: one ``unpack_from`` of all doubles, one
+        conversion of the integer fields (checked: each double must hold an integer), and
+        the :class:`RealtimeState` assembled from a few C-level ``itemgetter`` calls (one
+        per run of fields taken from the same source) — no loop over fields per packet.
+        The source is generated from the table."""
+        ints = {name: (begin, end) for name, begin, end in self._ints}
+        int_slot = {}  # name -> (first, end) in the converted integers
+        k = 0
+        for name, begin, end in self._ints:
+            int_slot[name] = (k, k + end - begin)
+            k += end - begin
+        floats = {name: (begin, end) for name, begin, end in self._spans if name not in ints}
+        # each field of the state: (source, key); sources: f doubles, n integers, None absent
+        plan: list[tuple[str, object]] = []
+        for name in RealtimeState._fields:
+            if name in ("version", "size", "tail"):
+                plan.append(({"version": "label"}.get(name, name), None))
+                continue
+            table, source = (floats, "f") if name in floats else (int_slot, "n")
+            span = table.get(name)
+            if span is None:
+                plan.append(("None", None))
+            else:
+                begin, end = span
+                plan.append((source, begin if end - begin == 1 else slice(begin, end)))
+        namespace: dict[str, object] = {
+            "unpack_from": self.struct.unpack_from, "int_error": _int_error, "layout": self,
+            "new": tuple.__new__, "State": RealtimeState, "trunc": float.__trunc__}
+        items = []
+        run: list[tuple[str, object]] = []
+
+        def flush() -> None:
+            if not run:
+                return
+            source = run[0][0]
+            if source in ("f", "n") and len(run) > 1:
+                getter = f"get{len(namespace)}"
+                namespace[getter] = operator.itemgetter(*(key for _, key in run))
+                items.append(f"*{getter}({source})")
+            elif source in ("f", "n"):
+                key = run[0][1]
+                items.append(f"{source}[{key}]" if isinstance(key, int)
+                             else f"{source}[{key.start}:{key.stop}]")  # type: ignore
+            else:
+                items.extend(source for _ in run)
+            run.clear()
+
+        for entry in plan:
+            if run and run[0][0] != entry[0]:
+                flush()
+            run.append(entry)
+        flush()
+        int_indices = [i for _, begin, end in self._ints for i in range(begin, end)]
+        if len(int_indices) > 1:
+            namespace["get_ints"] = operator.itemgetter(*int_indices)
+            fetch = "get_ints(f)"
+        else:  # itemgetter of one key would return a bare value
+            fetch = f"(f[{int_indices[0]}],)"
+        source = (
+            "def read(data, start, label, size, tail):\n"
+            "    f = unpack_from(data, start + 4)\n"
+            f"    i = {fetch}\n"
+            "    try:\n"
+            "        n = tuple(map(trunc, i))\n"
+            "    except (ValueError, OverflowError):\n"
+            "        n = None\n"
+            "    if n != i:\n"
+            "        raise int_error(layout, f)\n"
+            f"    return new(State, ({', '.join(items)}))\n")
+        # the encoder: every field of the table by name, vectors spread, in one pack call;
+        # None (some value is missing, of the wrong type or length) leaves the diagnosis to
+        # encode_realtime's field-by-field path
+        vectors = [item.name for item in self.table if item.count > 1]
+        lengths = tuple(item.count for item in self.table if item.count > 1)
+        spread = ", ".join(f"*s.{item.name}" if item.count > 1 else f"s.{item.name}"
+                           for item in self.table)
+        source += (
+            "\ndef write(s):\n"
+            f"    if ({', '.join(f'len(s.{name})' for name in vectors)},) != {lengths}:\n"
+            "        return None\n"
+            "    tail = s.tail\n"
+            f"    return pack({self.size} + len(tail), {spread}) + tail\n")
+        namespace["pack"] = struct.Struct(f">i{self.doubles}d").pack
+        exec(source, namespace)  # noqa: S102 - generated from the layout table above
+        self._read = namespace["read"]
+        self._write = namespace["write"]
+        self._source = source
 
     def slot(self, name: str) -> slice:
         """Where field ``name`` sits in the packet's array of doubles (after the size field);
@@ -187,6 +367,12 @@ most ~100 bytes. Allowing 8 KiB keeps room for future fields (kept raw) while a 
 desynchronised size field — almost any 4 random bytes read as int32 exceed it — is
 rejected at once instead of making the decoder wait for megabytes that never come.
 """
+
+
+for _layout in LAYOUTS.values():  # every table row must be a field of RealtimeState
+    assert set(_layout.names) <= set(RealtimeState._fields), \
+        set(_layout.names) - set(RealtimeState._fields)
+del _layout
 
 
 def layout_for_size(size: int) -> RealtimeLayout:
@@ -235,133 +421,6 @@ def layout_for_version(version: str) -> RealtimeLayout:
                         "(known: 1.6–1.8, 3.x, 5.x)", interface="realtime")
 
 
-Vector = tuple[float, ...]
-
-
-@dataclass(frozen=True)
-class RealtimeState:
-    """One realtime packet, every field by name (SI units: rad, rad/s, m, N, A, V, °C, s).
-
-    Fields a version does not send are ``None``. Modes and bit masks are ``int``; vectors are
-    tuples (joint vectors base … wrist 3; poses x, y, z, rx, ry, rz in the Base frame).
-    ``version`` names the layout (or the version the decoder was told); ``size`` is the
-    packet's size field; ``tail`` holds the bytes after the known layout, undecoded.
-    """
-
-    version: str = "5.10"
-    size: int = 0
-    time: float | None = None
-    q_target: Vector | None = None
-    qd_target: Vector | None = None
-    qdd_target: Vector | None = None
-    i_target: Vector | None = None
-    m_target: Vector | None = None
-    q_actual: Vector | None = None
-    qd_actual: Vector | None = None
-    i_actual: Vector | None = None
-    i_control: Vector | None = None
-    tool_vector_actual: Vector | None = None
-    tcp_speed_actual: Vector | None = None
-    tcp_force: Vector | None = None
-    tool_vector_target: Vector | None = None
-    tcp_speed_target: Vector | None = None
-    digital_input_bits: int | None = None
-    motor_temperatures: Vector | None = None
-    controller_timer: float | None = None
-    test_value: float | None = None
-    robot_mode: int | None = None
-    joint_modes: tuple[int, ...] | None = None
-    safety_mode: int | None = None
-    reserved_420: Vector | None = None
-    reserved_820: Vector | None = None
-    tool_accelerometer_values: Vector | None = None
-    reserved_892: Vector | None = None
-    speed_scaling: float | None = None
-    linear_momentum_norm: float | None = None
-    reserved_956: float | None = None
-    reserved_964: float | None = None
-    v_main: float | None = None
-    v_robot: float | None = None
-    i_robot: float | None = None
-    v_actual: Vector | None = None
-    digital_outputs: int | None = None
-    program_state: int | None = None
-    elbow_position: Vector | None = None
-    elbow_velocity: Vector | None = None
-    safety_status: int | None = None
-    reserved_1116: Vector | None = None
-    payload_mass: float | None = None
-    payload_cog: Vector | None = None
-    payload_inertia: Vector | None = None
-    tail: bytes = b""
-
-    @property
-    def tcp_pose(self) -> Vector | None:
-        """The actual TCP pose (x, y, z, rx, ry, rz) [m, rad] in the Base frame."""
-        return self.tool_vector_actual
-
-    @property
-    def layout(self) -> RealtimeLayout:
-        """The layout of this packet's known fields."""
-        return LAYOUTS[self.version] if self.version in LAYOUTS else \
-            layout_for_version(self.version)
-
-
-_STATE_FIELDS = frozenset(f.name for f in fields(RealtimeState))
-for _layout in LAYOUTS.values():  # every table row must be a field of RealtimeState
-    assert set(_layout.names) <= _STATE_FIELDS, set(_layout.names) - _STATE_FIELDS
-
-
-def _int_error(layout: RealtimeLayout, values: tuple[float, ...]) -> ProtocolError:
-    """The error for the first integer field of ``values`` that holds no integer."""
-    for name, begin, end in layout._ints + layout._int_vectors:
-        for index in range(begin, end):
-            value = values[index]
-            if value != value or value in (_INF, -_INF) or int(value) != value:
-                offset = _HEADER.size + 8 * index
-                return ProtocolError(f"field {name} at offset {offset} should hold an "
-                                     f"integer, got {value!r}", interface="realtime",
-                                     offset=offset)
-    raise AssertionError("no bad integer field")  # pragma: no cover
-
-
-_INF = float("inf")
-
-
-def _decode_fields(layout: RealtimeLayout, data: bytes | bytearray | memoryview,
-                   start: int) -> dict[str, object]:
-    values = layout.struct.unpack_from(data, start + _HEADER.size)
-    out = dict(zip(layout.names, layout._get_all(values), strict=True))
-    try:
-        scalars = layout._get_ints(values)
-        numbers = tuple(map(int, scalars))
-        if numbers != scalars:
-            raise ValueError
-        out.update(zip(layout._int_names, numbers, strict=False))
-        for name, segment in zip(layout._int_vector_names, layout._get_int_vectors(values),
-                                 strict=False):
-            vector = tuple(map(int, segment))
-            if vector != segment:
-                raise ValueError(name)
-            out[name] = vector
-    except (ValueError, OverflowError):
-        raise _int_error(layout, values) from None
-    return out
-
-
-def _make_state(version: str, size: int, values: dict[str, object], tail: bytes) -> RealtimeState:
-    # Building the frozen dataclass through its __dict__ skips 45 object.__setattr__ calls
-    # (the slow part of a frozen __init__); fields a layout lacks fall back to the class
-    # defaults (None), exactly as the constructor would leave them.
-    state = object.__new__(RealtimeState)
-    attrs = state.__dict__
-    attrs.update(values)
-    attrs["version"] = version
-    attrs["size"] = size
-    attrs["tail"] = tail
-    return state
-
-
 def _decode_at(data: bytes | bytearray | memoryview, start: int, size: int,
                version: str | None) -> RealtimeState:
     if version is None:
@@ -375,7 +434,7 @@ def _decode_at(data: bytes | bytearray | memoryview, start: int, size: int,
                                 f"({layout.name} layout), this one has {size}",
                                 interface="realtime", offset=0)
     tail = bytes(data[start + layout.size:start + size]) if size > layout.size else b""
-    return _make_state(label, size, _decode_fields(layout, data, start), tail)
+    return layout._read(data, start, label, size, tail)
 
 
 def _check_size(size: int) -> None:
@@ -425,8 +484,9 @@ def realtime_state(version: str = "5.10", **values: object) -> RealtimeState:
         else:
             value = int(value) if item.kind == "int" else float(value)
         full[item.name] = value
-    tail = bytes(values.get("tail", b""))
-    return _make_state(version, layout.size + len(tail), full, tail)
+    tail = bytes(values.get("tail", b""))  # type: ignore[call-overload]
+    return RealtimeState(version=version, size=layout.size + len(tail), tail=tail,
+                         **full)  # type: ignore[arg-type]
 
 
 def encode_realtime(state: RealtimeState, version: str | None = None) -> bytes:
@@ -437,6 +497,12 @@ def encode_realtime(state: RealtimeState, version: str | None = None) -> bytes:
     counted in the size field.
     """
     layout = layout_for_version(version or state.version)
+    try:
+        data = layout._write(state)
+    except (TypeError, OverflowError, struct.error):
+        data = None
+    if data is not None and len(data) <= MAX_SIZE:
+        return data
     values: list[float] = []
     for item in layout.table:
         value = getattr(state, item.name)
@@ -472,9 +538,14 @@ class RealtimeDecoder:
     """
 
     def __init__(self, version: str | None = None) -> None:
-        if version is not None:
-            layout_for_version(version)  # fail early on a version we do not know
+        if version is None:
+            exact = {layout.size: (layout._read, layout.name) for layout in LAYOUTS.values()}
+        else:
+            layout = layout_for_version(version)  # fail early on a version we do not know
+            exact = {layout.size: (layout._read, version)}
         self.version = version
+        # the common case: a whole packet of a layout's exact size → (its decoder, label)
+        self._exact = exact
         self._buffer = bytearray()
         self._error: ProtocolError | None = None
         self.decoded = 0
@@ -520,17 +591,19 @@ class RealtimeDecoder:
 
     def feed(self, data: bytes) -> list[RealtimeState]:
         """Add received bytes; return every packet they complete, oldest first."""
-        if not self._buffer and self._error is None and len(data) >= _HEADER.size:
-            # the common case: exactly one whole packet, decoded without copying it
-            (size,) = _HEADER.unpack_from(data, 0)
-            if size == len(data) and MIN_SIZE <= size <= MAX_SIZE:
-                try:
-                    state = _decode_at(data, 0, size, self.version)
-                except ProtocolError as exc:
-                    self._error = exc
-                    raise
-                self.decoded += 1
-                return [state]
+        if not self._buffer and len(data) >= 4 and self._error is None:
+            # the common case: exactly one whole packet of a known layout, decoded in place
+            (size,) = _unpack_size(data)
+            if size == len(data):
+                plan = self._exact.get(size)
+                if plan is not None:
+                    try:
+                        state = plan[0](data, 0, plan[1], size, b"")
+                    except ProtocolError as exc:
+                        self._error = exc
+                        raise
+                    self.decoded += 1
+                    return [state]
         frames = self._take(data)
         states = [self._decode(start, size) for start, size in frames]
         if frames:

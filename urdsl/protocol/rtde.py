@@ -25,8 +25,10 @@ A name the controller does not know comes back with the type ``NOT_FOUND``; an i
 another client already controls comes back as ``IN_USE``. Either makes the recipe unusable:
 an output recipe with a NOT_FOUND name streams nothing at all.
 
-This module has the packages as frozen dataclasses (requests, replies, :class:`DataPackage`,
-:class:`RtdeTextMessage`), :class:`Recipe` (encode/decode data by recipe), and two state
+This module has the packages as immutable values (requests, replies and
+:class:`RtdeTextMessage` frozen dataclasses; :class:`DataPackage`, the streamed one, a named
+tuple), :class:`Recipe` (encode/decode data by recipe, each with its own generated reader and
+packer), and two state
 machines without sockets: :class:`RtdeClient` (what to send, what replies mean) and
 :class:`RtdeServer` (the virtual controller: parse requests, produce replies, track
 recipes, refuse inputs another client owns via a shared :class:`InputOwnership`).
@@ -39,7 +41,8 @@ import struct
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import ClassVar
+from functools import partial
+from typing import ClassVar, NamedTuple
 
 from ._binary import read_text, text_bytes
 from .errors import ProtocolError
@@ -82,14 +85,34 @@ def _error(message: str, offset: int | None = None) -> ProtocolError:
 # --- recipes --------------------------------------------------------------------------------
 
 
-def _reader(plan: list[tuple[str, int, int]], skip: int):
-    """A function from a whole package's unpacked tuple (header first, ``skip`` items) to
-    the dict of name → value: one dict display, as a hand-written decoder would have."""
+def _reader(plan: list[tuple[str, int, int]], body: str, with_id: bool):
+    """The fast decoder of one recipe's data packages (with or without the recipe id byte):
+    a function from a whole package (header included) to its :class:`DataPackage`, or
+    ``None`` when the package is not one of this recipe's (wrong size, size field or type;
+    the caller then takes the general path, which names the problem).
+
+    One ``struct.unpack`` of the whole package — it requires the exact length — and one
+    dict display, as a hand-written decoder would have; generated from the recipe's plan
+    (the names appear only as ``repr`` literals)."""
+    whole = struct.Struct((">HBB" if with_id else ">HB") + body)
+    skip = 3 if with_id else 2
     items = ", ".join(
         f"{name!r}: flat[{skip + index}]" if count == 1
         else f"{name!r}: flat[{skip + index}:{skip + index + count}]"
         for name, index, count in plan)
-    return eval(f"lambda flat: {{{items}}}", {})  # noqa: S307 - names are repr() literals
+    source = (
+        "def read(package):\n"
+        "    try:\n"
+        "        flat = unpack(package)\n"
+        "    except error:\n"
+        "        return None\n"
+        f"    if flat[0] != {whole.size} or flat[1] != 85:\n"
+        "        return None\n"
+        f"    return new(DataPackage, ({'flat[2]' if with_id else 'None'}, {{{items}}}))\n")
+    namespace = {"unpack": whole.unpack, "error": struct.error, "new": tuple.__new__,
+                 "DataPackage": DataPackage}
+    exec(source, namespace)  # noqa: S102 - names are repr() literals
+    return namespace["read"]
 
 
 @dataclass(frozen=True)
@@ -104,7 +127,8 @@ class Recipe:
     _struct: struct.Struct | None = field(default=None, init=False, repr=False, compare=False)
     _plan: tuple[tuple[str, int, int], ...] = field(default=(), init=False, repr=False,
                                                     compare=False)
-    _whole: dict | None = field(default=None, init=False, repr=False, compare=False)
+    _readers: tuple | None = field(default=None, init=False, repr=False, compare=False)
+    _packers: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if len(self.names) != len(self.types):
@@ -124,10 +148,14 @@ class Recipe:
         object.__setattr__(self, "_struct", struct.Struct("".join(fmt)))
         object.__setattr__(self, "_plan", tuple(plan))
         body = "".join(fmt[1:])
-        object.__setattr__(self, "_whole", {
-            True: (struct.Struct(">HBB" + body), _reader(plan, 3)),   # with the recipe id
-            False: (struct.Struct(">HB" + body), _reader(plan, 2)),   # v1 output: none
-        })
+        # indexed by "has a recipe id" (False: a v1 output package)
+        object.__setattr__(self, "_readers", (_reader(plan, body, False),
+                                              _reader(plan, body, True)))
+        # whole data packages from the values (recipe id first when there is one): the
+        # header's size and type are constants of the recipe
+        object.__setattr__(self, "_packers", tuple(
+            partial(whole.pack, whole.size, DataPackage.CODE)
+            for whole in (struct.Struct(">HB" + body), struct.Struct(">HBB" + body))))
 
     @property
     def not_found(self) -> tuple[str, ...]:
@@ -297,14 +325,33 @@ class PauseReply:
     accepted: bool = True
 
 
-@dataclass(frozen=True)
-class DataPackage:
-    """'U': one sample of a recipe. ``values`` maps each recipe name to its value (vectors
-    as tuples). ``recipe_id`` is ``None`` for v1 output packages, which carry none."""
-
-    CODE: ClassVar[int] = ord("U")
+class _DataPackageFields(NamedTuple):
     recipe_id: int | None = None
-    values: dict[str, object] = field(default_factory=dict, hash=False)
+    values: dict[str, object] = {}  # noqa: RUF012 - replaced by a fresh dict in __new__
+
+
+class DataPackage(_DataPackageFields):
+    """'U': one sample of a recipe. ``values`` maps each recipe name to its value (vectors
+    as tuples). ``recipe_id`` is ``None`` for v1 output packages, which carry none.
+
+    Immutable and tuple-backed (a named tuple, so a decoder builds it in one step); equal
+    only to another :class:`DataPackage` with the same id and values."""
+
+    __slots__ = ()
+    CODE: ClassVar[int] = ord("U")
+
+    def __new__(cls, recipe_id: int | None = None,
+                values: dict[str, object] | None = None) -> DataPackage:
+        return tuple.__new__(cls, (recipe_id, {} if values is None else values))
+
+    def __eq__(self, other: object) -> bool:
+        return type(other) is DataPackage and tuple.__eq__(self, other)
+
+    def __ne__(self, other: object) -> bool:
+        return not self.__eq__(other)
+
+    def __hash__(self) -> int:
+        return hash((self.recipe_id,))  # the values (a dict) are not hashed
 
 
 @dataclass(frozen=True)
@@ -462,20 +509,21 @@ def decode_rtde(package: bytes, *, sender: str, protocol: int = 2,
     Data packages are decoded with ``recipes`` (recipe id → :class:`Recipe`; a v1 output
     recipe is under ``None``).
     """
-    if sender != "server" and sender != "client":
+    if sender == "server":
+        with_id = protocol >= 2
+    elif sender == "client":
+        with_id = True
+    else:
         raise ValueError(f"sender must be 'client' or 'server', not {sender!r}")
-    if recipes and len(package) > 3 and package[2] == 85:  # 'U': the fast path
-        with_id = sender == "client" or protocol >= 2
-        recipe = recipes.get(package[3] if with_id else None)
-        if recipe is not None and recipe._whole is not None:
-            whole, read = recipe._whole[with_id]
-            if whole.size == len(package):
-                flat = whole.unpack_from(package)
-                if flat[0] == whole.size:
-                    message = object.__new__(DataPackage)
-                    message.__dict__.update(recipe_id=flat[2] if with_id else None,
-                                            values=read(flat))
-                    return message
+    if recipes:  # a data package of a known recipe: the fast path
+        try:
+            read = recipes[package[3] if with_id else None]._readers[with_id]  # type: ignore
+        except (KeyError, IndexError, TypeError):  # no such recipe, too short, unusable
+            read = None
+        if read is not None:
+            message = read(package)
+            if message is not None:
+                return message
     if len(package) < _HEADER.size:
         raise _error(f"{len(package)} bytes cannot hold the 3-byte package header", 0)
     size, code = _HEADER.unpack_from(package)
@@ -926,14 +974,14 @@ class RtdeServer:
         flattened (the simulator's fast path: no dict, no dataclass). Raises
         :class:`ProtocolError` without a usable output recipe or for values that do not fit."""
         recipe = self.output_recipe
-        if recipe is None or recipe._struct is None:
+        if recipe is None or recipe._packers is None:
             raise _error("no usable output recipe")
         try:
-            body = recipe._struct.pack(*values)
+            if recipe.id is None:  # a v1 output package carries no recipe id
+                return recipe._packers[0](*values)
+            return recipe._packers[1](recipe.id, *values)
         except struct.error as exc:
             raise _error(f"data package for recipe {recipe.id}: {exc}") from None
-        head = b"" if recipe.id is None else bytes((recipe.id,))
-        return _HEADER.pack(_HEADER.size + len(head) + len(body), DataPackage.CODE) + head + body
 
     def outputs(self, values: Mapping[str, object], cycle: int) -> bytes | None:
         """The output data package for control cycle ``cycle`` (counting from 0), or

@@ -1,6 +1,7 @@
 """The dashboard server's commands and replies (port 29999), without sockets.
 
-One line in, one line out, with the replies of docs/controller-facts.md §13. The virtual
+One line in, one line out, with the replies of docs/controller-facts.md §13 — their texts are
+the protocol's (:data:`urdsl.protocol.dashboard.COMMANDS`), written once. The virtual
 controller is always in remote control. ``load`` reads URScript files (``.script``,
 ``.urscript``, ``.txt``) and PolyScope programs (``.urp``, compiled with their installation
 as ``urdsl compile`` does) from the controller's programs folder; a file that cannot be read
@@ -9,9 +10,19 @@ or compiled answers ``Error while loading program``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
-from ..protocol.dashboard import MAX_LINE, WELCOME, LineBuffer
+from ..protocol.dashboard import (
+    COMMANDS,
+    MAX_LINE,
+    UNKNOWN_COMMAND,
+    WELCOME,
+    DashboardCommand,
+    LineBuffer,
+    decode_command,
+    format_reply,
+)
 from ..protocol.errors import ProtocolError
 from .state import ProgramState, SimError
 
@@ -52,140 +63,168 @@ class DashboardSession:
         return replies
 
     def command(self, line: str) -> str:
-        """The reply to one command line."""
-        lower = line.lower()
-        if lower.startswith("load installation "):
-            return f"Loading installation: {line[18:].strip()}"
-        if lower.startswith("load "):
-            return self._load(line[5:].strip())
-        if lower.startswith("popup "):
-            return "showing popup"
-        if lower.startswith("addtolog "):
-            return "Added log message"
-        if lower.startswith("setuserrole "):
-            return f"Setting user role: {line[12:].strip()}"
-        if lower.startswith("set operational mode "):
-            self._operational_mode = line[21:].strip().upper()
-            return f"Operational mode '{self._operational_mode.lower()}' is set"
-        simple = _COMMANDS.get(lower)
-        if simple is not None:
-            return simple(self)
-        return f"could not understand: '{line}'"
+        """The reply to one command line. The words are matched in any case; the reply texts
+        are the protocol's (:func:`urdsl.protocol.dashboard.format_reply`)."""
+        command = decode_command(line, ignore_case=True)
+        spec = COMMANDS.get(command.name)
+        if spec is None or (spec.argument is not None and not command.argument):
+            return UNKNOWN_COMMAND.format(text=line)
+        if command.argument is not None:
+            command = DashboardCommand(command.name, command.argument.strip())
+        ok, variant, fields = _HANDLERS[spec.name](self, command)
+        try:
+            return format_reply(command, ok, variant, **fields)
+        except ProtocolError:  # a reply the line protocol cannot carry (too long)
+            return UNKNOWN_COMMAND.format(text=line[:200])
 
-    # ---- commands --------------------------------------------------------------------------
+    # ---- commands: (ok, reply variant, the reply's fields) ---------------------------------
 
-    def _load(self, name: str) -> str:
+    def _load(self, command: DashboardCommand) -> Reply:
+        name = command.argument or ""
         try:
             loaded = self.sim.load_program(name)
         except FileNotFoundError:
-            return f"File not found: {name}"
+            return False, 0, {}
         except SimError:
-            return f"Error while loading program: {name}"
-        return f"Loading program: {loaded}"
+            return False, 1, {}
+        return True, 0, {"arg": loaded}
 
-    def _play(self) -> str:
-        return "Starting program" if self.sim.play() else "Failed to execute: play"
+    def _play(self, command: DashboardCommand) -> Reply:
+        return bool(self.sim.play()), 0, {}
 
-    def _stop(self) -> str:
+    def _stop(self, command: DashboardCommand) -> Reply:
         self.sim.stop_program()
-        return "Stopped"
+        return True, 0, {}
 
-    def _pause(self) -> str:
-        return "Pausing program" if self.sim.pause_program() else "Failed to execute: pause"
+    def _pause(self, command: DashboardCommand) -> Reply:
+        return bool(self.sim.pause_program()), 0, {}
 
-    def _quit(self) -> str:
+    def _quit(self, command: DashboardCommand) -> Reply:
         self.closed = True
-        return "Disconnected"
+        return True, 0, {}
 
-    def _running(self) -> str:
-        running = self.sim.program_state != ProgramState.STOPPED
-        return f"Program running: {'true' if running else 'false'}"
+    def _shutdown(self, command: DashboardCommand) -> Reply:
+        self.sim.power_off()
+        return True, 0, {}
 
-    def _robotmode(self) -> str:
-        return f"Robotmode: {self.sim.robot_mode.name}"
+    def _running(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"bool": self.sim.program_state != ProgramState.STOPPED}
 
-    def _safetymode(self) -> str:
-        return f"Safetymode: {self.sim.safety_mode.name}"
+    def _robotmode(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"mode": self.sim.robot_mode.name}
 
-    def _safetystatus(self) -> str:
-        return f"Safetystatus: {self.sim.safety_mode.name}"
+    def _safetymode(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"mode": self.sim.safety_mode.name}
 
-    def _program_state(self) -> str:
+    def _program_state(self, command: DashboardCommand) -> Reply:
         state = self.sim.program_state
         shown = {ProgramState.STOPPING: "STOPPED", ProgramState.PAUSING: "PAUSED",
                  ProgramState.RESUMING: "PLAYING"}.get(state, state.name)
         name = self.sim.loaded_program or self.sim.program_name or "<unnamed>"
-        return f"{shown} {name}"
+        return True, 0, {"state": shown, "name": name}
 
-    def _loaded(self) -> str:
+    def _loaded(self, command: DashboardCommand) -> Reply:
         name = self.sim.loaded_program
-        return f"Loaded program: {name}" if name else "No program loaded"
+        return (True, 0, {"name": name}) if name else (True, 1, {})
 
-    def _power_on(self) -> str:
+    def _power_on(self, command: DashboardCommand) -> Reply:
         self.sim.power_on()
-        return "Powering on"
+        return True, 0, {}
 
-    def _power_off(self) -> str:
+    def _power_off(self, command: DashboardCommand) -> Reply:
         self.sim.power_off()
-        return "Powering off"
+        return True, 0, {}
 
-    def _brake_release(self) -> str:
+    def _brake_release(self, command: DashboardCommand) -> Reply:
         self.sim.brake_release()
-        return "Brake releasing"
+        return True, 0, {}
 
-    def _unlock(self) -> str:
+    def _unlock(self, command: DashboardCommand) -> Reply:
         if self.sim.unlock_protective_stop():
-            return "Protective stop releasing"
-        return ("Cannot unlock protective stop until 5s after occurrence. Always inspect cause "
-                "of protective stop before unlocking")
+            return True, 0, {}
+        return False, 0, {"text": "Always inspect cause of protective stop before unlocking"}
 
-    def _saved(self) -> str:
-        name = self.sim.loaded_program or "<unnamed>"
-        return f"true {name}"
+    def _restart_safety(self, command: DashboardCommand) -> Reply:
+        self.sim.restart_safety()
+        return True, 0, {}
 
-    def _polyscope(self) -> str:
-        return f"URSoftware {self.sim.version} (urdsl virtual controller)"
+    def _saved(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"bool": True, "name": self.sim.loaded_program or "<unnamed>"}
 
-    def _model(self) -> str:
+    def _polyscope(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"version": self.sim.version, "text": " (urdsl virtual controller)"}
+
+    def _version(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"version": self.sim.version}
+
+    def _model(self, command: DashboardCommand) -> Reply:
         name = self.sim.robot_name.upper()
-        return name[:-1] if name.endswith("E") else name
+        return True, 0, {"mode": name[:-1] if name.endswith("E") else name}
 
-    def _operational(self) -> str:
-        return self._operational_mode or "NONE"
+    def _serial(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"name": self.sim.serial_number}
 
-    def _clear_operational(self) -> str:
+    def _set_operational(self, command: DashboardCommand) -> Reply:
+        self._operational_mode = (command.argument or "").upper()
+        return True, 0, {"arg": self._operational_mode.lower()}
+
+    def _operational(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"mode": self._operational_mode or "NONE"}
+
+    def _clear_operational(self, command: DashboardCommand) -> Reply:
         self._operational_mode = None
-        return ("No longer controlling the operational mode. Current operational mode: "
-                "'none'.")
+        return True, 0, {"text": "Current operational mode: 'none'."}
+
+    def _remote(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"bool": True}  # the virtual controller is always in remote control
+
+    def _user_role(self, command: DashboardCommand) -> Reply:
+        return True, 0, {"mode": "PROGRAMMER"}
+
+    def _done(self, command: DashboardCommand) -> Reply:
+        """Commands whose answer is their one fixed text (popup, log, user role, …)."""
+        return True, 0, {}
 
 
-_COMMANDS = {
+Reply = tuple[bool, int, dict[str, Any]]
+"""A command's answer: ok, which of its documented texts, and the text's fields."""
+
+_HANDLERS: dict[str, Callable[[DashboardSession, DashboardCommand], Reply]] = {
+    "load": DashboardSession._load,
+    "load installation": DashboardSession._done,
     "play": DashboardSession._play,
     "stop": DashboardSession._stop,
     "pause": DashboardSession._pause,
     "quit": DashboardSession._quit,
-    "shutdown": lambda s: (s.sim.power_off(), "Shutting down")[1],
+    "shutdown": DashboardSession._shutdown,
     "running": DashboardSession._running,
     "robotmode": DashboardSession._robotmode,
     "safetymode": DashboardSession._safetymode,
-    "safetystatus": DashboardSession._safetystatus,
-    "programstate": DashboardSession._program_state,
+    "safetystatus": DashboardSession._safetymode,
+    "programState": DashboardSession._program_state,
     "get loaded program": DashboardSession._loaded,
     "power on": DashboardSession._power_on,
     "power off": DashboardSession._power_off,
     "brake release": DashboardSession._brake_release,
     "unlock protective stop": DashboardSession._unlock,
-    "close safety popup": lambda s: "closing safety popup",
-    "restart safety": lambda s: (s.sim.restart_safety(), "Restarting safety")[1],
-    "close popup": lambda s: "closing popup",
-    "isprogramsaved": DashboardSession._saved,
-    "polyscopeversion": DashboardSession._polyscope,
-    "version": lambda s: str(s.sim.version),
-    "get robot model": DashboardSession._model,
-    "get serial number": lambda s: s.sim.serial_number,
+    "close safety popup": DashboardSession._done,
+    "restart safety": DashboardSession._restart_safety,
+    "popup": DashboardSession._done,
+    "close popup": DashboardSession._done,
+    "addToLog": DashboardSession._done,
+    "isProgramSaved": DashboardSession._saved,
+    "PolyscopeVersion": DashboardSession._polyscope,
+    "version": DashboardSession._version,
+    "setUserRole": DashboardSession._done,
+    "getUserRole": DashboardSession._user_role,
+    "set operational mode": DashboardSession._set_operational,
     "get operational mode": DashboardSession._operational,
     "clear operational mode": DashboardSession._clear_operational,
-    "is in remote control": lambda s: "true",
-    "getuserrole": lambda s: "PROGRAMMER",
-    "savelog": lambda s: "Log saved to disk",
+    "is in remote control": DashboardSession._remote,
+    "get serial number": DashboardSession._serial,
+    "get robot model": DashboardSession._model,
+    "saveLog": DashboardSession._done,
 }
+"""What the virtual controller does for each documented command (every key of
+:data:`urdsl.protocol.dashboard.COMMANDS`)."""
+assert set(_HANDLERS) == set(COMMANDS), set(COMMANDS) ^ set(_HANDLERS)
