@@ -92,26 +92,29 @@ def _reader(plan: list[tuple[str, int, int]], body: str, with_id: bool):
     the caller then takes the general path, which names the problem).
 
     One ``struct.unpack`` of the whole package — it requires the exact length — and one
-    dict display, as a hand-written decoder would have; generated from the recipe's plan
-    (the names appear only as ``repr`` literals)."""
+    dict display, as a hand-written decoder would have; generated from the recipe's plan.
+    The generated source holds only identifiers and integers: the names (which a remote
+    client chose) are bound as default values ``k0``, ``k1``, ..., never written into it."""
     whole = struct.Struct((">HBB" if with_id else ">HB") + body)
     skip = 3 if with_id else 2
+    keys = {f"k{number}": name for number, (name, _, _) in enumerate(plan)}
     items = ", ".join(
-        f"{name!r}: flat[{skip + index}]" if count == 1
-        else f"{name!r}: flat[{skip + index}:{skip + index + count}]"
-        for name, index, count in plan)
+        f"k{number}: flat[{skip + index}]" if count == 1
+        else f"k{number}: flat[{skip + index}:{skip + index + count}]"
+        for number, (_, index, count) in enumerate(plan))
+    defaults = "".join(f", {key}={key}" for key in keys)
     source = (
-        "def read(package):\n"
+        f"def read(package{defaults}):\n"
         "    try:\n"
         "        flat = unpack(package)\n"
         "    except error:\n"
         "        return None\n"
-        f"    if flat[0] != {whole.size} or flat[1] != 85:\n"
+        f"    if flat[0] != {int(whole.size)} or flat[1] != 85:\n"
         "        return None\n"
         f"    return new(DataPackage, ({'flat[2]' if with_id else 'None'}, {{{items}}}))\n")
     namespace = {"unpack": whole.unpack, "error": struct.error, "new": tuple.__new__,
-                 "DataPackage": DataPackage}
-    exec(source, namespace)  # noqa: S102 - names are repr() literals
+                 "DataPackage": DataPackage, **keys}
+    exec(source, namespace)  # noqa: S102 - identifiers and integers only (see above)
     return namespace["read"]
 
 
