@@ -121,6 +121,14 @@ def test_join_waits_for_the_thread():
     assert result.globals["t"] == 1 and result.time == pytest.approx(0.5)
 
 
+def test_join_or_kill_of_a_thread_variable_never_run_does_nothing():
+    # UR's External Control script initialises its thread variables to 0 and joins them
+    # before any `run`; anything else that is not a handle stays a type error
+    assert value("thread_move = 0\njoin thread_move\nkill thread_move\nx = 1\n") == 1
+    assert "join needs a thread handle, not a float" in str(error("h = 1.5\njoin h\n"))
+    assert "kill needs a thread handle, not a int" in str(error("h = 2\nkill h\n"))
+
+
 def test_program_end_with_threads_running_is_reported():
     result = run("thread t():\n  while True:\n    sync()\n  end\nend\nrun t()\nsleep(0.01)\n")
     assert result.error is None and result.threads_left_running == ["t"]

@@ -468,6 +468,8 @@ class Interpreter:
         return thread.handle
 
     def join(self, handle: Any, node: n.Node) -> None:
+        if _no_thread(handle):
+            return
         if type(handle) is not ThreadHandle:
             raise self.error("type", f"join needs a thread handle, not a {type_name(handle)}",
                              node)
@@ -479,6 +481,8 @@ class Interpreter:
             self.wait_until(math.inf)
 
     def kill(self, handle: Any, node: n.Node) -> None:
+        if _no_thread(handle):
+            return
         if type(handle) is not ThreadHandle:
             raise self.error("type", f"kill needs a thread handle, not a {type_name(handle)}",
                              node)
@@ -1277,3 +1281,13 @@ def _device_reply(node: n.BinOp) -> tuple[str, object] | None:
                 and not call.keywords):
             return format_expr(call), other.value
     return None
+
+
+def _no_thread(handle: Any) -> bool:
+    """A thread variable that was never given a thread: programs initialise one to ``0`` and
+    ``join``/``kill`` it before any ``run`` — UR's own External Control script
+    (Universal_Robots_Client_Library, resources/external_control.urscript) sets
+    ``thread_move = 0`` and joins it on the first command of every session, so the
+    controller takes both as doing nothing."""
+    return type(handle) is int and handle == 0
+
