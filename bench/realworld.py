@@ -361,6 +361,12 @@ def load_runs(paths: list[Path]) -> list[Run]:
     return runs
 
 
+def hit_bound(item: Run) -> bool:
+    """Whether a check stopped at its own wall-clock bound (URS313 naming the bound)."""
+    return any(finding.get("code") == "URS313" and "wall-clock bound" in
+               finding.get("message", "") for finding in item.findings)
+
+
 def report(runs: list[Run], projects: list[Project], json_out: Path | None) -> None:
     """Match the runs' error findings against the labels and print the tables."""
     labels = read_labels()
@@ -385,9 +391,11 @@ def report(runs: list[Run], projects: list[Project], json_out: Path | None) -> N
     out += precision_table(scored, "error findings, all projects")
     out += precision_table([s for s in scored if s.split == "tune"], "tuning projects")
     out += precision_table([s for s in scored if s.split == "held"], "held-back projects")
-    out.append("wall time per run (s):")
+    out.append("wall time per run (s); 'bound' = the check stopped at its own wall-clock "
+               "bound (URS313) and says how far it got:")
     for item in runs:
         extra = f"  [{item.detail}]" if item.status in ("crash",) and item.detail else ""
+        extra += "  bound" if hit_bound(item) else ""
         out.append(f"  {item.project:>3} {item.tool:<5} {item.seconds:8.2f} {item.status:<7} "
                    f"{item.target}{extra}")
     if runs:
@@ -395,7 +403,8 @@ def report(runs: list[Run], projects: list[Project], json_out: Path | None) -> N
         out.append(f"slowest: project {slowest.project} {slowest.tool} {slowest.target} "
                    f"{slowest.seconds:.2f} s ({slowest.status}); timeouts: "
                    f"{sum(item.status == 'timeout' for item in runs)}; crashes: "
-                   f"{sum(item.status == 'crash' for item in runs)}")
+                   f"{sum(item.status == 'crash' for item in runs)}; checks that hit their "
+                   f"wall-clock bound: {sum(hit_bound(item) for item in runs)}")
     out.append(f"lost (labelled true, no longer reported): {len(lost)}")
     for label in sorted(lost, key=lambda lab: lab.key):
         out.append(f"  {label.project} {label.tool} {label.file}:{label.line} {label.code} "
