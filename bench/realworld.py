@@ -18,6 +18,10 @@ script does two things:
     (overall, tuning projects, held-back projects), the wall time of every run, the labelled-true
     findings no longer reported ("lost") and the unlabelled findings. Exit status 0.
 
+``score SAVED.json... [--tune|--held|--all] [--project ID]``
+    Match runs saved with ``run --json`` against the labels again and print the same tables
+    (after labelling, or to combine runs made with different code or at different times).
+
 Run: ``.venv/bin/python bench/realworld.py run --root /path/to/extracted --all``.
 Not part of the tests.
 """
@@ -328,7 +332,6 @@ def precision_table(scored: list[Scored], title: str) -> list[str]:
 
 def run(projects: list[Project], root: Path, timeout: float, json_out: Path | None,
         tools: tuple[str, ...]) -> None:
-    labels = read_labels()
     runs: list[Run] = []
     for project in projects:
         if not (root / project.id).is_dir():
@@ -344,7 +347,31 @@ def run(projects: list[Project], root: Path, timeout: float, json_out: Path | No
                 runs.append(check_file(project, root, script, timeout))
                 print(f"  {project.id} check {runs[-1].target} {runs[-1].seconds:7.2f} s "
                       f"{runs[-1].status}", file=sys.stderr)
+    report(runs, projects, json_out)
+
+
+def load_runs(paths: list[Path]) -> list[Run]:
+    """The runs saved by ``run --json`` (several files: their runs one after another)."""
+    runs: list[Run] = []
+    for path in paths:
+        document = json.loads(path.read_text(encoding="utf-8"))
+        for item in document["runs"]:
+            runs.append(Run(item["project"], item["tool"], item["target"], item["seconds"],
+                            item["status"], item.get("detail", ""), item.get("findings", [])))
+    return runs
+
+
+def hit_bound(item: Run) -> bool:
+    """Whether a check stopped at its own wall-clock bound (URS313 naming the bound)."""
+    return any(finding.get("code") == "URS313" and "wall-clock bound" in
+               finding.get("message", "") for finding in item.findings)
+
+
+def report(runs: list[Run], projects: list[Project], json_out: Path | None) -> None:
+    """Match the runs' error findings against the labels and print the tables."""
+    labels = read_labels()
     split_of = {project.id: project.split for project in projects}
+    runs = [item for item in runs if item.project in split_of]
     scored: list[Scored] = []
     for item in runs:
         for finding in item.findings:
@@ -364,9 +391,11 @@ def run(projects: list[Project], root: Path, timeout: float, json_out: Path | No
     out += precision_table(scored, "error findings, all projects")
     out += precision_table([s for s in scored if s.split == "tune"], "tuning projects")
     out += precision_table([s for s in scored if s.split == "held"], "held-back projects")
-    out.append("wall time per run (s):")
+    out.append("wall time per run (s); 'bound' = the check stopped at its own wall-clock "
+               "bound (URS313) and says how far it got:")
     for item in runs:
         extra = f"  [{item.detail}]" if item.status in ("crash",) and item.detail else ""
+        extra += "  bound" if hit_bound(item) else ""
         out.append(f"  {item.project:>3} {item.tool:<5} {item.seconds:8.2f} {item.status:<7} "
                    f"{item.target}{extra}")
     if runs:
@@ -374,7 +403,8 @@ def run(projects: list[Project], root: Path, timeout: float, json_out: Path | No
         out.append(f"slowest: project {slowest.project} {slowest.tool} {slowest.target} "
                    f"{slowest.seconds:.2f} s ({slowest.status}); timeouts: "
                    f"{sum(item.status == 'timeout' for item in runs)}; crashes: "
-                   f"{sum(item.status == 'crash' for item in runs)}")
+                   f"{sum(item.status == 'crash' for item in runs)}; checks that hit their "
+                   f"wall-clock bound: {sum(hit_bound(item) for item in runs)}")
     out.append(f"lost (labelled true, no longer reported): {len(lost)}")
     for label in sorted(lost, key=lambda lab: lab.key):
         out.append(f"  {label.project} {label.tool} {label.file}:{label.line} {label.code} "
@@ -422,6 +452,16 @@ def main(argv: list[str] | None = None) -> int:
     p_run.add_argument("--timeout", type=float, default=120.0,
                        help="wall-clock limit per lint or check run in s (default 120)")
     p_run.add_argument("--json", type=Path, help="also write everything as JSON here")
+    p_score = commands.add_parser("score", help="match saved runs (run --json) against the "
+                                  "labels again, without running anything")
+    p_score.add_argument("saved", type=Path, nargs="+", help="JSON files written by run --json")
+    group = p_score.add_mutually_exclusive_group()
+    group.add_argument("--tune", action="store_true", help="only the tuning projects")
+    group.add_argument("--held", action="store_true", help="only the held-back projects")
+    group.add_argument("--all", action="store_true", help="every project (default)")
+    p_score.add_argument("--project", action="append", default=[], metavar="ID",
+                         help="only this project (repeatable)")
+    p_score.add_argument("--json", type=Path, help="also write everything as JSON here")
     args = parser.parse_args(argv)
 
     projects = read_manifest()
@@ -434,6 +474,9 @@ def main(argv: list[str] | None = None) -> int:
         return 1 if failures else 0
     if args.project:
         projects = [p for p in projects if p.id in args.project]
+    if args.command == "score":
+        report(load_runs(args.saved), projects, args.json)
+        return 0
     run(projects, args.root, args.timeout, args.json, tuple(args.tool or ("lint", "check")))
     return 0
 

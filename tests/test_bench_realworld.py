@@ -4,6 +4,7 @@ from a git directory (no network), and scoring matches findings to labels."""
 from __future__ import annotations
 
 import importlib.util
+import json
 import shutil
 import subprocess
 import sys
@@ -91,3 +92,22 @@ def test_precision_counts_labelled_true_and_false_and_leaves_the_rest_unlabelled
               rw.Scored("1", "tune", "lint", "a.script", 5, "URS101", "", None)]
     table = "\n".join(rw.precision_table(scored, "t"))
     assert "URS101        3     1     1     1     50.0%" in table
+
+
+def test_score_matches_saved_runs_against_the_labels_without_running(tmp_path, capsys):
+    """``score`` reads what ``run --json`` saved and matches it against labels.tsv again."""
+    finding = {"file": "pwm_control.script", "line": 24, "code": "URS101",
+               "severity": "error", "message": "name 'aj' is not defined"}
+    other = dict(finding, line=9999)  # no label: counted as unlabelled
+    warning = dict(finding, line=25, severity="warning")  # not an error: not scored
+    saved = tmp_path / "runs.json"
+    saved.write_text(json.dumps({"runs": [
+        {"project": "35", "tool": "lint", "target": ".", "seconds": 1.0, "status": "ok",
+         "findings": [finding, other, warning]},
+        {"project": "2", "tool": "lint", "target": ".", "seconds": 1.0, "status": "ok",
+         "findings": [finding]}]}))
+    assert rw.main(["score", str(saved), "--project", "35"]) == 0
+    out = capsys.readouterr().out
+    assert "  lint   URS101        2     1     0     1    100.0%" in out
+    assert "unlabelled error findings: 1" in out
+    assert "35\tlint\tpwm_control.script\t9999\tURS101" in out

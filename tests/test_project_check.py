@@ -138,3 +138,15 @@ def test_a_global_given_a_value_in_a_loop_is_run_first_when_it_can_be(tmp_path, 
     assert status == 1
     assert report["findings"][0]["message"] == "name 'shifted' is not defined"
     assert "gives shifted a value only inside a function or loop" in report["context"]
+
+
+def test_a_name_the_controller_may_define_is_taken_from_the_project(tmp_path, capsys):
+    """``pi`` may be a controller variable [U]; a project that assigns it in a sibling file
+    gives the globals that use it their value (a hand-written library of globals)."""
+    (tmp_path / "globals.script").write_text(
+        "global pi = 3.14159265359\nglobal down = [pi, 0, -pi/2]\n")
+    (tmp_path / "main.script").write_text("textmsg(down)\n")
+    status, report = check(capsys, str(tmp_path / "main.script"))
+    assert status == 0, report["findings"]
+    assert report["findings"] == []
+    assert "pi" in report["context"] and "down" in report["context"]

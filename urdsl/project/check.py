@@ -41,7 +41,7 @@ class CheckContext:
 def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
     """``(variables, functions, threads)`` that ``module`` uses without defining them
     (builtins excluded)."""
-    from ..lint.scope import analyse
+    from ..lint.scope import BUILTIN_VARIABLES, analyse
     from ..script.builtins import lookup
 
     try:
@@ -53,7 +53,10 @@ def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
     threads: set[str] = set()
     for scope in analysis.scopes:
         for name in scope.reads:
-            if not analysis.defined(name.id, scope):
+            # a name the controller may define itself (``pi``, [U]) is still looked up in the
+            # project: a project that assigns it gives it the value the file reads
+            if not analysis.defined(name.id, scope) or (
+                    name.id in BUILTIN_VARIABLES and not _bound_in_file(analysis, name.id, scope)):
                 reads.add(name.id)
         for call in scope.calls:
             name = call.func.id  # type: ignore[union-attr]
@@ -65,6 +68,17 @@ def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
             if run.thread not in analysis.threads:
                 threads.add(run.thread)
     return reads, calls, threads
+
+
+def _bound_in_file(analysis, name: str, scope) -> bool:
+    """Whether reading ``name`` in ``scope`` finds a variable, function or thread of the file
+    itself (the controller's own variables not counted)."""
+    current = scope
+    while current is not None:
+        if current.binds(name):
+            return True
+        current = current.parent
+    return name in analysis.globals or name in analysis.functions or name in analysis.threads
 
 
 def _alone(statement: n.Stmt) -> n.Module:
