@@ -1027,7 +1027,17 @@ class _Compiler:
         files have none: the Direction's own acceleration)."""
         decel = float(until.attrs.get("decelerationAcceleration",
                                       accel if accel is not None else 3.0))
-        retraction = float(until.attrs.get("retraction", "0.0"))
+        retraction_text = until.attrs.get("retraction", "0.0")
+        if retraction_text == "NONE":  # no retraction: stop where the contact was found
+            return [
+                Declare("local", "targetTcpDirection", _call("get_target_tcp_speed")),
+                Declare("local", "stepsToRetract", Call(Name("tool_contact"), (), (
+                    Keyword("direction", Name("targetTcpDirection")),))),
+                If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), (
+                    Kill(Name(handle)), _stmt("stopl", _num(decel)),
+                    self.marker(until, "Until (tool_contact_detection)"),
+                    *self.block(until.children), Break()))]
+        retraction = float(retraction_text)
         direction = Name("targetTcpDirection")
         normalized = Name("normalizedPosDir")
         retract = Pose(tuple(BinOp("*", Index(normalized, (Number(i),)), _num(retraction))
