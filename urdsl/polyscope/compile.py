@@ -739,7 +739,16 @@ class _Compiler:
             raise self.error(node, f"the I/O {pin!r} is not named in the installation")
         return match.group(1), int(match.group(2))
 
+    def modbus_signal(self, pin: str):
+        """The installation's Modbus signal named ``pin`` (None when there is none)."""
+        for signal in getattr(self.installation, "modbus", ()) or ():
+            if signal.name == pin:
+                return signal
+        return None
+
     def pin_read(self, pin: str, node: Node) -> Expr:
+        if pin not in self.pins and self.modbus_signal(pin) is not None:
+            return _call("modbus_get_signal_status", String(pin))
         kind, index = self.resolve_pin(pin, node)
         function = _GET_FUNCTIONS.get(kind)
         if function is None:
@@ -763,9 +772,31 @@ class _Compiler:
             value = float(str(node.fields.get("analogValue", "0")))
             return [self.marker(node, f"Set {self.pin_label(pin)}={value}"),
                     _stmt("set_standard_analog_out", Number(index), _num(value))]
+        if kind == "ExpressionOutput":
+            return self.set_expression(node)
         if kind == "NoAction":
             return [self.marker(node, "Set")]
         return self.n_unknown(node)
+
+    def set_expression(self, node: Node) -> list[Item]:
+        """A Set node whose output takes an expression's value: a Modbus output signal
+        (``modbus_set_output_signal``, as PolyScope writes it), else the output's set
+        function with the expression (a form inferred, not yet seen [U])."""
+        pin = str(node.fields.get("pin"))
+        expression = node.fields["expression"]
+        value = self.expr(self.script_of(expression, node), node)
+        label = f"Set {self.pin_label(pin)}={expression.label}"
+        signal = self.modbus_signal(pin) if pin not in self.pins else None
+        if signal is not None:
+            if signal.kind != "DIGITAL_OUTPUT":
+                return self.n_unknown(node)
+            return [self.marker(node, label),
+                    _stmt("modbus_set_output_signal", String(pin), value)]
+        bank, index = self.resolve_pin(pin, node)
+        function = _SET_FUNCTIONS.get(bank)
+        if function is None:
+            raise self.error(node, f"cannot set the I/O {pin!r}")
+        return [self.marker(node, label), _stmt(function, Number(index), value)]
 
     def n_Assignment(self, node: Node) -> list[Item]:
         expression = node.fields["expression"]
@@ -1164,14 +1195,15 @@ class _Compiler:
                                     tuple(Keyword(k, v) for k, v in keywords)))
         untils = [child for child in node.children
                   if child.kind == "Until" and not child.suppressed]
+        tcp = self.move_tcp(move, node)
         if not untils:
-            return [self.marker(node, label, "breakAfter"), motion_call]
+            return [self.marker(node, label, "breakAfter"), *tcp, motion_call]
         # a waypoint with Until conditions: the move runs in a thread the conditions end
         number = self.number(node)
         flag, thread, handle = (f"move_thread_flag_{number}", f"move_thread_{number}",
                                 f"move_thread_han_{number}")
         accel = dict(keywords).get("a")
-        return [self.marker(node, label, "breakAfter"),
+        return [self.marker(node, label, "breakAfter"), *tcp,
                 Declare("global", flag, Number(0)),
                 ThreadDef(thread, (EnterCritical(), Assign(Name(flag), Number(1)), motion_call,
                                    Assign(Name(flag), Number(2)), ExitCritical())),
@@ -1179,6 +1211,25 @@ class _Compiler:
                 Assign(Name(handle), Run(thread)),
                 self.until_loop(untils, flag, handle,
                                 accel.value if isinstance(accel, Number) else None)]
+
+    def move_tcp(self, move: Node, waypoint: Node) -> list[Item]:
+        """``set_tcp`` before a waypoint's motion when its move names its own TCP
+        (``useActiveTCP="false"`` with a ``<tcp>``): the installation's offset of that TCP
+        (m, rad), else the offset the waypoint was taught with. A move that ignores the
+        TCP (no ``<tcp>``) writes nothing."""
+        if move.attrs.get("useActiveTCP") != "false" or not move.fields.get("tcp") or \
+                move.attrs.get("positionType") == "JointAngles":
+            return []  # a move to joint angles does not need the TCP
+        name = str(move.fields["tcp"])
+        offset = None
+        for tcp in getattr(self.installation, "tcps", ()) or ():
+            if tcp.name == name:
+                offset = tcp.offset
+        if offset is None:
+            offset = waypoint.fields.get("tcp_offset")
+        if not offset or len(offset) != 6:
+            return []
+        return [_stmt("set_tcp", Pose(tuple(_num(v) for v in offset)))]
 
     def motion_keywords(self, move: Node, waypoint: Node) -> list[tuple[str, Expr]]:
         params = waypoint.fields.get("params") or {}
