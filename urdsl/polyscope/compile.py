@@ -402,11 +402,11 @@ class _Compiler:
         timers: list[str] = []
         direction_helper = False
         for node in self._all_nodes(suppressed=True):
+            if node.suppressed:
+                continue
             if node.kind == "Direction" and not direction_helper:
                 direction_helper = True  # PolyScope defines it where the first one is
                 body.extend(_direction_helper())
-            if node.suppressed:
-                continue
             if node.kind == "Waypoint" and node.fields.get("type") in ("Fixed", "Relative"):
                 if (node.name or "Waypoint") not in self.waypoints:
                     self.waypoints[node.name or "Waypoint"] = node
@@ -420,6 +420,9 @@ class _Compiler:
             body.extend(self.node(program.before_start))
         for thread in program.threads:
             body.extend(self.thread(thread))
+        events = [node for node in program.others if node.kind == "Event" and not node.suppressed]
+        for index, event in enumerate(events):
+            body.extend(self.event(event, index))
         main = self.node(program.main)
         if program.main.attrs.get("runOnlyOnce") == "true":
             body.extend(main)
@@ -875,6 +878,22 @@ class _Compiler:
             body = [While(Paren(Bool(True)), tuple(body))]
         return [self.marker(node, name), ThreadDef(name, tuple(body)),
                 Assign(Name(f"threadId_{name}"), Run(name))]
+
+    def event(self, node: Node, index: int) -> list[Item]:
+        """An Event node: a thread that runs its children each time its expression holds
+        (checked every control cycle). The node itself has no marker. PolyScope names the
+        thread ``EventThread`` (a second event's name, ``EventThread_2``, is inferred [U]);
+        it is started after the threads, before the Robot Program (seen with no thread
+        or BeforeStart in the program [U])."""
+        suffix = f"_{index + 1}" if index else ""
+        expression = node.fields.get("expression")
+        if not isinstance(expression, Expression) or not expression:
+            return [Comment(" urdsl: an Event without an expression is not compiled")]
+        test = self.expr(self.script_of(expression, node), node)
+        loop = While(Paren(Bool(True)), (If(Paren(test), tuple(self.block(node.children))),
+                                         _stmt("sync")))
+        return [ThreadDef(f"EventThread{suffix}", (loop,)),
+                Assign(Name(f"eventThread{suffix}"), Run(f"EventThread{suffix}"))]
 
     def n_Loop(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")

@@ -600,9 +600,13 @@ def _call(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
         node.fields["subprogram"] = reader.node(target, None)
 
 
+def _event(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
 _FIELDS = {
     "Move": _move, "Waypoint": _waypoint, "Loop": _loop, "If": _if, "Wait": _wait,
     "Set": _set, "Assignment": _assignment, "Script": _script, "Popup": _popup,
     "Comment": _comment, "Timer": _timer, "Direction": _direction, "Force": _force,
-    "SubProgram": _subprogram, "CallSubProgram": _call,
+    "SubProgram": _subprogram, "CallSubProgram": _call, "Event": _event,
 }
