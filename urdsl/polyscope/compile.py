@@ -421,8 +421,7 @@ class _Compiler:
         for thread in program.threads:
             body.extend(self.thread(thread))
         events = [node for node in program.others if node.kind == "Event" and not node.suppressed]
-        for index, event in enumerate(events):
-            body.extend(self.event(event, index))
+        body.extend(self.event_thread(events))
         main = self.node(program.main)
         if program.main.attrs.get("runOnlyOnce") == "true":
             body.extend(main)
@@ -879,21 +878,26 @@ class _Compiler:
         return [self.marker(node, name), ThreadDef(name, tuple(body)),
                 Assign(Name(f"threadId_{name}"), Run(name))]
 
-    def event(self, node: Node, index: int) -> list[Item]:
-        """An Event node: a thread that runs its children each time its expression holds
-        (checked every control cycle). The node itself has no marker. PolyScope names the
-        thread ``EventThread`` (a second event's name, ``EventThread_2``, is inferred [U]);
-        it is started after the threads, before the Robot Program (seen with no thread
-        or BeforeStart in the program [U])."""
-        suffix = f"_{index + 1}" if index else ""
-        expression = node.fields.get("expression")
-        if not isinstance(expression, Expression) or not expression:
-            return [Comment(" urdsl: an Event without an expression is not compiled")]
-        test = self.expr(self.script_of(expression, node), node)
-        loop = While(Paren(Bool(True)), (If(Paren(test), tuple(self.block(node.children))),
-                                         _stmt("sync")))
-        return [ThreadDef(f"EventThread{suffix}", (loop,)),
-                Assign(Name(f"eventThread{suffix}"), Run(f"EventThread{suffix}"))]
+    def event_thread(self, events: list[Node]) -> list[Item]:
+        """The Event nodes: one thread, ``EventThread``, checks their expressions in file
+        order every control cycle and runs the children of the first that holds (an
+        ``if``/``elif`` chain). The Event nodes have no marker. It is started after the
+        threads, before the Robot Program (seen only in programs without threads or
+        BeforeStart [U])."""
+        tests: list[tuple[Expr, tuple[Item, ...]]] = []
+        for node in events:
+            expression = node.fields.get("expression")
+            if not isinstance(expression, Expression) or not expression:
+                raise self.error(node, "the Event has no expression (PolyScope shows it as "
+                                       "not defined and will not run the program)")
+            tests.append((Paren(self.expr(self.script_of(expression, node), node)),
+                          tuple(self.block(node.children))))
+        if not tests:
+            return []
+        (first, body), *rest = tests
+        chain = If(first, body, tuple(Elif(test, inner) for test, inner in rest))
+        return [ThreadDef("EventThread", (While(Paren(Bool(True)), (chain, _stmt("sync"))),)),
+                Assign(Name("eventThread"), Run("EventThread"))]
 
     def n_Loop(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
