@@ -758,6 +758,14 @@ class _Compiler:
         return _call(function, Number(index))
 
     def n_Set(self, node: Node) -> list[Item]:
+        """A Set node: its action (an output), then the TCP it selects (``set_tcp``), as
+        PolyScope writes them."""
+        items = self.set_action(node)
+        if node.fields.get("tcp"):
+            items.extend(self.set_tcp(str(node.fields["tcp"])))
+        return items
+
+    def set_action(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
         if kind == "DigitalOutput":
             pin = str(node.fields.get("pin"))
@@ -773,12 +781,25 @@ class _Compiler:
             bank, index = self.resolve_pin(pin, node)
             value = float(str(node.fields.get("analogValue", "0")))
             return [self.marker(node, f"Set {self.pin_label(pin)}={value}"),
-                    _stmt("set_standard_analog_out", Number(index), _num(value))]
+                    _stmt("set_standard_analog_out", Number(index),
+                          _num(value / self.analog_full_scale(index)))]
         if kind == "ExpressionOutput":
             return self.set_expression(node)
         if kind == "NoAction":
             return [self.marker(node, "Set")]
         return self.n_unknown(node)
+
+    def analog_full_scale(self, index: int) -> float:
+        """What an analog output's value (as the Set node stores it: V, or mA) is at the
+        ratio 1 that ``set_standard_analog_out`` takes: 10 V in the voltage domain (seen);
+        20 mA in the current domain [U]. The domain is the installation's
+        (``IOs/analogOutputDomain``: 0 current, 1 voltage); voltage when it is unknown [U]."""
+        settings = (getattr(self.installation, "settings", None) or {})
+        text = settings.get("IOs/analogOutputDomain", {}).get("value", "")
+        domains = [part.strip() for part in text.split(",")]
+        if index < len(domains) and domains[index] == "0":
+            return 20.0
+        return 10.0
 
     def set_expression(self, node: Node) -> list[Item]:
         """A Set node whose output takes an expression's value: a Modbus output signal
@@ -994,19 +1015,34 @@ class _Compiler:
             label = f"Direction: {frame}"
         else:
             return self.n_unknown(node)
-        if frame == "Tool":
-            feature_pose: Expr = _call("get_forward_kin")
+        variable_feature = node.fields.get("feature_name")
+        if variable_feature:
+            # a variable feature: its pose in the installation, written in place (seen); its
+            # name when the installation does not have it [U]
+            poses = dict(getattr(self.installation, "features", ()) or ())
+            pose = poses.get(str(variable_feature))
+            feature_pose: Expr = Pose(tuple(_num(v) for v in pose)) if pose else \
+                Name(str(variable_feature))
+            label = label.replace(f"{frame} ", f"{variable_feature} ", 1)
+        elif frame == "Tool":
+            feature_pose = _call("get_forward_kin")
         elif frame == "Base":
             feature_pose = Pose(tuple(_num(0.0) for _ in range(6)))
         else:
             feature_pose = Name(frame)
         untils = [child for child in node.children if child.kind == "Until"]
         distance = 1000.0
+        blend = 0.0
         for until in untils:
             if until.attrs.get("type") == "DISTANCE" and until.element is not None:
                 text = until.element.findtext("Distance")
                 if text:
                     distance = float(text)
+                params = until.element.find("motionParameters")
+                radius = _floats_or_none(params.get("blendRadius")) if params is not None \
+                    else None
+                if radius and radius[0] > 0:
+                    blend = radius[0]  # the move blends into what follows the distance
         speed = move.fields.get("speed") if move is not None else None
         accel = move.fields.get("acceleration") if move is not None else None
         params = _floats_or_none(node.attrs.get("toolParams"))
@@ -1019,6 +1055,8 @@ class _Compiler:
             keywords.append(Keyword("a", _num(accel)))
         if speed is not None:
             keywords.append(Keyword("v", _num(speed)))
+        if blend > 0:
+            keywords.append(Keyword("r", _num(blend)))
         thread_body: tuple[Item, ...] = (
             EnterCritical(),
             Assign(Name(flag), Number(1)),
@@ -1243,13 +1281,18 @@ class _Compiler:
         if move.attrs.get("useActiveTCP") != "false" or not move.fields.get("tcp") or \
                 move.attrs.get("positionType") == "JointAngles":
             return []  # a move to joint angles does not need the TCP
-        name = str(move.fields["tcp"])
+        return self.set_tcp(str(move.fields["tcp"]), waypoint.fields.get("tcp_offset"))
+
+    def set_tcp(self, name: str, taught=None) -> list[Item]:
+        """``set_tcp`` of the installation's TCP ``name`` (offset in the flange frame: m,
+        rad), else of ``taught`` (the offset a waypoint was taught with); nothing when
+        neither is known."""
         offset = None
         for tcp in getattr(self.installation, "tcps", ()) or ():
             if tcp.name == name:
                 offset = tcp.offset
         if offset is None:
-            offset = waypoint.fields.get("tcp_offset")
+            offset = taught
         if not offset or len(offset) != 6:
             return []
         return [_stmt("set_tcp", Pose(tuple(_num(v) for v in offset)))]

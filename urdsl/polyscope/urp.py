@@ -567,7 +567,10 @@ def _comment(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
 def _direction(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     feature = element.find("feature")
     if feature is not None:
-        node.fields["feature"] = reader.resolve(feature).get("referencedName")
+        feature = reader.resolve(feature)
+        node.fields["feature"] = feature.get("referencedName")
+        if feature.get("referencedName") is None and feature.get("featureName"):
+            node.fields["feature_name"] = feature.get("featureName")  # a variable feature
     node.fields["expression"] = reader.expression(element.find("expression"))
 
 
