@@ -435,8 +435,7 @@ class _Compiler:
     def _all_nodes(self, suppressed: bool = False):
         """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
         them has ``suppressed`` set)."""
-        roots = [self.program.before_start, self.program.main, *self.program.threads,
-                 *self.program.subprograms]
+        roots = [node for node in self.program.top if node is not self.program.init_variables]
         for root in roots:
             if root is None:
                 continue
@@ -1041,8 +1040,9 @@ class _Compiler:
                 params = until.element.find("motionParameters")
                 radius = _floats_or_none(params.get("blendRadius")) if params is not None \
                     else None
-                if radius and radius[0] > 0:
-                    blend = radius[0]  # the move blends into what follows the distance
+                if radius and radius[0] > 0 and until.attrs.get("distanceNodeType") == "BLEND":
+                    blend = radius[0]  # the move blends into what follows (a STOP keeps
+                    # the radius it had when it was a blend, but does not write it)
         speed = move.fields.get("speed") if move is not None else None
         accel = move.fields.get("acceleration") if move is not None else None
         params = _floats_or_none(node.attrs.get("toolParams"))
