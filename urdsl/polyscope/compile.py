@@ -654,6 +654,10 @@ class _Compiler:
             feature = move.fields.get("feature")
             if feature and feature not in _BASE_FEATURES:
                 target = _call("pose_trans", Name(str(feature)), target)
+            elif self.version < 5:
+                # PolyScope 3 writes a variable waypoint in the base as relative to the
+                # base's pose too (seen once, saved by 3.15)
+                target = _call("pose_trans", Pose(tuple(_num(0.0) for _ in range(6))), target)
             return target
         return self.in_variable_feature(node, move, self.fixed_values(node)[0])
 
@@ -1229,10 +1233,7 @@ class _Compiler:
         motion = str(move.fields.get("motion_type", "MoveJ"))
         if kind == "Variable":
             variable = str(node.fields.get("variable") or name)
-            target: Expr = Name(variable)
-            feature = move.fields.get("feature")
-            if feature and feature not in _BASE_FEATURES:
-                target = _call("pose_trans", Name(str(feature)), target)
+            target: Expr = self.target_of(node, move)
             label = variable
         elif kind == "Fixed":
             label = name
