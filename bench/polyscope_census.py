@@ -82,7 +82,7 @@ def node_variant(node: Node) -> str:
     """A node's variant: its choosing attributes' values, other attribute names, child
     element tags (a Waypoint's ``position`` children too)."""
     choosing = [f"{key}={node.attrs[key]}" for key in CHOOSING if key in node.attrs]
-    others = sorted(key for key in node.attrs if key not in CHOOSING)
+    others = sorted(key for key in node.attrs if key not in CHOOSING and key != "class")
     tags: list[str] = []
     if node.element is not None:
         for child in node.element:
@@ -96,7 +96,7 @@ def node_variant(node: Node) -> str:
                 tag += "[ref]"
             if tag not in tags:
                 tags.append(tag)
-    out = " ".join(choosing)
+    out = ("(suppressed) " if node.suppressed else "") + " ".join(choosing)
     if others:
         out += " @" + ",".join(others)
     if tags:
@@ -131,10 +131,21 @@ def installation_variant(data: bytes) -> dict[str, str] | None:
         facts["payloads"] = "toolPayload (3.x)"
     else:
         facts["payloads"] = "none"
-    kinds = collections.Counter(el.get("class", el.tag).rsplit(".", 1)[-1]
-                                for el in root.iter() if el.tag in ("feature", "Feature",
-                                                                   "GeomFeature"))
-    facts["features"] = ",".join(sorted(kinds)) or "none"
+    kinds: set[str] = set()
+    block = root.find("Features")
+    for wrapper in block if block is not None else ():
+        for element in wrapper:
+            if element.get("name") and element.get("hiddenSubFeature") != "true":
+                variable = "variable" if element.get("isVariable") == "true" else "fixed"
+                kinds.add(f"{element.tag.removeprefix('Geom').removesuffix('Node')} "
+                          f"({variable})")
+    facts["features"] = ", ".join(sorted(kinds)) or "none"
+    if tcps is not None:
+        urcap = sum(1 for tcp in tcps.iter("tcp") if tcp.find("ContributorInfo") is not None)
+        facts["URCap TCPs"] = str(urcap)
+    inertia = payloads is not None and any(p.get("inertiaParameters")
+                                           for p in payloads.iter("Payload"))
+    facts["payload inertia"] = "yes" if inertia else "no"
     comm = root.find(".//ToolCommSettings")
     facts["tool I/O"] = "ToolCommSettings" if comm is not None else (
         "toolOutputVoltage only" if root.find(".//*[@toolOutputVoltage]") is not None
