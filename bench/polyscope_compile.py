@@ -41,7 +41,8 @@ Pairs whose installation is not in the repository cannot have an exact preamble:
 counted, and the exact share is given over all pairs and over those with their
 installation.
 
-Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back),
+Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back;
+``extra``: projects found later, used to find the variants the tune pairs lack),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most. ``--show N`` prints the first differing lines of N programs.
 """
