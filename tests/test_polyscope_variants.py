@@ -244,3 +244,12 @@ def test_polyscope3_variable_waypoint_in_the_base():
           </children>
         </Move>""", version="3.15.8")
     assert "movel(pose_trans(p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], setp), a=0.1, v=2.0)" in lines
+
+
+def test_urscript_saved_as_urp_is_named_as_such():
+    from urdsl.polyscope.urp import UrpError
+
+    with pytest.raises(UrpError, match="not a PolyScope program but URScript text"):
+        parse_urp(b"textmsg(get_actual_joint_positions())\nsleep(0.5)\n", "main_cycle.urp")
+    with pytest.raises(UrpError, match="not well-formed XML"):
+        parse_urp(b"textmsg(1\n", "broken.urp")
