@@ -402,11 +402,11 @@ class _Compiler:
         timers: list[str] = []
         direction_helper = False
         for node in self._all_nodes(suppressed=True):
+            if node.suppressed:
+                continue
             if node.kind == "Direction" and not direction_helper:
                 direction_helper = True  # PolyScope defines it where the first one is
                 body.extend(_direction_helper())
-            if node.suppressed:
-                continue
             if node.kind == "Waypoint" and node.fields.get("type") in ("Fixed", "Relative"):
                 if (node.name or "Waypoint") not in self.waypoints:
                     self.waypoints[node.name or "Waypoint"] = node
@@ -420,6 +420,8 @@ class _Compiler:
             body.extend(self.node(program.before_start))
         for thread in program.threads:
             body.extend(self.thread(thread))
+        events = [node for node in program.others if node.kind == "Event" and not node.suppressed]
+        body.extend(self.event_thread(events))
         main = self.node(program.main)
         if program.main.attrs.get("runOnlyOnce") == "true":
             body.extend(main)
@@ -433,8 +435,7 @@ class _Compiler:
     def _all_nodes(self, suppressed: bool = False):
         """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
         them has ``suppressed`` set)."""
-        roots = [self.program.before_start, self.program.main, *self.program.threads,
-                 *self.program.subprograms]
+        roots = [node for node in self.program.top if node is not self.program.init_variables]
         for root in roots:
             if root is None:
                 continue
@@ -653,6 +654,10 @@ class _Compiler:
             feature = move.fields.get("feature")
             if feature and feature not in _BASE_FEATURES:
                 target = _call("pose_trans", Name(str(feature)), target)
+            elif self.version < 5:
+                # PolyScope 3 writes a variable waypoint in the base as relative to the
+                # base's pose too (seen once, saved by 3.15)
+                target = _call("pose_trans", Pose(tuple(_num(0.0) for _ in range(6))), target)
             return target
         return self.in_variable_feature(node, move, self.fixed_values(node)[0])
 
@@ -739,7 +744,16 @@ class _Compiler:
             raise self.error(node, f"the I/O {pin!r} is not named in the installation")
         return match.group(1), int(match.group(2))
 
+    def modbus_signal(self, pin: str):
+        """The installation's Modbus signal named ``pin`` (None when there is none)."""
+        for signal in getattr(self.installation, "modbus", ()) or ():
+            if signal.name == pin:
+                return signal
+        return None
+
     def pin_read(self, pin: str, node: Node) -> Expr:
+        if pin not in self.pins and self.modbus_signal(pin) is not None:
+            return _call("modbus_get_signal_status", String(pin))
         kind, index = self.resolve_pin(pin, node)
         function = _GET_FUNCTIONS.get(kind)
         if function is None:
@@ -747,6 +761,14 @@ class _Compiler:
         return _call(function, Number(index))
 
     def n_Set(self, node: Node) -> list[Item]:
+        """A Set node: its action (an output), then the TCP it selects (``set_tcp``), as
+        PolyScope writes them."""
+        items = self.set_action(node)
+        if node.fields.get("tcp"):
+            items.extend(self.set_tcp(str(node.fields["tcp"])))
+        return items
+
+    def set_action(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
         if kind == "DigitalOutput":
             pin = str(node.fields.get("pin"))
@@ -762,10 +784,45 @@ class _Compiler:
             bank, index = self.resolve_pin(pin, node)
             value = float(str(node.fields.get("analogValue", "0")))
             return [self.marker(node, f"Set {self.pin_label(pin)}={value}"),
-                    _stmt("set_standard_analog_out", Number(index), _num(value))]
+                    _stmt("set_standard_analog_out", Number(index),
+                          _num(value / self.analog_full_scale(index)))]
+        if kind == "ExpressionOutput":
+            return self.set_expression(node)
         if kind == "NoAction":
             return [self.marker(node, "Set")]
         return self.n_unknown(node)
+
+    def analog_full_scale(self, index: int) -> float:
+        """What an analog output's value (as the Set node stores it: V, or mA) is at the
+        ratio 1 that ``set_standard_analog_out`` takes: 10 V in the voltage domain (seen);
+        20 mA in the current domain [U]. The domain is the installation's
+        (``IOs/analogOutputDomain``: 0 current, 1 voltage); voltage when it is unknown [U]."""
+        settings = (getattr(self.installation, "settings", None) or {})
+        text = settings.get("IOs/analogOutputDomain", {}).get("value", "")
+        domains = [part.strip() for part in text.split(",")]
+        if index < len(domains) and domains[index] == "0":
+            return 20.0
+        return 10.0
+
+    def set_expression(self, node: Node) -> list[Item]:
+        """A Set node whose output takes an expression's value: a Modbus output signal
+        (``modbus_set_output_signal``, as PolyScope writes it), else the output's set
+        function with the expression (a form inferred, not yet seen [U])."""
+        pin = str(node.fields.get("pin"))
+        expression = node.fields["expression"]
+        value = self.expr(self.script_of(expression, node), node)
+        label = f"Set {self.pin_label(pin)}={expression.label}"
+        signal = self.modbus_signal(pin) if pin not in self.pins else None
+        if signal is not None:
+            if signal.kind != "DIGITAL_OUTPUT":
+                return self.n_unknown(node)
+            return [self.marker(node, label),
+                    _stmt("modbus_set_output_signal", String(pin), value)]
+        bank, index = self.resolve_pin(pin, node)
+        function = _SET_FUNCTIONS.get(bank)
+        if function is None:
+            raise self.error(node, f"cannot set the I/O {pin!r}")
+        return [self.marker(node, label), _stmt(function, Number(index), value)]
 
     def n_Assignment(self, node: Node) -> list[Item]:
         expression = node.fields["expression"]
@@ -844,6 +901,27 @@ class _Compiler:
             body = [While(Paren(Bool(True)), tuple(body))]
         return [self.marker(node, name), ThreadDef(name, tuple(body)),
                 Assign(Name(f"threadId_{name}"), Run(name))]
+
+    def event_thread(self, events: list[Node]) -> list[Item]:
+        """The Event nodes: one thread, ``EventThread``, checks their expressions in file
+        order every control cycle and runs the children of the first that holds (an
+        ``if``/``elif`` chain). The Event nodes have no marker. It is started after the
+        threads, before the Robot Program (seen only in programs without threads or
+        BeforeStart [U])."""
+        tests: list[tuple[Expr, tuple[Item, ...]]] = []
+        for node in events:
+            expression = node.fields.get("expression")
+            if not isinstance(expression, Expression) or not expression:
+                raise self.error(node, "the Event has no expression (PolyScope shows it as "
+                                       "not defined and will not run the program)")
+            tests.append((Paren(self.expr(self.script_of(expression, node), node)),
+                          tuple(self.block(node.children))))
+        if not tests:
+            return []
+        (first, body), *rest = tests
+        chain = If(first, body, tuple(Elif(test, inner) for test, inner in rest))
+        return [ThreadDef("EventThread", (While(Paren(Bool(True)), (chain, _stmt("sync"))),)),
+                Assign(Name("eventThread"), Run("EventThread"))]
 
     def n_Loop(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
@@ -940,19 +1018,35 @@ class _Compiler:
             label = f"Direction: {frame}"
         else:
             return self.n_unknown(node)
-        if frame == "Tool":
-            feature_pose: Expr = _call("get_forward_kin")
+        variable_feature = node.fields.get("feature_name")
+        if variable_feature:
+            # a variable feature: its pose in the installation, written in place (seen); its
+            # name when the installation does not have it [U]
+            poses = dict(getattr(self.installation, "features", ()) or ())
+            pose = poses.get(str(variable_feature))
+            feature_pose: Expr = Pose(tuple(_num(v) for v in pose)) if pose else \
+                Name(str(variable_feature))
+            label = label.replace(f"{frame} ", f"{variable_feature} ", 1)
+        elif frame == "Tool":
+            feature_pose = _call("get_forward_kin")
         elif frame == "Base":
             feature_pose = Pose(tuple(_num(0.0) for _ in range(6)))
         else:
             feature_pose = Name(frame)
         untils = [child for child in node.children if child.kind == "Until"]
         distance = 1000.0
+        blend = 0.0
         for until in untils:
             if until.attrs.get("type") == "DISTANCE" and until.element is not None:
                 text = until.element.findtext("Distance")
                 if text:
                     distance = float(text)
+                params = until.element.find("motionParameters")
+                radius = _floats_or_none(params.get("blendRadius")) if params is not None \
+                    else None
+                if radius and radius[0] > 0 and until.attrs.get("distanceNodeType") == "BLEND":
+                    blend = radius[0]  # the move blends into what follows (a STOP keeps
+                    # the radius it had when it was a blend, but does not write it)
         speed = move.fields.get("speed") if move is not None else None
         accel = move.fields.get("acceleration") if move is not None else None
         params = _floats_or_none(node.attrs.get("toolParams"))
@@ -965,6 +1059,8 @@ class _Compiler:
             keywords.append(Keyword("a", _num(accel)))
         if speed is not None:
             keywords.append(Keyword("v", _num(speed)))
+        if blend > 0:
+            keywords.append(Keyword("r", _num(blend)))
         thread_body: tuple[Item, ...] = (
             EnterCritical(),
             Assign(Name(flag), Number(1)),
@@ -1027,7 +1123,17 @@ class _Compiler:
         files have none: the Direction's own acceleration)."""
         decel = float(until.attrs.get("decelerationAcceleration",
                                       accel if accel is not None else 3.0))
-        retraction = float(until.attrs.get("retraction", "0.0"))
+        retraction_text = until.attrs.get("retraction", "0.0")
+        if retraction_text == "NONE":  # no retraction: stop where the contact was found
+            return [
+                Declare("local", "targetTcpDirection", _call("get_target_tcp_speed")),
+                Declare("local", "stepsToRetract", Call(Name("tool_contact"), (), (
+                    Keyword("direction", Name("targetTcpDirection")),))),
+                If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), (
+                    Kill(Name(handle)), _stmt("stopl", _num(decel)),
+                    self.marker(until, "Until (tool_contact_detection)"),
+                    *self.block(until.children), Break()))]
+        retraction = float(retraction_text)
         direction = Name("targetTcpDirection")
         normalized = Name("normalizedPosDir")
         retract = Pose(tuple(BinOp("*", Index(normalized, (Number(i),)), _num(retraction))
@@ -1127,10 +1233,7 @@ class _Compiler:
         motion = str(move.fields.get("motion_type", "MoveJ"))
         if kind == "Variable":
             variable = str(node.fields.get("variable") or name)
-            target: Expr = Name(variable)
-            feature = move.fields.get("feature")
-            if feature and feature not in _BASE_FEATURES:
-                target = _call("pose_trans", Name(str(feature)), target)
+            target: Expr = self.target_of(node, move)
             label = variable
         elif kind == "Fixed":
             label = name
@@ -1154,14 +1257,15 @@ class _Compiler:
                                     tuple(Keyword(k, v) for k, v in keywords)))
         untils = [child for child in node.children
                   if child.kind == "Until" and not child.suppressed]
+        tcp = self.move_tcp(move, node)
         if not untils:
-            return [self.marker(node, label, "breakAfter"), motion_call]
+            return [self.marker(node, label, "breakAfter"), *tcp, motion_call]
         # a waypoint with Until conditions: the move runs in a thread the conditions end
         number = self.number(node)
         flag, thread, handle = (f"move_thread_flag_{number}", f"move_thread_{number}",
                                 f"move_thread_han_{number}")
         accel = dict(keywords).get("a")
-        return [self.marker(node, label, "breakAfter"),
+        return [self.marker(node, label, "breakAfter"), *tcp,
                 Declare("global", flag, Number(0)),
                 ThreadDef(thread, (EnterCritical(), Assign(Name(flag), Number(1)), motion_call,
                                    Assign(Name(flag), Number(2)), ExitCritical())),
@@ -1169,6 +1273,30 @@ class _Compiler:
                 Assign(Name(handle), Run(thread)),
                 self.until_loop(untils, flag, handle,
                                 accel.value if isinstance(accel, Number) else None)]
+
+    def move_tcp(self, move: Node, waypoint: Node) -> list[Item]:
+        """``set_tcp`` before a waypoint's motion when its move names its own TCP
+        (``useActiveTCP="false"`` with a ``<tcp>``): the installation's offset of that TCP
+        (m, rad), else the offset the waypoint was taught with. A move that ignores the
+        TCP (no ``<tcp>``) writes nothing."""
+        if move.attrs.get("useActiveTCP") != "false" or not move.fields.get("tcp") or \
+                move.attrs.get("positionType") == "JointAngles":
+            return []  # a move to joint angles does not need the TCP
+        return self.set_tcp(str(move.fields["tcp"]), waypoint.fields.get("tcp_offset"))
+
+    def set_tcp(self, name: str, taught=None) -> list[Item]:
+        """``set_tcp`` of the installation's TCP ``name`` (offset in the flange frame: m,
+        rad), else of ``taught`` (the offset a waypoint was taught with); nothing when
+        neither is known."""
+        offset = None
+        for tcp in getattr(self.installation, "tcps", ()) or ():
+            if tcp.name == name:
+                offset = tcp.offset
+        if offset is None:
+            offset = taught
+        if not offset or len(offset) != 6:
+            return []
+        return [_stmt("set_tcp", Pose(tuple(_num(v) for v in offset)))]
 
     def motion_keywords(self, move: Node, waypoint: Node) -> list[tuple[str, Expr]]:
         params = waypoint.fields.get("params") or {}

@@ -211,6 +211,10 @@ def parse_urp(data: bytes, path: str = "<urp>") -> Program:
     try:
         root = ElementTree.fromstring(xml)
     except ElementTree.ParseError as error:
+        if not xml.lstrip().startswith(b"<") and _looks_like_urscript(xml):
+            raise UrpError(f"{path}: error: not a PolyScope program but URScript text (a "
+                           "program saved by PolyScope is XML); check it as a script: "
+                           "`urdsl check` of a copy named .script") from None
         what = "truncated" if "no element found" in str(error) or "unclosed" in str(error) \
             else "not well-formed XML"
         raise UrpError(f"{path}: error: not a readable PolyScope program ({what}: "
@@ -225,6 +229,23 @@ def parse_urp(data: bytes, path: str = "<urp>") -> Program:
     reader = _Reader(root, path)
     reader.positions = _positions(xml, root)
     return reader.program()
+
+
+def _looks_like_urscript(data: bytes) -> bool:
+    """Whether text that is not XML reads as URScript (seen: script files saved as
+    ``.urp``)."""
+    from ..script import parse
+    from ..script.diagnostics import ScriptError
+
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    try:
+        parse(text, "<urp>")
+    except ScriptError:
+        return False
+    return True
 
 
 def _positions(xml: bytes, root: ElementTree.Element) -> dict[ElementTree.Element, tuple[int, int]]:
@@ -567,7 +588,10 @@ def _comment(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
 def _direction(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     feature = element.find("feature")
     if feature is not None:
-        node.fields["feature"] = reader.resolve(feature).get("referencedName")
+        feature = reader.resolve(feature)
+        node.fields["feature"] = feature.get("referencedName")
+        if feature.get("referencedName") is None and feature.get("featureName"):
+            node.fields["feature_name"] = feature.get("featureName")  # a variable feature
     node.fields["expression"] = reader.expression(element.find("expression"))
 
 
@@ -600,9 +624,13 @@ def _call(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
         node.fields["subprogram"] = reader.node(target, None)
 
 
+def _event(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    node.fields["expression"] = reader.expression(element.find("expression"))
+
+
 _FIELDS = {
     "Move": _move, "Waypoint": _waypoint, "Loop": _loop, "If": _if, "Wait": _wait,
     "Set": _set, "Assignment": _assignment, "Script": _script, "Popup": _popup,
     "Comment": _comment, "Timer": _timer, "Direction": _direction, "Force": _force,
-    "SubProgram": _subprogram, "CallSubProgram": _call,
+    "SubProgram": _subprogram, "CallSubProgram": _call, "Event": _event,
 }

@@ -1,0 +1,255 @@
+"""Node variants PolyScope writes that the census (bench/polyscope_census.py) found beyond the
+tune pairs: a move with its own TCP, a Set node that selects a TCP, analog outputs, Modbus
+signals as I/O, Event nodes, Direction in a variable feature, Until blends, tool contact
+without retraction and PolyScope 3 variable waypoints. Fixtures are written here (plain
+XML, as read_urp accepts it); the expected forms are those of real PolyScope scripts."""
+
+from __future__ import annotations
+
+import pytest
+
+from urdsl.polyscope.compile import CompileError, compile_program
+from urdsl.polyscope.installation import parse_installation
+from urdsl.polyscope.urp import parse_urp
+from urdsl.script import parse
+from urdsl.script.printer import format as print_tree
+
+KINEMATICS = """
+  <kinematics status="LINEARIZED" validChecksum="true">
+    <deltaTheta value="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
+    <a value="0.0, -0.425, -0.3922, 0.0, 0.0, 0.0"/>
+    <d value="0.1625, 0.0, 0.0, 0.1333, 0.0997, 0.0996"/>
+    <alpha value="1.5707963267948966, 0.0, 0.0, 1.5707963267948966, -1.5707963267948966, 0.0"/>
+  </kinematics>"""
+
+INSTALLATION = """<Installation name="cell">
+  <IOs>
+    <analogOutputDomain value="1, 0"/>
+    <ModbusUnits>
+      <Unit ipAddress="192.168.1.18" sequentialMode="false">
+        <ModbusSignal name="RUN" type="DIGITAL_INPUT" signalAddress="3" slaveAddress="255"/>
+        <ModbusSignal name="BRUSH" type="DIGITAL_OUTPUT" signalAddress="4" slaveAddress="255"/>
+      </Unit>
+    </ModbusUnits>
+  </IOs>
+  <TCPSettings activePose="Flange">
+    <tcp name="Flange" offset="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
+    <tcp name="Sander" offset="0.003, 0.11, 0.098, -0.785, 0.0, 0.0"/>
+  </TCPSettings>
+  <Features>
+    <wrapper>
+      <GeomPoseNode name="Cube" isVariable="true">
+        <toolPosition value="-0.65, -0.29, 0.15"/>
+        <toolAxisAngle value="1.19, 1.2, 1.23"/>
+      </GeomPoseNode>
+    </wrapper>
+  </Features>
+</Installation>"""
+
+WAYPOINT = """<Waypoint type="Fixed" name="{name}" kinematicsFlags="3">
+              <motionParameters/>
+              <position>
+                <JointAngles angles="0.0, -1.5, 1.5, -1.5, -1.5, 0.0"/>
+                <TCPOffset pose="0.0, 0.0, 0.2, 0.0, 0.0, 0.0"/>
+              </position>
+            </Waypoint>"""
+
+
+def program(body: str, others: str = "", version: str = "5.11.5") -> str:
+    return f"""<URProgram name="variants" installation="cell" createdIn="{version}"
+    lastSavedIn="{version}">{KINEMATICS}
+  <children>
+    <MainProgram runOnlyOnce="true" InitVariablesNode="false">
+      <children>
+{body}
+      </children>
+    </MainProgram>
+{others}
+  </children>
+</URProgram>"""
+
+
+def compiled(body: str, others: str = "", version: str = "5.11.5",
+             installation: bool = True) -> list[str]:
+    prog = parse_urp(program(body, others, version).encode(), "variants.urp")
+    inst = parse_installation(INSTALLATION.encode(), "cell.installation") \
+        if installation else None
+    text = compile_program(prog, inst).text
+    assert print_tree(parse(text)) == text  # what is written is URScript
+    return [line.strip() for line in text.splitlines()]
+
+
+def after(lines: list[str], marker: str, count: int) -> list[str]:
+    at = next(i for i, line in enumerate(lines) if line.startswith(marker))
+    return lines[at + 1:at + 1 + count]
+
+
+MOVE_WITH_TCP = f"""
+        <Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="false"
+              positionType="CartesianPose">
+          <tcp referencedName="Sander"/>
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            {WAYPOINT.format(name="Start")}
+            <Waypoint type="Variable" name="Here" kinematicsFlags="-1">
+              <motionParameters/>
+              <variable name="here_pose"/>
+            </Waypoint>
+          </children>
+        </Move>
+        <Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="false"
+              positionType="JointAngles">
+          <tcp referencedName="Sander"/>
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            {WAYPOINT.format(name="Home")}
+          </children>
+        </Move>"""
+
+
+def test_a_move_with_its_own_tcp_sets_it_before_each_motion():
+    lines = compiled(MOVE_WITH_TCP)
+    sander = "set_tcp(p[0.003, 0.11, 0.098, -0.785, 0.0, 0.0])"
+    assert after(lines, '$ 3 "Start"', 2) == [sander, "movel(Start_p, a=1.2, v=0.25)"]
+    assert after(lines, '$ 4 "here_pose"', 2) == [sander, "movel(here_pose, a=1.2, v=0.25)"]
+    # a move to joint angles does not need the TCP: nothing is set
+    assert after(lines, '$ 6 "Home"', 1) == ["movej(Home_q, a=1.4, v=1.05)"]
+
+
+def test_without_the_installation_the_taught_tcp_is_set():
+    lines = compiled(MOVE_WITH_TCP, installation=False)
+    assert after(lines, '$ 3 "Start"', 1) == ["set_tcp(p[0.0, 0.0, 0.2, 0.0, 0.0, 0.0])"]
+
+
+def test_set_node_selecting_a_tcp_and_an_output_with_a_tcp():
+    lines = compiled("""
+        <Set type="NoAction"><tcp referencedName="Sander"/></Set>
+        <Set type="DigitalOutput">
+          <tcp referencedName="Flange"/>
+          <pin referencedName="digital_out[1]"/>
+          <digitalValue>1</digitalValue>
+        </Set>""")
+    assert after(lines, '$ 2 "Set"', 1) == ["set_tcp(p[0.003, 0.11, 0.098, -0.785, 0.0, 0.0])"]
+    assert after(lines, '$ 3 "Set digital_out[1]=On"', 2) == [
+        "set_standard_digital_out(1, True)", "set_tcp(p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0])"]
+
+
+def test_analog_output_is_a_ratio_of_its_domain():
+    lines = compiled("""
+        <Set type="AnalogOutput"><pin referencedName="analog_out[0]"/>
+          <analogValue>4.0</analogValue></Set>
+        <Set type="AnalogOutput"><pin referencedName="analog_out[1]"/>
+          <analogValue>10.0</analogValue></Set>""")
+    assert "set_standard_analog_out(0, 0.4)" in lines  # 4 V of 10 V (voltage domain)
+    assert "set_standard_analog_out(1, 0.5)" in lines  # 10 mA of 20 mA (current domain)
+
+
+def test_modbus_signals_as_io():
+    lines = compiled("""
+        <Set type="ExpressionOutput">
+          <pin referencedName="BRUSH"/>
+          <expression><ExpressionToken token=" False "/></expression>
+        </Set>
+        <Wait type="DigitalInput">
+          <pin referencedName="RUN"/>
+          <digitalValue>1</digitalValue>
+        </Wait>""")
+    assert after(lines, '$ 2 "Set BRUSH= False "', 1) == [
+        'modbus_set_output_signal("BRUSH", False)']
+    assert after(lines, '$ 3 "Wait RUN=HI"', 1) == [
+        'while (modbus_get_signal_status("RUN") == False):']
+
+
+def test_an_unknown_io_is_still_one_message():
+    with pytest.raises(CompileError, match="NOPE"):
+        compiled("""<Set type="ExpressionOutput"><pin referencedName="NOPE"/>
+          <expression><ExpressionToken token=" True "/></expression></Set>""")
+
+
+def test_events_share_one_thread_started_before_the_robot_program():
+    events = """
+    <Event>
+      <expression><ExpressionIO><pin referencedName="digital_in[1]"/></ExpressionIO>
+        <ExpressionChar character="≠"/><ExpressionToken token=" True "/></expression>
+      <children><Halt/></children>
+    </Event>
+    <Event>
+      <expression><ExpressionIO><pin referencedName="digital_in[2]"/></ExpressionIO>
+        <ExpressionChar character="≟"/><ExpressionToken token=" True "/></expression>
+      <children><Set type="DigitalOutput"><pin referencedName="digital_out[0]"/>
+        <digitalValue>0</digitalValue></Set></children>
+    </Event>"""
+    lines = compiled('<Wait type="Sleep"><waitTime>1.0</waitTime></Wait>', events)
+    start = lines.index("thread EventThread():")
+    assert lines[start:start + 9] == [
+        "thread EventThread():", "while (True):",
+        "if (get_standard_digital_in(1) != True):", '$ 4 "Halt"', "halt",
+        "elif (get_standard_digital_in(2) == True):", '$ 6 "Set digital_out[0]=Off"',
+        "set_standard_digital_out(0, False)", "end"]
+    assert lines.index("eventThread = run EventThread()") < lines.index('$ 1 "Robot Program"')
+
+
+DIRECTION = """
+        <Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            <gui.program.direction.MoveDirectionNode selectedDirection="ZPlus">
+              <feature class="GeomFeatureVariable" featureName="Cube"/>
+              <children>
+                <Until type="DISTANCE" allowActions="false" deceleration="3.0"
+                       distanceNodeType="{kind}">
+                  <Distance>0.1</Distance>
+                  <motionParameters blendRadius="0.025"/>
+                </Until>
+              </children>
+            </gui.program.direction.MoveDirectionNode>
+            <gui.program.direction.MoveDirectionNode selectedDirection="ZMinus">
+              <feature class="GeomFeatureReference" referencedName="Joint_6_name"/>
+              <children>
+                <Until type="TOOL_CONTACT_DETECTION" allowActions="false" retraction="NONE"
+                       decelerationAcceleration="3.0"/>
+              </children>
+            </gui.program.direction.MoveDirectionNode>
+          </children>
+        </Move>"""
+
+
+def test_direction_in_a_variable_feature_and_until_blend():
+    lines = compiled(DIRECTION.format(kind="BLEND"))
+    assert "local towardsPos = calculate_point_to_move_towards(" \
+           "p[-0.65, -0.29, 0.15, 1.19, 1.2, 1.23], [0.0, 0.0, 1.0], 0.1)" in lines
+    assert "movel(towardsPos, a=1.2, v=0.25, r=0.025)" in lines
+    # a STOP distance does not blend, whatever radius it keeps
+    assert "movel(towardsPos, a=1.2, v=0.25)" in compiled(DIRECTION.format(kind="STOP"))
+
+
+def test_tool_contact_without_retraction_stops_where_it_touched():
+    lines = compiled(DIRECTION.format(kind="STOP"))
+    found = lines.index("if (stepsToRetract > 0):")
+    assert lines[found + 1:found + 6] == [
+        "kill move_thread_han_5", "stopl(3.0)", '$ 6 "Until (tool_contact_detection)"',
+        "break", "end"]
+    assert not any(line.startswith("local backTrackMovement") for line in lines)
+
+
+def test_polyscope3_variable_waypoint_in_the_base():
+    lines = compiled("""
+        <Move motionType="MoveL" speed="2.0" acceleration="0.1" useActiveTCP="false">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            <Waypoint type="Variable" name="Waypoint" kinematicsFlags="-1">
+              <motionParameters/>
+              <variable name="setp"/>
+            </Waypoint>
+          </children>
+        </Move>""", version="3.15.8")
+    assert "movel(pose_trans(p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], setp), a=0.1, v=2.0)" in lines
+
+
+def test_urscript_saved_as_urp_is_named_as_such():
+    from urdsl.polyscope.urp import UrpError
+
+    with pytest.raises(UrpError, match="not a PolyScope program but URScript text"):
+        parse_urp(b"textmsg(get_actual_joint_positions())\nsleep(0.5)\n", "main_cycle.urp")
+    with pytest.raises(UrpError, match="not well-formed XML"):
+        parse_urp(b"textmsg(1\n", "broken.urp")
