@@ -173,11 +173,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         if not args.json:
             _print(report, args.all_moves)
     if args.json and reports:
-        import json
+        from .report import dumps
 
         documents = [r.to_dict() for r in reports]
-        json.dump(documents[0] if len(documents) == 1 else documents, sys.stdout, indent=2)
-        sys.stdout.write("\n")
+        sys.stdout.write(dumps(documents[0] if len(documents) == 1 else documents) + "\n")
     if args.plot and reports:
         reports[0].plot(args.plot)
         print(f"plot written to {args.plot}", file=sys.stderr)
