@@ -9,6 +9,7 @@ that fails at a sample can name the program line that commanded it.
 
 from __future__ import annotations
 
+import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -40,6 +41,9 @@ class Trace:
     dt: float
     segments: list
     unreachable: np.ndarray
+    cut: float | None = None
+    """Robot time (s) where sampling stopped at the wall-clock bound (the samples end there,
+    before the motion does); None when the whole motion was sampled."""
 
     @property
     def qdd(self) -> np.ndarray:
@@ -434,19 +438,76 @@ def joints_at(planner, times: np.ndarray) -> np.ndarray:
     return result
 
 
-def sample(planner, dt: float | None = None, until: float | None = None) -> Trace:
+WINDOW_SAMPLES = 1 << 16
+"""Samples :func:`sample` evaluates at once (131 s of robot time at the e-Series' 2 ms): a
+window holds only the moves under way in it, so that memory and the time to the next look
+at the deadline stay bounded however long the program runs."""
+
+
+class _Window:
+    """The moves ``segments`` of a planner under way in one window of samples, as
+    :func:`_displacements` reads a planner: ``q_start`` is where the arm is before the first
+    of them (every move starts where the one before it ends)."""
+
+    def __init__(self, planner, segments: list, q_start: np.ndarray) -> None:
+        self.kinematics = planner.kinematics
+        self.segments = segments
+        self.q_start = q_start
+
+
+def sample(planner, dt: float | None = None, until: float | None = None,
+           deadline: float | None = None) -> Trace:
     """Sample the planned trajectory every ``dt`` s (default: the controller step), up to
-    robot time ``until`` (s; default: the end of the last move)."""
+    robot time ``until`` (s; default: the end of the last move).
+
+    Samples are evaluated in windows of :data:`WINDOW_SAMPLES`, in time order. With a
+    ``deadline`` (``time.monotonic()``) sampling stops at the first window boundary after
+    it has passed: the trace then ends there, less its last two samples (so that every
+    kept speed is the central difference a complete trace has), and ``Trace.cut`` says at
+    which robot time."""
     dt = dt or planner.step_time
-    end = max(planner.end_time, max((s.end for s in planner.segments), default=0.0))
+    segments = planner.segments
+    end = max(planner.end_time, max((s.end for s in segments), default=0.0))
     if until is not None:
         end = min(end, until)
     count = int(np.floor(end / dt + 1e-9)) + 1
-    times = np.arange(count) * dt
     pool = shared_pool()
-    q, active, unreachable = _displacements(planner, times, pool)
+    starts = np.maximum.accumulate(np.array([s.start for s in segments] or [0.0]))
+    ends = np.maximum.accumulate(np.array([s.end for s in segments] or [0.0]))
+    q_parts, active_parts, unreachable_parts = [], [], []
+    stop = count
+    for low in range(0, count, WINDOW_SAMPLES):
+        if deadline is not None and low > 0 and time.monotonic() > deadline:
+            stop = low
+            break
+        times = np.arange(low, min(low + WINDOW_SAMPLES, count)) * dt
+        # the moves under way in the window: every one before them has ended (ends rise
+        # with starts: a blend starts a move before the previous one ends, never after
+        # its end)
+        first = min(int(np.searchsorted(ends, times[0], side="right")), len(segments))
+        last = min(int(np.searchsorted(starts, times[-1], side="right")), len(segments))
+        if first < len(segments):
+            q_before = np.asarray(segments[first].q_start, dtype=float)
+        else:
+            q_before = np.asarray(segments[-1].q_end if segments else planner.q_start,
+                                  dtype=float)
+        window = _Window(planner, segments[first:max(first, last)], q_before)
+        q, active, unreachable = _displacements(window, times, pool)
+        q_parts.append(q)
+        active_parts.append(np.where(active >= 0, active + first, first - 1))
+        unreachable_parts.append(unreachable)
+    q = np.concatenate(q_parts) if q_parts else np.zeros((0, 6))
+    active = np.concatenate(active_parts) if active_parts else np.zeros(0, dtype=np.int64)
+    unreachable = (np.concatenate(unreachable_parts) if unreachable_parts
+                   else np.zeros(0, dtype=bool))
     qd = _derivative(q, dt, pool)
-    return Trace(times, q, qd, None, active, dt, planner.segments, unreachable)
+    cut = None
+    if stop < count:
+        keep = max(stop - 2, 0)
+        cut = float(keep * dt)
+        q, qd, active, unreachable = q[:keep], qd[:keep], active[:keep], unreachable[:keep]
+    times = np.arange(len(q)) * dt
+    return Trace(times, q, qd, None, active, dt, segments, unreachable, cut)
 
 
 def _derivative(values: np.ndarray, dt: float, pool: ThreadPoolExecutor,

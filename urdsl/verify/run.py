@@ -51,6 +51,11 @@ Sampling is not interrupted: with 80 % here, a cell program stopped by a 60 s bo
 (573,099 moves, 2,292 s of robot time) needed 4 s more on a quiet machine and 17 s under load
 to sample and check, past the bound; with 60 % it ends in 39 s on the quiet machine."""
 
+SAMPLE_SHARE = 0.8
+"""The part of the wall-clock bound by which sampling the trajectory must be done: it stops
+there, at the start of the first move not yet sampled (``Trace.cut``), and the trace checks
+get the rest, the collision sweep (the slowest) stopping at the bound itself."""
+
 DEFAULT_START = (0.0, -1.5707963267948966, 1.5707963267948966, -1.5707963267948966,
                  -1.5707963267948966, 0.0)
 """Where the simulated arm rests before the program (rad): upper arm up, forearm
@@ -209,7 +214,9 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     # sampled while the arm moves (after the last move it rests: nothing to check), and
     # never past --max-time
     last = max((s.end for s in planner.segments), default=0.0)
-    trace = sample(planner, options.sample_time or step, until=min(last, options.max_time))
+    sampling = None if options.timeout is None else started + SAMPLE_SHARE * options.timeout
+    trace = sample(planner, options.sample_time or step, until=min(last, options.max_time),
+                   deadline=sampling)
     report.trace = trace
     report.cycle_time = float(min(max(result.time, trace.duration), options.max_time))
     report.moves = [Move(s.kind, s.span, s.start, s.duration, s.params.get("lead"))
@@ -272,9 +279,17 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
     """The trace checks, in order; once ``deadline`` (``time.monotonic()``) has passed the
     remaining ones are skipped and a URS313 finding names them."""
     findings: list[Finding] = []
+    if trace.cut is not None:
+        # the first move not sampled: what the program did from there on was not checked
+        where = next((s for s in planner.segments if s.start >= trace.cut), None)
+        findings.append(Finding.of(
+            "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s while "
+            f"sampling the motion: the moves from robot time {trace.cut:.3f} s on were not "
+            "checked", where.span if where is not None else span, trace.cut,
+            "use --timeout to allow more time"))
     if len(trace.times) == 0 or not planner.segments:
         return findings
-    ctx = checks.TraceContext(trace, planner, robot, options)
+    ctx = checks.TraceContext(trace, planner, robot, options, deadline=deadline)
     steps = [check for check in checks.trace_checks() if check.applies(options)]
     for index, check in enumerate(steps):
         if deadline is not None and time.monotonic() > deadline:
@@ -284,4 +299,9 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
                 f"not checked: {skipped}", span, None, "use --timeout to allow more time"))
             break
         findings += check.run(ctx)
+    for label, reached in ctx.partial.items():
+        findings.append(Finding.of(
+            "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s; "
+            f"{label} checked up to robot time {reached:.3f} s only", span, reached,
+            "use --timeout to allow more time"))
     return findings
