@@ -38,7 +38,7 @@ from . import checks
 from .findings import Finding, nothing_runs
 from .report import Move, Report
 
-__all__ = ["CheckOptions", "check_text", "check_tree", "check_file", "DEFAULT_START",
+__all__ = ["CheckOptions", "Progress", "check_text", "check_tree", "check_file", "DEFAULT_START",
            "DEFAULT_TIMEOUT"]
 
 DEFAULT_TIMEOUT = 60.0
@@ -60,6 +60,21 @@ DEFAULT_START = (0.0, -1.5707963267948966, 1.5707963267948966, -1.57079632679489
                  -1.5707963267948966, 0.0)
 """Where the simulated arm rests before the program (rad): upper arm up, forearm
 horizontal, tool pointing down — a pose every model reaches away from singularities."""
+
+
+@dataclass
+class Progress:
+    """How far one program's check got, for the report of a check that overran its bound
+    (:func:`urdsl.verify.command.cmd_check`): the ``phase`` under way ("running the
+    program", ...) and the ``span`` of the program once parsed."""
+
+    phase: str = "reading the program"
+    span: Any = NO_SPAN
+
+
+def _phase(options: CheckOptions, phase: str) -> None:
+    if options.progress is not None:
+        options.progress.phase = phase
 
 
 @dataclass
@@ -103,6 +118,8 @@ class CheckOptions:
     unknown_globals: dict[str, str] = field(default_factory=dict)
     """Globals the program reads that something outside it defines (a URCap node's code):
     name → where the value comes from; each holds an unknown value."""
+    progress: Progress | None = field(default=None, repr=False, compare=False)
+    """Where the check records its phase (see :class:`Progress`), or None."""
 
 
 def check_text(text: str, filename: str = "<script>", *, robot: str = "ur5e",
@@ -149,6 +166,9 @@ def check_tree(module, filename: str, options: CheckOptions,
 
 
 def _check_tree(module, filename: str, options: CheckOptions, started: float) -> Report:
+    if options.progress is not None:
+        options.progress.span = module.span
+    _phase(options, "running the program")
     robot = _robot_model(options.robot, options.calibration)
     cb3 = getattr(robot.spec, "generation", "") == "cb3"
     step = 0.008 if cb3 else 0.002
@@ -215,6 +235,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     # never past --max-time
     last = max((s.end for s in planner.segments), default=0.0)
     sampling = None if options.timeout is None else started + SAMPLE_SHARE * options.timeout
+    _phase(options, "sampling the motion")
     trace = sample(planner, options.sample_time or step, until=min(last, options.max_time),
                    deadline=sampling)
     report.trace = trace
@@ -222,6 +243,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     report.moves = [Move(s.kind, s.span, s.start, s.duration, s.params.get("lead"))
                     for s in planner.segments]
     final = None if options.timeout is None else started + options.timeout
+    _phase(options, "checking the motion")
     report.findings.extend(_trace_findings(trace, planner, robot, options, final,
                                            module.span))
     report.sort()
