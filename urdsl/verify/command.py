@@ -156,13 +156,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     for name in args.files:
         if name.endswith(".py"):
             try:
-                report = _check_program(name, options)
+                report = _bounded(name, options, lambda o, n=name: _check_program(n, o))
             except (DslError, ProgramFileError) as error:
                 print(str(error), file=sys.stderr)
                 failed = True
                 continue
         elif name.lower().endswith(".urp"):
-            report = _check_urp(name, args, options)
+            report = _bounded(name, options, lambda o, n=name: _check_urp(n, args, o))
             if report is None:
                 failed = True
                 continue
