@@ -124,3 +124,14 @@ def test_the_command_ends_with_its_report_at_a_small_timeout(tmp_path):
     report = json.loads(done.stdout)
     assert any(f["code"] == "URS313" for f in report["findings"])
     assert report["moves"]
+
+
+def test_the_collision_sweep_stops_at_its_deadline_and_says_where():
+    from urdsl.verify.checks import collisions
+
+    trace = sample(long_planner(5))
+    partial: dict[str, float] = {}
+    findings = collisions(trace, Robot.model("ur5e"), None, deadline=time.monotonic() - 1.0,
+                          partial=partial)
+    assert findings == [] and partial == {"collisions": 0.0}
+    assert collisions(trace, Robot.model("ur5e"), None, partial=partial) == []

@@ -46,10 +46,10 @@ DEFAULT_TIMEOUT = 60.0
 
 RUN_SHARE = 0.6
 """The part of the wall-clock bound the program's run may use; sampling the trajectory and
-the trace checks get the rest (each check is skipped, and named, once the bound has passed).
-Sampling is not interrupted: with 80 % here, a cell program stopped by a 60 s bound after 48 s
-(573,099 moves, 2,292 s of robot time) needed 4 s more on a quiet machine and 17 s under load
-to sample and check, past the bound; with 60 % it ends in 39 s on the quiet machine."""
+the trace checks get the rest (see :data:`SAMPLE_SHARE`). A cell program stopped by a 60 s
+bound after 48 s (80 % here; 573,099 moves, 2,292 s of robot time) needed 4 s more on a
+quiet machine and 17 s under load to sample and check, when sampling could not be
+interrupted."""
 
 SAMPLE_SHARE = 0.8
 """The part of the wall-clock bound by which sampling the trajectory must be done: it stops
