@@ -137,6 +137,32 @@ class _Moves:
                              & (not every_sample))
 
     def knots(self, moves: np.ndarray) -> _Knots:
+        """:meth:`solve_knots` of ``moves`` (sorted move indices), each distinct move solved
+        once: a move is the same as another when it starts from the same joints toward the
+        same target, along the same path, with the same speed profile and TCP (a loop that
+        repeats a toolpath from the same place), and then so are its knots."""
+        paths = self.paths
+        rows = np.concatenate([self.q_start[moves], self.q_delta[moves], self.profile[moves],
+                               paths.p0[moves], paths.p1[moves],
+                               paths.r0[moves].reshape(-1, 9), paths.w[moves],
+                               paths.tcp_group[moves, None].astype(float)], axis=1)
+        if len(moves) < 2 or not np.isfinite(rows).all():
+            return self.solve_knots(moves)
+        _, keep, which = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        if len(keep) == len(moves):
+            return self.solve_knots(moves)
+        order = np.argsort(keep)  # the distinct moves by first occurrence
+        rank = np.empty(len(keep), dtype=np.int64)
+        rank[order] = np.arange(len(keep))
+        solved = self.solve_knots(moves[keep[order]])
+        counts = np.diff(np.append(solved.first, len(solved.t)))
+        of_move = rank[which.reshape(-1)]  # each move's distinct move, in `solved`
+        per_move = counts[of_move]
+        first = np.cumsum(per_move) - per_move
+        index = np.repeat(solved.first[of_move] - first, per_move) + np.arange(per_move.sum())
+        return _Knots(moves, first, solved.t[index], solved.q[index], solved.velocity[index])
+
+    def solve_knots(self, moves: np.ndarray) -> _Knots:
         """The knots of straight-line moves ``moves`` (sorted move indices), solved: each
         phase of the speed profile (accelerating, cruising, braking) split into equal steps
         of at most :data:`KNOT_TIME` (cruising: of at most ``max(KNOT_TIME, KNOT_PATH / v)``),
