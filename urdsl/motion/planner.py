@@ -426,6 +426,8 @@ class MotionPlanner:
                        pose: np.ndarray, r: float, span: Span, params: dict, now: float,
                        via: np.ndarray | None = None) -> float:
         if self.lazy_ik:
+            if len(self._unresolved) >= RESOLVE_BATCH:
+                self.resolve()  # as it runs, so that the run's time bound covers it
             segment = self._segment(kind, profile, None, None, r, span, params, pose_from, pose)
         else:
             q_from = self._q
@@ -649,6 +651,11 @@ def _matching_branch(solutions: np.ndarray, q: np.ndarray, tolerance: float = 1e
         return None
     return int(matches[0])
 
+
+RESOLVE_BATCH = 4096
+"""Most straight-line moves whose joints are left unsolved (:meth:`MotionPlanner.resolve`
+solves them in one batch): a toolpath of a million moves is solved in batches as the
+program runs, not all after it."""
 
 POSE_CACHE = 4096
 """Most TCP poses :meth:`MotionPlanner._pose_of` keeps (then it starts again)."""

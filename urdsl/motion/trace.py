@@ -482,15 +482,17 @@ class _Window:
 
 
 def sample(planner, dt: float | None = None, until: float | None = None,
-           deadline: float | None = None) -> Trace:
+           deadline: float | None = None, reserve: float = 0.0) -> Trace:
     """Sample the planned trajectory every ``dt`` s (default: the controller step), up to
     robot time ``until`` (s; default: the end of the last move).
 
     Samples are evaluated in windows of :data:`WINDOW_SAMPLES`, in time order. With a
     ``deadline`` (``time.monotonic()``) sampling stops at the first window boundary after
-    it has passed: the trace then ends there, less its last two samples (so that every
-    kept speed is the central difference a complete trace has), and ``Trace.cut`` says at
-    which robot time."""
+    it, or, with a ``reserve`` r, once the time sampling has taken times 1 + r would reach
+    it (leaving the checks of the samples about r times the time it took to make them): the
+    trace then ends there, less its last two samples (so that every kept speed is the
+    central difference a complete trace has), and ``Trace.cut`` says at which robot
+    time."""
     dt = dt or planner.step_time
     segments = planner.segments
     end = max(planner.end_time, max((s.end for s in segments), default=0.0))
@@ -502,8 +504,10 @@ def sample(planner, dt: float | None = None, until: float | None = None,
     ends = np.maximum.accumulate(np.array([s.end for s in segments] or [0.0]))
     q_parts, active_parts, unreachable_parts = [], [], []
     stop = count
+    began = time.monotonic()
     for low in range(0, count, WINDOW_SAMPLES):
-        if deadline is not None and low > 0 and time.monotonic() > deadline:
+        now = time.monotonic()
+        if deadline is not None and low > 0 and now + reserve * (now - began) > deadline:
             stop = low
             break
         times = np.arange(low, min(low + WINDOW_SAMPLES, count)) * dt
