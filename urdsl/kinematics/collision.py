@@ -61,6 +61,7 @@ Cell file (TOML, obstacles in the robot's Base frame; m, rad)::
 
 from __future__ import annotations
 
+import time
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -99,6 +100,9 @@ class CollisionResult:
     closest: list[tuple[str, str]]
     pairs: dict[int, list[tuple[str, str]]] = field(default_factory=dict)
     margin: float = 0.0
+    stopped: int | None = None
+    """:meth:`CollisionModel.sweep` with a deadline: the first sample not checked when the
+    deadline passed (the samples from there on were not looked at); None: all checked."""
 
     @property
     def colliding(self) -> np.ndarray:
@@ -363,8 +367,8 @@ class CollisionModel:
                             if result.min_distance <= margin]
         return CollisionResult(distance, closest, pairs, margin)
 
-    def sweep(self, Q, tcp=None, stride: int = 1, margin: float = 0.0
-              ) -> tuple[np.ndarray, CollisionResult]:
+    def sweep(self, Q, tcp=None, stride: int = 1, margin: float = 0.0,
+              deadline: float | None = None) -> tuple[np.ndarray, CollisionResult]:
         """Check a sampled path ``Q`` (N, 6) [rad] every ``stride``-th sample, or further
         apart where no contact is possible in between (conservative advancement): with a
         clearance ``d`` [m] at one sample, no pair can touch before the joints have
@@ -373,6 +377,9 @@ class CollisionModel:
         change with the joints before the first of them: seen from that link, only the other
         one moves, by at most that travel; an obstacle stands still. An arm at rest is
         checked once.
+
+        With a ``deadline`` (``time.monotonic()``) the sweep stops once it has passed, and
+        the result's ``stopped`` says at which sample.
 
         Returns the indices of the checked samples and their :class:`CollisionResult`.
         """
@@ -394,7 +401,11 @@ class CollisionModel:
         closest: list[tuple[str, str]] = []
         pairs: dict[int, list[tuple[str, str]]] = {}
         i, n = 0, len(Q)
+        stopped = None
         while i < n:
+            if deadline is not None and not len(index) & 63 and time.monotonic() > deadline:
+                stopped = i
+                break
             k = pin.computeDistances(model, data, geometry, geometry_data, Q[i])
             value = results[k].min_distance
             if value <= margin:
@@ -409,7 +420,7 @@ class CollisionModel:
                 ahead = max(ahead, safe)
             i = ahead
         return np.array(index, dtype=np.int64), CollisionResult(
-            np.array(distance), closest, pairs, margin)
+            np.array(distance), closest, pairs, margin, stopped)
 
     def levers(self) -> np.ndarray:
         """(6,) [m]: for each joint, a bound on the distance from its axis of every point

@@ -54,6 +54,8 @@ def rotvec_to_matrix(rotvec) -> np.ndarray:
     ``R = I + (sin θ/θ)·K + ((1 − cos θ)/θ²)·K²`` with ``K = [r]×`` and ``θ = |r|``; both
     coefficients are evaluated through ``sinc`` so the formula is exact at and near θ = 0.
     """
+    if isinstance(rotvec, np.ndarray) and rotvec.shape == (3,) and rotvec.dtype == float:
+        return _one_matrix(0.0, 0.0, 0.0, *rotvec.tolist())[:3, :3].copy()  # one: scalar maths
     r = _array(rotvec, 3, "a rotation vector")
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
     theta = np.sqrt(x * x + y * y + z * z)
@@ -109,6 +111,8 @@ def matrix_to_rotvec(rotation) -> np.ndarray:
     Computed through the quaternion ``(w, v)``: ``θ = 2·atan2(|v|, w)``, which is accurate at
     θ = 0 and at θ = π (where the axis comes from the diagonal, see :func:`matrix_to_quaternion`).
     """
+    if isinstance(rotation, np.ndarray) and rotation.shape == (3, 3):
+        return np.array(_one_rotvec(rotation.tolist()))  # one matrix: scalar maths is faster
     q = matrix_to_quaternion(rotation)
     w, v = q[..., 0], q[..., 1:]
     norm = np.linalg.norm(v, axis=-1)
@@ -116,6 +120,28 @@ def matrix_to_rotvec(rotation) -> np.ndarray:
     small = norm < 1e-12
     scale = np.where(small, 2.0 / np.where(small, w, 1.0), angle / np.where(small, 1.0, norm))
     return v * scale[..., None]
+
+
+def _one_rotvec(m: list) -> tuple[float, float, float]:
+    """:func:`matrix_to_rotvec` of one rotation matrix given as nested lists (3x3), with the
+    same formulas (Shepperd's quaternion, then ``θ = 2·atan2(|v|, w)``)."""
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = (row[:3] for row in m[:3])
+    squares = (1.0 + m00 + m11 + m22, 1.0 + m00 - m11 - m22, 1.0 - m00 + m11 - m22,
+               1.0 - m00 - m11 + m22)
+    pick = max(range(4), key=squares.__getitem__)
+    big = 0.5 * math.sqrt(max(squares[pick], 1e-300))
+    inv = 0.25 / big
+    wx, wy, wz = (m21 - m12) * inv, (m02 - m20) * inv, (m10 - m01) * inv
+    xy, xz, yz = (m01 + m10) * inv, (m02 + m20) * inv, (m12 + m21) * inv
+    w, x, y, z = ((big, wx, wy, wz), (wx, big, xy, xz), (wy, xy, big, yz),
+                  (wz, xz, yz, big))[pick]
+    length = math.sqrt(w * w + x * x + y * y + z * z)
+    if w < 0.0:
+        length = -length
+    w, x, y, z = w / length, x / length, y / length, z / length
+    norm = math.sqrt(x * x + y * y + z * z)
+    scale = 2.0 / w if norm < 1e-12 else 2.0 * math.atan2(norm, w) / norm
+    return x * scale, y * scale, z * scale
 
 
 def rotation_angle(r0, r1) -> np.ndarray | float:
@@ -171,6 +197,8 @@ def to_matrix(pose) -> np.ndarray:
     if isinstance(pose, (tuple, list)) and len(pose) == 6 \
             and all(isinstance(v, (int, float)) for v in pose):
         return _one_matrix(*map(float, pose))  # one pose of numbers: scalar maths is faster
+    if isinstance(pose, np.ndarray) and pose.shape == (6,) and pose.dtype == float:
+        return _one_matrix(*pose.tolist())
     p = _array(pose, 6, "a pose")
     out = np.zeros(p.shape[:-1] + (4, 4))
     out[..., :3, :3] = rotvec_to_matrix(p[..., 3:])
@@ -200,6 +228,9 @@ def from_matrix(matrix) -> np.ndarray:
     m = np.asarray(matrix, dtype=float)
     if m.shape[-2:] != (4, 4):
         raise ValueError(f"a transform must be 4x4, got shape {m.shape}")
+    if m.shape == (4, 4):  # one matrix: scalar maths is faster
+        rows = m.tolist()
+        return np.array([rows[0][3], rows[1][3], rows[2][3], *_one_rotvec(rows)])
     return np.concatenate([m[..., :3, 3], matrix_to_rotvec(m[..., :3, :3])], axis=-1)
 
 

@@ -88,12 +88,31 @@ def _transform_batch(x, name: str = "poses") -> np.ndarray:
     raise KinematicsError(f"{name} must have shape (N, 6) or (N, 4, 4), got {array.shape}")
 
 
+_TCP_CACHE: dict[bytes, np.ndarray | None] = {}
+"""TCP poses (6,) already converted to matrices, by the bytes of the pose: a program sets a
+few TCPs and every forward-kinematics call of the checker converts one of them."""
+
+
 def _tcp(tcp) -> np.ndarray | None:
+    """The TCP (a pose (6,) or a matrix (4, 4)) as a read-only matrix; None for the flange."""
     if tcp is None:
         return None
+    if isinstance(tcp, np.ndarray) and tcp.shape == (6,) and tcp.dtype == float:
+        key = tcp.tobytes()
+        if key not in _TCP_CACHE:
+            if len(_TCP_CACHE) > 1024:
+                _TCP_CACHE.clear()
+            _TCP_CACHE[key] = _tcp_matrix(tcp)
+        return _TCP_CACHE[key]
+    return _tcp_matrix(tcp)
+
+
+def _tcp_matrix(tcp) -> np.ndarray | None:
     matrix = _transform(tcp, "tcp")
     if np.array_equal(matrix, np.eye(4)):
         return None
+    matrix = np.array(matrix, dtype=float)
+    matrix.setflags(write=False)
     return matrix
 
 

@@ -187,6 +187,7 @@ class MotionPlanner:
         self._unresolved: list[Segment] = []  # Cartesian moves whose joints are not solved
         self._free_at = 0.0  # when the arm is at rest at _q (no pending blend)
         self.end_time = 0.0
+        self._poses: dict[tuple, np.ndarray] = {}  # see _pose_of
         # Solving the targets of straight-line moves in batches is what makes checking a
         # long toolpath fast; only a model that gives all analytic solutions at once can.
         self.lazy_ik = (lazy_ik and hasattr(kinematics, "ik_all_many")
@@ -211,7 +212,7 @@ class MotionPlanner:
     def _end_matrix(self) -> np.ndarray:
         """TCP (4x4) at the end of everything planned, without solving pending moves."""
         if self._end_pose is None:
-            self._end_pose = self.fk(self._q)
+            self._end_pose = self._pose_of(self._q)
         return self._end_pose
 
     def resolve(self) -> None:
@@ -299,7 +300,23 @@ class MotionPlanner:
         return self.kinematics.fk(self.joints_at(time), tcp=self.tcp)
 
     def fk(self, q: np.ndarray) -> np.ndarray:
+        """TCP pose (4x4, m) of joints ``q`` (rad) with the active TCP."""
         return self.kinematics.fk(q, tcp=self.tcp)
+
+    def _pose_of(self, q: np.ndarray) -> np.ndarray:
+        """:meth:`fk`, remembered: a move's start is the previous move's end, and a loop
+        commands the same targets again and again (a read-only matrix; the cache holds at
+        most :data:`POSE_CACHE` poses)."""
+        q = np.asarray(q, dtype=float)
+        key = (q.tobytes(), None if self._tcp is None else self._tcp.tobytes())
+        pose = self._poses.get(key)
+        if pose is None:
+            if len(self._poses) >= POSE_CACHE:
+                self._poses.clear()
+            pose = np.array(self.fk(q), dtype=float)
+            pose.setflags(write=False)
+            self._poses[key] = pose
+        return pose
 
     def ik(self, pose: np.ndarray, q_near: np.ndarray | None = None) -> np.ndarray:
         """Joints (rad) for a TCP pose (4x4) with the active TCP, closest to ``q_near``
@@ -409,6 +426,8 @@ class MotionPlanner:
                        pose: np.ndarray, r: float, span: Span, params: dict, now: float,
                        via: np.ndarray | None = None) -> float:
         if self.lazy_ik:
+            if len(self._unresolved) >= RESOLVE_BATCH:
+                self.resolve()  # as it runs, so that the run's time bound covers it
             segment = self._segment(kind, profile, None, None, r, span, params, pose_from, pose)
         else:
             q_from = self._q
@@ -502,9 +521,9 @@ class MotionPlanner:
                  r: float, span: Span, params: dict, pose_from: np.ndarray | None = None,
                  pose_to: np.ndarray | None = None) -> Segment:
         if pose_from is None:
-            pose_from = self.fk(q_from)
+            pose_from = self._pose_of(q_from)
         if pose_to is None:
-            pose_to = self.fk(q_to)
+            pose_to = self._pose_of(q_to)
         tcp = None if self.tcp is None else self.tcp.copy()
         q_from = None if q_from is None else np.asarray(q_from, dtype=float).copy()
         q_to = None if q_to is None else np.asarray(q_to, dtype=float).copy()
@@ -632,6 +651,14 @@ def _matching_branch(solutions: np.ndarray, q: np.ndarray, tolerance: float = 1e
         return None
     return int(matches[0])
 
+
+RESOLVE_BATCH = 4096
+"""Most straight-line moves whose joints are left unsolved (:meth:`MotionPlanner.resolve`
+solves them in one batch): a toolpath of a million moves is solved in batches as the
+program runs, not all after it."""
+
+POSE_CACHE = 4096
+"""Most TCP poses :meth:`MotionPlanner._pose_of` keeps (then it starts again)."""
 
 STOP_SEARCH = 4.0
 """How far (m) along a line that a condition stops the planner looks for where the arm can

@@ -9,6 +9,7 @@ that fails at a sample can name the program line that commanded it.
 
 from __future__ import annotations
 
+import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -40,6 +41,9 @@ class Trace:
     dt: float
     segments: list
     unreachable: np.ndarray
+    cut: float | None = None
+    """Robot time (s) where sampling stopped at the wall-clock bound (the samples end there,
+    before the motion does); None when the whole motion was sampled."""
 
     @property
     def qdd(self) -> np.ndarray:
@@ -133,6 +137,32 @@ class _Moves:
                              & (not every_sample))
 
     def knots(self, moves: np.ndarray) -> _Knots:
+        """:meth:`solve_knots` of ``moves`` (sorted move indices), each distinct move solved
+        once: a move is the same as another when it starts from the same joints toward the
+        same target, along the same path, with the same speed profile and TCP (a loop that
+        repeats a toolpath from the same place), and then so are its knots."""
+        paths = self.paths
+        rows = np.concatenate([self.q_start[moves], self.q_delta[moves], self.profile[moves],
+                               paths.p0[moves], paths.p1[moves],
+                               paths.r0[moves].reshape(-1, 9), paths.w[moves],
+                               paths.tcp_group[moves, None].astype(float)], axis=1)
+        if len(moves) < 2 or not np.isfinite(rows).all():
+            return self.solve_knots(moves)
+        _, keep, which = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        if len(keep) == len(moves):
+            return self.solve_knots(moves)
+        order = np.argsort(keep)  # the distinct moves by first occurrence
+        rank = np.empty(len(keep), dtype=np.int64)
+        rank[order] = np.arange(len(keep))
+        solved = self.solve_knots(moves[keep[order]])
+        counts = np.diff(np.append(solved.first, len(solved.t)))
+        of_move = rank[which.reshape(-1)]  # each move's distinct move, in `solved`
+        per_move = counts[of_move]
+        first = np.cumsum(per_move) - per_move
+        index = np.repeat(solved.first[of_move] - first, per_move) + np.arange(per_move.sum())
+        return _Knots(moves, first, solved.t[index], solved.q[index], solved.velocity[index])
+
+    def solve_knots(self, moves: np.ndarray) -> _Knots:
         """The knots of straight-line moves ``moves`` (sorted move indices), solved: each
         phase of the speed profile (accelerating, cruising, braking) split into equal steps
         of at most :data:`KNOT_TIME` (cruising: of at most ``max(KNOT_TIME, KNOT_PATH / v)``),
@@ -434,19 +464,80 @@ def joints_at(planner, times: np.ndarray) -> np.ndarray:
     return result
 
 
-def sample(planner, dt: float | None = None, until: float | None = None) -> Trace:
+WINDOW_SAMPLES = 1 << 16
+"""Samples :func:`sample` evaluates at once (131 s of robot time at the e-Series' 2 ms): a
+window holds only the moves under way in it, so that memory and the time to the next look
+at the deadline stay bounded however long the program runs."""
+
+
+class _Window:
+    """The moves ``segments`` of a planner under way in one window of samples, as
+    :func:`_displacements` reads a planner: ``q_start`` is where the arm is before the first
+    of them (every move starts where the one before it ends)."""
+
+    def __init__(self, planner, segments: list, q_start: np.ndarray) -> None:
+        self.kinematics = planner.kinematics
+        self.segments = segments
+        self.q_start = q_start
+
+
+def sample(planner, dt: float | None = None, until: float | None = None,
+           deadline: float | None = None, reserve: float = 0.0) -> Trace:
     """Sample the planned trajectory every ``dt`` s (default: the controller step), up to
-    robot time ``until`` (s; default: the end of the last move)."""
+    robot time ``until`` (s; default: the end of the last move).
+
+    Samples are evaluated in windows of :data:`WINDOW_SAMPLES`, in time order. With a
+    ``deadline`` (``time.monotonic()``) sampling stops at the first window boundary after
+    it, or, with a ``reserve`` r, once the time sampling has taken times 1 + r would reach
+    it (leaving the checks of the samples about r times the time it took to make them): the
+    trace then ends there, less its last two samples (so that every kept speed is the
+    central difference a complete trace has), and ``Trace.cut`` says at which robot
+    time."""
     dt = dt or planner.step_time
-    end = max(planner.end_time, max((s.end for s in planner.segments), default=0.0))
+    segments = planner.segments
+    end = max(planner.end_time, max((s.end for s in segments), default=0.0))
     if until is not None:
         end = min(end, until)
     count = int(np.floor(end / dt + 1e-9)) + 1
-    times = np.arange(count) * dt
     pool = shared_pool()
-    q, active, unreachable = _displacements(planner, times, pool)
+    starts = np.maximum.accumulate(np.array([s.start for s in segments] or [0.0]))
+    ends = np.maximum.accumulate(np.array([s.end for s in segments] or [0.0]))
+    q_parts, active_parts, unreachable_parts = [], [], []
+    stop = count
+    began = time.monotonic()
+    for low in range(0, count, WINDOW_SAMPLES):
+        now = time.monotonic()
+        if deadline is not None and low > 0 and now + reserve * (now - began) > deadline:
+            stop = low
+            break
+        times = np.arange(low, min(low + WINDOW_SAMPLES, count)) * dt
+        # the moves under way in the window: every one before them has ended (ends rise
+        # with starts: a blend starts a move before the previous one ends, never after
+        # its end)
+        first = min(int(np.searchsorted(ends, times[0], side="right")), len(segments))
+        last = min(int(np.searchsorted(starts, times[-1], side="right")), len(segments))
+        if first < len(segments):
+            q_before = np.asarray(segments[first].q_start, dtype=float)
+        else:
+            q_before = np.asarray(segments[-1].q_end if segments else planner.q_start,
+                                  dtype=float)
+        window = _Window(planner, segments[first:max(first, last)], q_before)
+        q, active, unreachable = _displacements(window, times, pool)
+        q_parts.append(q)
+        active_parts.append(np.where(active >= 0, active + first, first - 1))
+        unreachable_parts.append(unreachable)
+    q = np.concatenate(q_parts) if q_parts else np.zeros((0, 6))
+    active = np.concatenate(active_parts) if active_parts else np.zeros(0, dtype=np.int64)
+    unreachable = (np.concatenate(unreachable_parts) if unreachable_parts
+                   else np.zeros(0, dtype=bool))
     qd = _derivative(q, dt, pool)
-    return Trace(times, q, qd, None, active, dt, planner.segments, unreachable)
+    cut = None
+    if stop < count:
+        keep = max(stop - 2, 0)
+        cut = float(keep * dt)
+        q, qd, active, unreachable = q[:keep], qd[:keep], active[:keep], unreachable[:keep]
+    times = np.arange(len(q)) * dt
+    return Trace(times, q, qd, None, active, dt, segments, unreachable, cut)
 
 
 def _derivative(values: np.ndarray, dt: float, pool: ThreadPoolExecutor,

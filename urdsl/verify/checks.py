@@ -14,7 +14,7 @@ one decorated function ``check(ctx) -> list[Finding]`` (and its test).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -48,6 +48,10 @@ class TraceContext:
     robot: Any
     options: CheckOptions
     excluded: np.ndarray | None = None
+    deadline: float | None = None
+    """``time.monotonic()`` after which a long check stops where it got to (None: never)."""
+    partial: dict[str, float] = field(default_factory=dict)
+    """Checks that stopped at the deadline: their label → the robot time (s) checked up to."""
 
 
 @dataclass(frozen=True)
@@ -355,12 +359,14 @@ _SINGULARITY_HINTS = {
 
 
 def collisions(trace: Trace, robot, cell, step: float = 0.02,
-               self_collision: bool = True) -> list[Finding]:
+               self_collision: bool = True, deadline: float | None = None,
+               partial: dict[str, float] | None = None) -> list[Finding]:
     """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders, planes) or itself,
     checked every ``step`` s of robot time while it moves, or further apart where it cannot
     come into contact in between (see :meth:`CollisionModel.sweep`). ``cell`` is a path of a
     cell TOML or a ready :class:`urdsl.kinematics.collision.CollisionModel` (None: no
-    obstacles)."""
+    obstacles). With a ``deadline`` (``time.monotonic()``) the sweep stops once it has
+    passed; ``partial["collisions"]`` then holds the robot time (s) checked up to."""
     if cell is None and not self_collision:
         return []
     from ..kinematics.collision import CollisionModel
@@ -376,8 +382,11 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
     if len(moving) == 0:
         return []
     tcp = trace.segments[-1].tcp if trace.segments else None
-    index, result = model.sweep(trace.q[moving[0]:], tcp=tcp, stride=stride)
+    index, result = model.sweep(trace.q[moving[0]:], tcp=tcp, stride=stride,
+                                deadline=deadline)
     index += moving[0]
+    if result.stopped is not None and partial is not None:
+        partial["collisions"] = float(trace.times[result.stopped + moving[0]])
     hit = np.zeros(len(trace.times), dtype=bool)
     hit[index] = result.colliding
     position = {int(sample): i for i, sample in enumerate(index)}
@@ -532,7 +541,7 @@ cell.toml) and against each other. The finding names the colliding pair and the 
 def _collisions(ctx: TraceContext) -> list[Finding]:
     options = ctx.options
     return collisions(ctx.trace, ctx.robot, options.cell, options.collision_step,
-                      options.self_collision)
+                      options.self_collision, ctx.deadline, ctx.partial)
 
 
 @trace_check(

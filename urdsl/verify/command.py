@@ -156,28 +156,27 @@ def cmd_check(args: argparse.Namespace) -> int:
     for name in _expand_folders(args.files):
         if name.endswith(".py"):
             try:
-                report = _check_program(name, options)
+                report = _bounded(name, options, lambda o, n=name: _check_program(n, o))
             except (DslError, ProgramFileError) as error:
                 print(str(error), file=sys.stderr)
                 failed = True
                 continue
         elif name.lower().endswith(".urp"):
-            report = _check_urp(name, args, options)
+            report = _bounded(name, options, lambda o, n=name: _check_urp(n, args, o))
             if report is None:
                 failed = True
                 continue
         else:
             source = read_input(name)
-            report = _check_script(source, args, options)
+            report = _bounded(name, options, lambda o, s=source: _check_script(s, args, o))
         reports.append(report)
         if not args.json:
             _print(report, args.all_moves)
     if args.json and reports:
-        import json
+        from .report import dumps
 
         documents = [r.to_dict() for r in reports]
-        json.dump(documents[0] if len(documents) == 1 else documents, sys.stdout, indent=2)
-        sys.stdout.write("\n")
+        sys.stdout.write(dumps(documents[0] if len(documents) == 1 else documents) + "\n")
     if args.plot and reports:
         reports[0].plot(args.plot)
         print(f"plot written to {args.plot}", file=sys.stderr)
@@ -206,6 +205,57 @@ def _expand_folders(names: list[str]) -> list[str]:
     return files
 
 
+GRACE = 1.5
+"""Seconds past a program's wall-clock bound after which ``urdsl check`` stops waiting for
+a check that did not stop by itself (a phase that does not look at the bound, such as
+reading a very large project) and reports it as stopped there (URS313)."""
+
+
+def _bounded(name: str, options, check):
+    """``check(options)`` for the program ``name``, on a thread of its own, awaited until
+    ``options.timeout`` + :data:`GRACE` s: a check still running then is left behind (it
+    ends with the process) and its report says in which phase it was (URS313)."""
+    import threading
+    from dataclasses import replace
+
+    from .._deep import STACK_BYTES
+    from .findings import Finding
+    from .report import Report
+    from .run import Progress
+
+    if options.timeout is None:
+        return check(options)
+    started = time.monotonic()
+    progress = Progress()
+    options = replace(options, progress=progress)
+    outcome: dict = {}
+
+    def work() -> None:
+        try:
+            outcome["report"] = check(options)
+        except BaseException as error:  # noqa: BLE001 - re-raised in the caller's thread
+            outcome["error"] = error
+
+    previous = threading.stack_size()
+    threading.stack_size(STACK_BYTES)  # as deep as the thread that runs the command
+    try:
+        worker = threading.Thread(target=work, name=f"urdsl-check {name}", daemon=True)
+        worker.start()
+    finally:
+        threading.stack_size(previous)
+    worker.join(max(0.0, started + options.timeout + GRACE - time.monotonic()))
+    if worker.is_alive():
+        report = Report(name, options.robot)
+        report.findings.append(Finding.of(
+            "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s while "
+            f"{progress.phase} and was abandoned there; nothing of the program was reported",
+            progress.span, None, "use --timeout to allow more time"))
+        return report
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["report"]
+
+
 def _check_script(source, args: argparse.Namespace, options):
     """Check a script file in its project's context (a fragment runs with the definitions
     it takes from its host program, sibling files and installation variables), with what can
@@ -226,6 +276,9 @@ def _check_script(source, args: argparse.Namespace, options):
         module = parse(source.text, source.name)
     except ScriptError:
         return check_text(source.text, source.name, options=options)  # reports the syntax
+    if options.progress is not None:
+        options.progress.span = module.span
+        options.progress.phase = "reading the program's project"
     context = None
     if not args.no_project and source.path is not None:
         missing = [extra for extra in args.include if not os.path.exists(extra)]
@@ -237,6 +290,8 @@ def _check_script(source, args: argparse.Namespace, options):
             raise UsageError(str(error)) from None
     if context is not None:
         module = context.module
+    if options.progress is not None:
+        options.progress.phase = "inferring the robot"
     inference = infer(module, source.path, robot=options.robot if args.robot else None,
                       start_joints=args.start_joints or args.start_joints_deg, tcp=args.tcp,
                       default_robot=options.robot)

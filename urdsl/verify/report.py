@@ -26,7 +26,7 @@ from typing import Any
 from ..script.nodes import Span
 from .findings import Finding
 
-__all__ = ["Report", "Move"]
+__all__ = ["Report", "Move", "dumps"]
 
 
 @dataclass(frozen=True)
@@ -100,14 +100,14 @@ class Report:
             "context": self.context,
             "summary": {s: self.count(s) for s in ("error", "warning", "info")},
             "findings": [f.to_dict() for f in self.findings],
-            "moves": [m.to_dict() for m in self.moves],
+            "moves": _move_dicts(self.moves),
             "events": [{"time": round(e.time, 6), "kind": e.kind, "message": e.message,
                         "line": e.span.line} for e in self.events],
             **({"inferred": self.inferred.to_dict()} if self.inferred is not None else {}),
         }
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2)
+        return dumps(self.to_dict())
 
     def render_text(self, moves: bool = True, max_moves: int = 20) -> str:
         """Plain-text report: each finding with its source line, then the moves and the
@@ -173,3 +173,63 @@ def _seconds(value: float) -> str:
     """A time in s for the move table: milliseconds, or a power of ten for absurd lengths
     (``movej(q, t=1e300)``)."""
     return f"{value:.3f}" if abs(value) < 1e9 else f"{value:.3e}"
+
+
+def _move_dicts(moves: list[Move]) -> list[dict[str, Any]]:
+    """:meth:`Move.to_dict` of every move, each statement's line and column looked up once
+    (a loop's moves share a few statements)."""
+    where: dict[tuple, tuple[int, int]] = {}
+    out = []
+    for move in moves:
+        span = move.span
+        key = (id(span.source), span.start)
+        place = where.get(key)
+        if place is None:
+            place = where[key] = (span.line, span.column)
+        out.append({"kind": move.kind, "line": place[0], "column": place[1],
+                    "start": round(move.start, 6), "duration": round(move.duration, 6)})
+    return out
+
+
+_ROWS = ("moves", "events")
+"""Lists of a report's JSON document that :func:`dumps` writes one entry a line."""
+
+
+def dumps(document: Any) -> str:
+    """A report's JSON document (or a list of them) as text, indented by two spaces, with
+    each entry of its ``moves`` and ``events`` on one line: a cell program's report lists
+    hundreds of thousands of moves, which Python's indenting encoder takes tens of seconds
+    to write, its compact one well under one."""
+    rows: dict[str, list] = {}
+    key_of: dict[str, str] = {}
+
+    def hollow(item: Any) -> Any:
+        if isinstance(item, list):
+            return [hollow(entry) for entry in item]
+        if not isinstance(item, dict):
+            return item
+        out = {}
+        for key, value in item.items():
+            if key in _ROWS and isinstance(value, list) and value:
+                marker = f"\x00rows-{len(rows)}\x00"
+                rows[json.dumps(marker)] = value
+                key_of[json.dumps(marker)] = key
+                out[key] = marker
+            else:
+                out[key] = value
+        return out
+
+    text = json.dumps(hollow(document), indent=2)
+    for marker, value in rows.items():
+        at = text.index(marker)
+        line = text[text.rindex("\n", 0, at) + 1:at]
+        indent = line[:len(line) - len(line.lstrip())]
+        if key_of[marker] == "moves" and "}" not in "".join({m["kind"] for m in value}):
+            # numbers and a move's kind, no brace in any text: one call of the encoder,
+            # split between entries
+            inner = indent + "  " + json.dumps(value)[1:-1].replace(
+                "}, {", "},\n" + indent + "  {")
+        else:
+            inner = ",\n".join(indent + "  " + json.dumps(entry) for entry in value)
+        text = text[:at] + "[\n" + inner + "\n" + indent + "]" + text[at + len(marker):]
+    return text

@@ -38,7 +38,7 @@ from . import checks
 from .findings import Finding, nothing_runs
 from .report import Move, Report
 
-__all__ = ["CheckOptions", "check_text", "check_tree", "check_file", "DEFAULT_START",
+__all__ = ["CheckOptions", "Progress", "check_text", "check_tree", "check_file", "DEFAULT_START",
            "DEFAULT_TIMEOUT"]
 
 DEFAULT_TIMEOUT = 60.0
@@ -46,15 +46,42 @@ DEFAULT_TIMEOUT = 60.0
 
 RUN_SHARE = 0.6
 """The part of the wall-clock bound the program's run may use; sampling the trajectory and
-the trace checks get the rest (each check is skipped, and named, once the bound has passed).
-Sampling is not interrupted: with 80 % here, a cell program stopped by a 60 s bound after 48 s
-(573,099 moves, 2,292 s of robot time) needed 4 s more on a quiet machine and 17 s under load
-to sample and check, past the bound; with 60 % it ends in 39 s on the quiet machine."""
+the trace checks get the rest (see :data:`CHECK_RESERVE`). A cell program stopped by a 60 s
+bound after 48 s (80 % here; 573,099 moves, 2,292 s of robot time) needed 4 s more on a
+quiet machine and 17 s under load to sample and check, when sampling could not be
+interrupted."""
+
+CHECK_RESERVE = 2.0
+"""Sampling the trajectory stops once the time it has taken, counted three times, would
+pass the end of the bound (less the report's writing): the trace checks, and the work
+between them and sampling (joining the windows, speeds), get twice as long as sampling
+took, whatever the machine's speed (measured on a toolpath: the checks take 0.4 times as
+long as sampling, the work between 0.3 times; twice that under load)."""
+
+OUTPUT_SECONDS_PER_MOVE = 5e-6
+"""Wall-clock time (s) kept back per planned move for writing the report after the checks
+(a JSON report lists every move: about 3 µs each measured, on a loaded machine; a cell
+program stopped at the bound may have planned 900,000)."""
 
 DEFAULT_START = (0.0, -1.5707963267948966, 1.5707963267948966, -1.5707963267948966,
                  -1.5707963267948966, 0.0)
 """Where the simulated arm rests before the program (rad): upper arm up, forearm
 horizontal, tool pointing down — a pose every model reaches away from singularities."""
+
+
+@dataclass
+class Progress:
+    """How far one program's check got, for the report of a check that overran its bound
+    (:func:`urdsl.verify.command.cmd_check`): the ``phase`` under way ("running the
+    program", ...) and the ``span`` of the program once parsed."""
+
+    phase: str = "reading the program"
+    span: Any = NO_SPAN
+
+
+def _phase(options: CheckOptions, phase: str) -> None:
+    if options.progress is not None:
+        options.progress.phase = phase
 
 
 @dataclass
@@ -98,6 +125,8 @@ class CheckOptions:
     unknown_globals: dict[str, str] = field(default_factory=dict)
     """Globals the program reads that something outside it defines (a URCap node's code):
     name → where the value comes from; each holds an unknown value."""
+    progress: Progress | None = field(default=None, repr=False, compare=False)
+    """Where the check records its phase (see :class:`Progress`), or None."""
 
 
 def check_text(text: str, filename: str = "<script>", *, robot: str = "ur5e",
@@ -144,6 +173,9 @@ def check_tree(module, filename: str, options: CheckOptions,
 
 
 def _check_tree(module, filename: str, options: CheckOptions, started: float) -> Report:
+    if options.progress is not None:
+        options.progress.span = module.span
+    _phase(options, "running the program")
     robot = _robot_model(options.robot, options.calibration)
     cb3 = getattr(robot.spec, "generation", "") == "cb3"
     step = 0.008 if cb3 else 0.002
@@ -209,12 +241,18 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     # sampled while the arm moves (after the last move it rests: nothing to check), and
     # never past --max-time
     last = max((s.end for s in planner.segments), default=0.0)
-    trace = sample(planner, options.sample_time or step, until=min(last, options.max_time))
+    # the bound less the time to write the report: sampling leaves the trace checks as
+    # long as it took (CHECK_RESERVE), the checks stop at the end of it
+    final = None if options.timeout is None else started + options.timeout - \
+        OUTPUT_SECONDS_PER_MOVE * len(planner.segments)
+    _phase(options, "sampling the motion")
+    trace = sample(planner, options.sample_time or step, until=min(last, options.max_time),
+                   deadline=final, reserve=CHECK_RESERVE)
     report.trace = trace
     report.cycle_time = float(min(max(result.time, trace.duration), options.max_time))
     report.moves = [Move(s.kind, s.span, s.start, s.duration, s.params.get("lead"))
                     for s in planner.segments]
-    final = None if options.timeout is None else started + options.timeout
+    _phase(options, "checking the motion")
     report.findings.extend(_trace_findings(trace, planner, robot, options, final,
                                            module.span))
     report.sort()
@@ -272,9 +310,17 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
     """The trace checks, in order; once ``deadline`` (``time.monotonic()``) has passed the
     remaining ones are skipped and a URS313 finding names them."""
     findings: list[Finding] = []
+    if trace.cut is not None:
+        # the first move not sampled: what the program did from there on was not checked
+        where = next((s for s in planner.segments if s.start >= trace.cut), None)
+        findings.append(Finding.of(
+            "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s while "
+            f"sampling the motion: the moves from robot time {trace.cut:.3f} s on were not "
+            "checked", where.span if where is not None else span, trace.cut,
+            "use --timeout to allow more time"))
     if len(trace.times) == 0 or not planner.segments:
         return findings
-    ctx = checks.TraceContext(trace, planner, robot, options)
+    ctx = checks.TraceContext(trace, planner, robot, options, deadline=deadline)
     steps = [check for check in checks.trace_checks() if check.applies(options)]
     for index, check in enumerate(steps):
         if deadline is not None and time.monotonic() > deadline:
@@ -284,4 +330,9 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
                 f"not checked: {skipped}", span, None, "use --timeout to allow more time"))
             break
         findings += check.run(ctx)
+    for label, reached in ctx.partial.items():
+        findings.append(Finding.of(
+            "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s; "
+            f"{label} checked up to robot time {reached:.3f} s only", span, reached,
+            "use --timeout to allow more time"))
     return findings
