@@ -173,16 +173,18 @@ def _folder_with_programs(tmp_path: Path) -> Path:
     return cell
 
 
-def test_lint_of_a_folder_takes_its_urp_programs_and_skips_polyscopes_scripts(tmp_path,
-                                                                             capsys):
+def test_lint_of_a_folder_takes_polyscopes_script_for_a_urp_beside_it(tmp_path, capsys):
     cell = _folder_with_programs(tmp_path)
     assert main(["lint", "--format", "json", str(cell)]) == 0
     captured = capsys.readouterr()
     assert "Found" not in captured.out
-    assert f"note: {cell / 'pick.script'} skipped: PolyScope wrote it beside pick.urp, " \
-           "which is linted instead" in captured.err
+    # the .script PolyScope generated holds what the URCaps add: it is what the robot ran
+    assert f"note: {cell / 'pick.urp'} skipped: pick.script beside it is what PolyScope " \
+           "generated from it" in captured.err
+    assert "name pick.urp to lint its program tree" in captured.err
     assert "tool.script" not in captured.err
-    # the .urp is really linted: a program PolyScope could not run is an error naming it
+    # a .urp without its .script is linted: a program PolyScope could not run is an error
+    (cell / "pick.script").unlink()
     (cell / "pick.urp").write_bytes(program('<Set type="DigitalOutput"><pin '
                                             'referencedName="nowhere"/></Set>', name="pick"))
     assert main(["lint", str(cell)]) == 1
@@ -194,10 +196,13 @@ def test_check_of_a_folder_checks_each_program_once(tmp_path, capsys):
     cell = _folder_with_programs(tmp_path)
     main(["check", "--json", str(cell)])
     captured = capsys.readouterr()
-    assert "pick.script skipped" in captured.err
+    assert "pick.urp skipped" in captured.err
     import json
     names = [Path(document["file"]).name for document in json.loads(captured.out)]
-    assert sorted(names) == ["pick.urp (compiled)", "tool.script"]
+    assert sorted(names) == ["pick.script", "tool.script"]
+    # named on the command line, the .urp is checked itself
+    main(["check", "--json", str(cell / "pick.urp")])
+    assert Path(json.loads(capsys.readouterr().out)["file"]).name == "pick.urp (compiled)"
 
 
 WAYPOINT_UNTIL = """<Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true"

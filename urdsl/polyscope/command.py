@@ -18,33 +18,38 @@ SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
 
 def collect_programs(folder: str | Path) -> tuple[list[str], list[tuple[str, str]]]:
     """The programs in ``folder`` and its subfolders (hidden ones left out), sorted:
-    PolyScope programs (``.urp``) and URScript files, except a ``.script`` PolyScope wrote
-    beside a ``.urp`` of the same name (the program is the ``.urp``; its ``.script`` is a
-    copy PolyScope writes on saving, often stale). Returns ``(files, skipped)``, ``skipped``
-    holding ``(script, urp)`` pairs."""
+    URScript files and PolyScope programs (``.urp``), except a ``.urp`` with a ``.script`` of
+    the same name beside it. That ``.script`` is what PolyScope generated when it saved the
+    program and what the controller ran: it holds the code URCaps generate and the preamble
+    of the installation the program ran with, which compiling the ``.urp`` here cannot
+    reproduce (a folder check of the ``.urp`` reported the URCaps' names as undefined).
+    Name the ``.urp`` itself to lint or check its program tree. Returns ``(files,
+    skipped)``, ``skipped`` holding ``(urp, script)`` pairs."""
     root = Path(folder)
     found = sorted(
         path for path in root.rglob("*")
         if path.suffix.lower() in (*SCRIPT_SUFFIXES, ".urp") and path.is_file()
         and not any(part.startswith(".") for part in path.parts[len(root.parts):]))
-    programs = {path.with_suffix("") for path in found if path.suffix.lower() == ".urp"}
+    scripts = {path.with_suffix(""): path for path in found if path.suffix.lower() == ".script"}
     files: list[str] = []
     skipped: list[tuple[str, str]] = []
     for path in found:
-        if path.suffix.lower() == ".script" and path.with_suffix("") in programs:
-            urp = next(p for p in found if p.suffix.lower() == ".urp"
-                       and p.with_suffix("") == path.with_suffix(""))
-            skipped.append((str(path), str(urp)))
+        script = scripts.get(path.with_suffix("")) if path.suffix.lower() == ".urp" else None
+        if script is not None:
+            skipped.append((str(path), str(script)))
         else:
             files.append(str(path))
     return files, skipped
 
 
 def report_skipped(skipped: list[tuple[str, str]], verb: str) -> None:
-    """Say on standard error which ``.script`` files were left out for their ``.urp``."""
-    for script, urp in skipped:
-        print(f"note: {script} skipped: PolyScope wrote it beside {Path(urp).name}, "
-              f"which is {verb} instead", file=sys.stderr)
+    """Say on standard error which ``.urp`` programs were left out for PolyScope's
+    ``.script`` beside them."""
+    for urp, script in skipped:
+        print(f"note: {urp} skipped: {Path(script).name} beside it is what PolyScope "
+              f"generated from it (with its URCaps' code), and is {verb} instead; name "
+              f"{Path(urp).name} to {verb[:-2] if verb.endswith('ed') else verb} its program "
+              "tree", file=sys.stderr)
 
 
 def _installation_for(program: Program, path: str | Path) -> Installation | None:
