@@ -80,6 +80,24 @@ def test_urcap_nodes_are_an_info_finding_and_a_device(tmp_path, capsys):
     assert report["cycle_time"] == pytest.approx(DEVICE_REPLY_TIME + 0.5, abs=0.01)
 
 
+def test_lint_of_a_urp_with_urcap_code_warns_for_names_only_that_code_can_define(tmp_path,
+                                                                                capsys):
+    program = tmp_path / "urcap.urp"
+    body = ('<If type="If" checkContinuously="false"><expression>' + _chars("grip_ok")
+            + '</expression><children><Wait type="Sleep"><waitTime>0.5</waitTime></Wait>'
+            '</children></If>')
+    program.write_text(_program(URCAP + body))
+    assert main(["lint", str(program)]) == 0
+    out = capsys.readouterr().out
+    assert "URS101 name 'grip_ok' is not defined; it may come from code only a URCap " \
+           "generates (Example_Gripper)" in out and "Found 1 warning" in out
+    # without URCap code nothing can define it: still an error
+    program.write_text(_program(body))
+    assert main(["lint", str(program)]) == 1
+    out = capsys.readouterr().out
+    assert "URS101 name 'grip_ok' is not defined [node" in out and "Found 1 error" in out
+
+
 def test_lint_names_the_node(cell, capsys):
     main(["lint", str(cell), "--format", "json"])
     found = json.loads(capsys.readouterr().out)

@@ -237,7 +237,12 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
     """A PolyScope program: compiled, its script linted, each finding naming its node (see
     :mod:`urdsl.polyscope.check`); a program that cannot be compiled is one URS001 error."""
     from .._cli import UsageError
-    from ..polyscope.check import generate, node_findings, urcap_diagnostics
+    from ..polyscope.check import (
+        generate,
+        node_findings,
+        soften_urcap_names,
+        urcap_diagnostics,
+    )
     from ..polyscope.compile import CompileError
     from ..polyscope.urp import UrpError
     from ..script.diagnostics import Diagnostic
@@ -257,7 +262,8 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         text = str(error)
         message = text.split(": error: ", 1)[1] if ": error: " in text else text
         return [Diagnostic(name, 1, 1, "error", "URS001", message)]
-    found = node_findings(generated, lint_text(generated.text, generated.filename, settings))
+    found = node_findings(generated, soften_urcap_names(
+        generated, lint_text(generated.text, generated.filename, settings)))
     wanted = not select or any("URS214".startswith(code) for code in select)
     if wanted and not any("URS214".startswith(code) for code in ignore):
         found.extend(urcap_diagnostics(generated))

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..script import nodes as n
@@ -142,6 +142,34 @@ def urcap_diagnostics(generated: Generated) -> list[Diagnostic]:
         out.append(Diagnostic(generated.filename, line, 1, "info", URCAP_CODE,
                               f"{message} [{generated.where(node)}]",
                               source_line=lines[line - 1] if lines else None))
+    return out
+
+
+def urcap_sources(generated: Generated) -> list[str]:
+    """The URCaps whose code urdsl cannot generate into this program: its URCap program
+    nodes and the URCaps contributing to its installation (their preamble code defines
+    names the program uses, e.g. a gripper's state variables)."""
+    names = [node.attrs.get("strategyURCapName") or node.title
+             for _number, node in generated.urcap_nodes()]
+    if generated.installation is not None:
+        names.extend(name for name, _vendor, _title in generated.installation.urcaps)
+    return list(dict.fromkeys(name for name in names if name))
+
+
+def soften_urcap_names(generated: Generated, found: list) -> list:
+    """Lint findings of a compiled program with URCap code: a name defined nowhere in what
+    urdsl generated (URS101) may come from that code, so it is a warning naming the
+    URCaps rather than an error."""
+    sources = urcap_sources(generated)
+    if not sources:
+        return found
+    out = []
+    for finding in found:
+        if finding.code == "URS101" and finding.severity == "error":
+            finding = replace(finding, severity="warning", message=(
+                f"{finding.message}; it may come from code only a URCap generates "
+                f"({', '.join(sources)})"))
+        out.append(finding)
     return out
 
 
