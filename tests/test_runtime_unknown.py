@@ -3,6 +3,7 @@ warns once per statement, and never turns a device's reply into an error."""
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -233,6 +234,15 @@ def test_an_operation_with_an_unknown_operand_never_fails(op, known, unknown_lef
     assert result.error is None, result.error
     x = result.globals["x"]
     assert type(x) is Unknown or (op in ("and", "or") and type(x) is bool)
+
+
+@pytest.mark.parametrize("op", ["+", "-", "*", "/", "<", "==", "!=", "and", "or", "xor"])
+def test_an_operation_on_two_unknowns_is_unknown(op):
+    # PolyScope writes `read_input_boolean_register(64) xor read_input_boolean_register(65)`
+    result = run("a = read_input_boolean_register(64)\nb = read_input_boolean_register(65)\n"
+                 f"x = a {op} b\n")
+    assert result.error is None, result.error
+    assert type(result.globals["x"]) is Unknown
 
 
 def test_boolean_registers_go_up_to_127():

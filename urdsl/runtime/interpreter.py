@@ -1070,8 +1070,11 @@ class _Compiler:
                 raise rt.error("arithmetic", "division by zero", node) from None
             except (TypeError, ValueError) as error:
                 found = has_unknown(a) or has_unknown(b)
-                if found is not None and not (op == "xor" and type(a if found is b else b)
-                                              is not bool):
+                # xor of an unknown needs the other side a bool or unknown too (two device
+                # reads, e.g. RTDE boolean registers, are a valid xor)
+                other = b if found is a else a
+                if found is not None and not (op == "xor" and type(other) is not bool
+                                              and has_unknown(other) is None):
                     return found.leaning(None)
                 raise rt.error("type", f"'{op}' cannot combine a {type_name(a)} and a "
                                f"{type_name(b)}" + (f": {error}" if str(error) else ""),
