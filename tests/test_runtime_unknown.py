@@ -176,6 +176,22 @@ def test_a_thread_looping_on_an_input_without_sync_is_still_stopped():
     assert result.error is not None and result.error.diagnostic.code == "URS207"
 
 
+def test_a_socket_read_with_a_timeout_the_device_sent_still_waits():
+    # UR's External Control loop: the read's timeout comes from the previous reply
+    result = run('socket_open("127.0.0.1", 50001, "reverse")\n'
+                 "timeout = 0.0\n"
+                 "n = 0\n"
+                 "while n < 20000:\n"
+                 '  reply = socket_read_binary_integer(8, "reverse", timeout)\n'
+                 "  timeout = reply[1] / 1000.0\n"
+                 "  n = n + 1\n"
+                 "end\n", runaway_limit=5_000)
+    assert result.error is None, result.error
+    assert result.time >= 19_999 * 0.002  # one controller frame per read at least
+    assert any("its wait is taken as one controller frame" in w.message
+               for w in result.warnings)
+
+
 def test_real_errors_on_known_values_stay_errors():
     result = run("r = read_input_integer_register(0)\nx = [1, 2][5]\n")
     assert result.error is not None and result.error.diagnostic.code == "URS202"

@@ -218,6 +218,14 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
         rt.warn_once(f"{name}() depends on {found.source}, which is unknown offline; not "
                      "checked", node)
         return None
+    if kind == "read":
+        # a socket read whose timeout (or socket, or count) is unknown still waits for the
+        # device: at least one controller frame (UR's External Control script reads its
+        # command socket with a timeout the driver sent, in a loop that has no other wait)
+        rt.warn_once(f"{name}() depends on {found.source}, which is unknown offline; its "
+                     "wait is taken as one controller frame and its reply is unknown", node)
+        rt.sync()
+        return unknown_from(name, node)
     return found
 
 
@@ -225,7 +233,8 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
 def _kind(name: str, positional: int, keywords: tuple[str, ...]) -> str:
     """How :func:`unknown_call` treats a call shape: ``call`` (as usual: it takes unknown
     values, or the call is wrong and reports it), ``store``, ``motion``, ``sleep``,
-    ``procedure`` (skipped) or ``function`` (an unknown result)."""
+    ``procedure`` (skipped), ``read`` (a socket read: one controller frame, an unknown
+    reply) or ``function`` (an unknown result)."""
     from ..script.builtins import lookup
 
     row = lookup(name)
@@ -239,6 +248,8 @@ def _kind(name: str, positional: int, keywords: tuple[str, ...]) -> str:
         return "motion"
     if name == "sleep":
         return "sleep"
+    if name.startswith("socket_read") or name == "socket_get_var":
+        return "read"  # a read over a link waits for the device; an input read does not
     if not row.returns or row.returns[0] == "None":
         return "procedure"
     return "function"
