@@ -133,3 +133,27 @@ def test_a_file_in_a_subfolder_finds_the_program_above_that_includes_it(capsys):
     # a file no program above includes keeps its own folder
     lonely = DATA / "configured" / "lib" / "tools.script"
     assert Project.discover(lonely, use_config=False).root == lonely.parent
+
+
+def test_the_search_above_parses_only_files_that_may_include_the_fragment(tmp_path,
+                                                                          monkeypatch):
+    # searching the folders above a fragment (for /tmp/x.script: /tmp) meets unrelated
+    # scripts; only one that names the fragment or holds its lines is parsed
+    from urdsl.project import model
+
+    (tmp_path / "cell" / "scripts").mkdir(parents=True)
+    fragment = tmp_path / "cell" / "scripts" / "seam.script"
+    fragment.write_text("seam_speed = 0.01\nmovel(seam_end, v=seam_speed)\n")
+    (tmp_path / "cell" / "weld.script").write_text(
+        'def weld():\n  $ 1 "Script: seam.script"\n  seam_end = p[0.4, 0, 0.2, 0, 3.14, 0]\n'
+        "  seam_speed = 0.01\n  movel(seam_end, v=seam_speed)\nend\n")
+    (tmp_path / "cell" / "other.script").write_text(
+        "def other():\n" + "  x = 1\n" * 2000 + "end\n")
+    parsed: list[str] = []
+    real = model.script_file
+    monkeypatch.setattr(model, "script_file",
+                        lambda path, *a: parsed.append(path.name) or real(path, *a))
+    model._CACHE.clear()
+    project = Project.discover(fragment, use_config=False)
+    assert names(project.context(fragment).hosts) == ["weld.script"]
+    assert "weld.script" in parsed and "other.script" not in parsed[:parsed.index("weld.script")]

@@ -398,6 +398,8 @@ def _folder_above(start: Path, paths: list[Path], beside: list[Path]) -> Path | 
         for candidate in candidates:
             if candidate.suffix not in SCRIPT_SUFFIXES or _key(candidate) in skip:
                 continue
+            if not any(_may_include(candidate, fragment) for fragment in fragments):
+                continue  # cannot include any of them: not parsed
             host = load_script(candidate)
             if host is not None and host.is_host and any(
                     _includes(host, fragment) for fragment in fragments):
@@ -588,6 +590,25 @@ def _code_lines(text: str) -> list[str]:
             continue
         lines.append(compact)
     return lines
+
+
+def _may_include(path: Path, fragment: ScriptFile) -> bool:
+    """Whether the file at ``path`` could include ``fragment`` (see :func:`_includes`),
+    decided from its text without parsing it: its text names the fragment's file, or holds
+    enough of its code lines. Searching the folders above a file (for ``/tmp/x.script``,
+    ``/tmp`` itself) meets large unrelated scripts; only a possible host is parsed."""
+    try:
+        if path.stat().st_size > MAX_FILE_BYTES:
+            return False
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return False
+    if fragment.path.name.lower() in text.lower():
+        return True
+    lines = fragment.code_line_list
+    if not lines:
+        return False
+    return _share(lines, frozenset(_code_lines(text))) >= min(_INLINE_SHARE, _SUBPROGRAM_SHARE)
 
 
 def _includes(host: ScriptFile, fragment: ScriptFile) -> bool:
