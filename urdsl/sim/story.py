@@ -49,7 +49,9 @@ class StoryResult:
     ``planned_time``: the checker's cycle time (s); ``observed_time``: how long the
     controller reported PLAYING (s of controller time); ``max_deviation``: largest
     difference between recorded and planned joints (rad) over the run; ``samples``: RTDE
-    samples recorded; ``sent``: False when the check found errors and nothing was sent.
+    samples recorded; ``sent``: False when the check found errors and nothing was sent;
+    ``behind``: wall seconds the controller gave up keeping ``speed`` because the machine was
+    too slow (its controller time, and so ``observed_time``, is not affected).
     """
 
     program: Path
@@ -61,6 +63,7 @@ class StoryResult:
     observed_time: float = 0.0
     max_deviation: float = float("nan")
     sent: bool = False
+    behind: float = 0.0
     messages: list[str] = field(default_factory=list)
 
     def paths(self) -> list[Path]:
@@ -195,6 +198,7 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
         stop.set()
         recorder.join(10)
         result.messages = [f"{m.kind}: {m.text}" for m in sim.messages]
+        result.behind = sim.stats.behind
     if "error" in recording:
         result.messages.append(f"recorder: {recording['error']}")
 
@@ -224,6 +228,10 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
         f"{result.observed_time:.3f} s of controller time",
         f"largest gap between recorded and planned joints: {result.max_deviation:.2e} rad",
     ]
+    if result.behind:
+        lines.append(f"the machine was too slow for speed x{speed:g}: the controller ran "
+                     f"{result.behind:.2f} s of wall time behind (its controller time, in "
+                     "lockstep with the program, is not affected)")
     if result.messages:
         lines += ["controller messages:"] + [f"  {m}" for m in result.messages]
     result.report.write_text("\n".join(lines) + "\n", encoding="utf-8")
