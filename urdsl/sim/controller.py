@@ -144,7 +144,8 @@ class VirtualController:
 
     ``robot``: model name (``urdsl.kinematics.MODELS``); ``version``: controller software
     (``"5.15"``; default 5.15 for e-Series arms, 3.15 for CB3 arms); ``speed``: how much faster
-    than real time programs run; ``start_joints`` (rad); ``programs_dir``: the folder the
+    than real time programs run (at most: controller time keeps in lockstep with the program,
+    see the module docstring); ``start_joints`` (rad); ``programs_dir``: the folder the
     dashboard's ``load`` reads; ``powered``: start powered on with brakes released (a real
     controller boots powered off: pass False to practise the start-up sequence);
     ``kinematics``: a robot model object to use instead of ``Robot.model(robot)``.
