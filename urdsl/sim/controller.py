@@ -12,6 +12,8 @@ Threads
   :meth:`VirtualController._pace` with the robot time it is about to advance to, and the
   runner waits there until the clock reaches it. A new ``def`` (or bare lines) stops the
   running program first; between programs the arm rests where the last one left it.
+* ``sec`` programs run at once in a thread of their own, beside the main program, against the
+  same I/O and registers; they may read the robot state but not move it.
 
 **Lockstep.** Controller time is a count of steps, not a reading of the wall clock: the
 clock moves it on by one step, lets the interpreter run everything due up to that time, and
@@ -23,8 +25,6 @@ of the program: a delay of up to :data:`CATCH_UP` steps is made up by publishing
 steps back to back; a longer one is given up (``stats.behind``, a warning on the logger
 ``urdsl.sim`` the first time), and the controller goes on from there, more slowly in wall
 time. No step is ever skipped.
-* ``sec`` programs run at once in a thread of their own, beside the main program, against the
-  same I/O and registers; they may read the robot state but not move it.
 
 Everything the world sees goes through :meth:`snapshot` and the messages given to the
 message subscribers: runtime exceptions (with line and column), ``textmsg`` texts, popups,
@@ -813,10 +813,11 @@ class VirtualController:
         self.stats.behind += seconds
         self.stats.slowdowns += 1
         if self.stats.slowdowns == 1:
-            _log.warning("virtual controller: this machine is too slow for speed x%g (%.0f ms "
-                         "behind): controller time now runs slower than wall time; every "
+            _log.warning("virtual controller: fell %.0f ms of wall time behind speed x%g (this "
+                         "machine is too slow for it, or the process was held up): "
+                         "controller time goes on from here, slower than wall time; every "
                          "step is still published, and programs keep their timing in "
-                         "controller time", self.speed, seconds * 1000)
+                         "controller time", seconds * 1000, self.speed)
 
     def _compute(self, now: float) -> tuple[Snapshot, list[Callable[[Snapshot], None]]]:
         """The state at controller time ``now`` (s) and the subscribers to give it to."""
