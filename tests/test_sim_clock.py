@@ -43,17 +43,19 @@ def counting(frames: int = FRAMES, work: int = 0) -> str:
 
 
 def run_recorded(sim: VirtualController, program: str,
-                 timeout: float = 60.0) -> list[tuple[float, int, int]]:
+                 timeout: float = 60.0) -> list[tuple[float, int, int, float]]:
     """Run ``program`` and return every state published from its start to the first step
-    after its end: (controller time s, program state, output integer register 0)."""
-    steps: list[tuple[float, int, int]] = []
+    after its end: (controller time s, program state, output integer register 0, speed
+    scaling)."""
+    steps: list[tuple[float, int, int, float]] = []
     ended = threading.Event()
 
     def watch(snap) -> None:
         if ended.is_set():
             return
         if snap.program_state == ProgramState.PLAYING or steps:
-            steps.append((snap.time, int(snap.program_state), snap.output_int_registers[0]))
+            steps.append((snap.time, int(snap.program_state), snap.output_int_registers[0],
+                          snap.speed_scaling))
             if snap.program_state == ProgramState.STOPPED:
                 ended.set()
 
@@ -64,16 +66,17 @@ def run_recorded(sim: VirtualController, program: str,
     return steps
 
 
-def assert_lockstep(sim: VirtualController, steps: list[tuple[float, int, int]],
+def assert_lockstep(sim: VirtualController, steps: list[tuple[float, int, int, float]],
                     frames: int = FRAMES) -> None:
-    times = np.array([t for t, _, _ in steps])
+    times = np.array([t for t, *_ in steps])
     step = sim.step_time * sim.speed
     # every step published, in order: consecutive states are exactly one step apart
     assert np.allclose(np.diff(times), step, atol=1e-9)
     start = times[0]
-    for time_, state, register in steps:
+    for time_, state, register, scaling in steps:
         if state == ProgramState.PLAYING:
             # the program has done exactly the frames due by the step's controller time
+            assert scaling == 1.0
             assert register == min(round((time_ - start) / FRAME), frames - 1)
     # the program took its own time in controller time, however long it took in wall time
     assert steps[-1][1] == ProgramState.STOPPED
@@ -144,3 +147,42 @@ def test_rtde_carries_the_controller_time_of_the_programs_state(monkeypatch, tmp
     assert len(playing) == FRAMES * FRAME / 0.008
     expected = np.minimum(np.round((playing[:, 0] - playing[0, 0]) / FRAME), FRAMES - 1)
     assert np.array_equal(playing[:, 2], expected)
+
+
+def test_a_program_that_overruns_a_step_is_held_while_the_streams_go_on(monkeypatch):
+    """A step's work that takes longer than OVERRUN s of wall time (here one frame that
+    sleeps 0.6 s): the steps are still published, one after the other, with the program held
+    (speed scaling 0, its time standing still) until it has done that step's work; the arm
+    and the program agree throughout, and the program takes the held steps longer."""
+    import time
+
+    from urdsl.sim.controller import OVERRUN
+
+    original = Interpreter.sync
+    calls = []
+
+    def stuck_once(self) -> None:
+        calls.append(1)
+        if len(calls) == 20:
+            time.sleep(OVERRUN + 0.35)
+        original(self)
+
+    monkeypatch.setattr(Interpreter, "sync", stuck_once)
+    with VirtualController(speed=4.0) as sim:
+        steps = run_recorded(sim, counting(frames=64))
+        held_total = sim.stats.held
+    step = sim.step_time * sim.speed
+    times = np.array([t for t, *_ in steps])
+    assert np.allclose(np.diff(times), step, atol=1e-9)  # published on, none skipped
+    held = np.array([state == ProgramState.PLAYING and scaling == 0.0
+                     for _, state, _, scaling in steps])
+    # about (0.6 s - OVERRUN) of held steps at 500 Hz; at least a few, however loaded
+    assert held.sum() == held_total >= 10
+    program_time = times - times[0] - step * np.cumsum(held)
+    overrun = np.roll(held, -1) & ~held  # the step published mid-way through the work
+    for (_, state, register, _), t, mid in zip(steps, program_time, overrun | held, strict=True):
+        if state == ProgramState.PLAYING:
+            expected = min(round(t / FRAME), 63)
+            assert register <= expected if mid else register == expected
+    assert steps[-1][1] == ProgramState.STOPPED
+    assert program_time[-1] == pytest.approx(64 * FRAME, abs=1e-9)

@@ -26,6 +26,15 @@ steps back to back; a longer one is given up (``stats.behind``, a warning on the
 ``urdsl.sim`` the first time), and the controller goes on from there, more slowly in wall
 time. No step is ever skipped.
 
+**Overruns.** A real controller stops a program that does not finish its work within a frame;
+urdsl runs it to the end (a 100,000-line program without a move runs in one frame), but the
+streams must not stall meanwhile. When the program has not finished a step's work after
+:data:`OVERRUN` s of wall time, the clock publishes the step anyway, and goes on publishing
+steps while the program works, with the program held: its time stands still (as while
+paused, ``speed_scaling`` 0) until it has caught up, so the arm and the program still agree;
+the program then takes that much longer in controller time (``stats.held`` steps, a warning
+the first time).
+
 Everything the world sees goes through :meth:`snapshot` and the messages given to the
 message subscribers: runtime exceptions (with line and column), ``textmsg`` texts, popups,
 safety events, and the controller's complaints.
@@ -79,6 +88,11 @@ CATCH_UP = 50
 a delay of the process or of the interpreter; a longer delay is not made up: the controller
 goes on from where it is, behind ``speed`` x wall time (never skipping a step)."""
 
+OVERRUN = 0.25
+"""Wall time (s) the clock waits for the program's work of one step before it holds the
+program and goes on publishing (module docstring, "Overruns"): far above what a loaded
+machine takes for a step's usual work, far below the timeouts of clients waiting for data."""
+
 LOCKSTEP_POLL = 0.05
 """Longest single wait (s of wall time) of the clock for the interpreter and of the
 interpreter for the clock, between which the waiter looks again at stops and closing."""
@@ -106,6 +120,8 @@ class _Program:
     frozen_at: float | None = None  # program time at which a stop froze the arm
     stop: bool = False
     waiting: float | None = None  # the program time the interpreter waits for in _pace
+    overrun: bool = False  # the interpreter overran a step: the clock holds it while busy
+    held: bool = False  # the state being published holds the program (time stands still)
 
     def program_time(self, now: float) -> float:
         if self.frozen_at is not None:
@@ -128,11 +144,14 @@ class Stats:
     """Counters for benchmarks and tests: ``ticks`` published (one per controller step, none
     ever skipped), ``behind`` wall seconds the controller gave up keeping ``speed`` (it was
     too slow: controller time fell behind ``speed`` x wall time by that much),
-    ``slowdowns`` how often that happened, ``programs`` started, ``errors`` reported."""
+    ``slowdowns`` how often that happened, ``held`` steps published while a program that
+    overran its step was held (:data:`OVERRUN`), ``programs`` started, ``errors``
+    reported."""
 
     ticks: int = 0
     behind: float = 0.0
     slowdowns: int = 0
+    held: int = 0
     programs: int = 0
     errors: int = 0
     protective_stops: int = 0
@@ -217,6 +236,7 @@ class VirtualController:
         self._wall0 = time.perf_counter()
         self._time = 0.0  # controller time of the current step (s), moved on by the clock
         self._computed = 0.0  # controller time of the last state computed (s)
+        self._overrun_said = False
         self._prev_q = q.copy()
         self._prev_qd = np.zeros(6)
         self._prev_tcp = None
@@ -802,11 +822,51 @@ class VirtualController:
                 if program is not None and program.waiting is not None \
                         and self._due(program, program.waiting):
                     self._wake.notify_all()  # the program may run to this step
-                while self._busy() and not self._closing.is_set():
-                    self._wake.wait(LOCKSTEP_POLL)
+                self._wait_for_program(step)
                 # computed in the same hold of the lock: no program starts or ends between
                 snapshot, subscribers = self._compute(self._time)
             self._emit(snapshot, subscribers)
+
+    def _wait_for_program(self, step: float) -> None:
+        """Wait until the running program has done its work due by the current step, at most
+        :data:`OVERRUN` s of wall time (caller holds the lock). A program still working on a
+        step's work then overran: this step shows it mid-way, and each further step while it
+        works holds it. A program that was not even woken within that time (a starved
+        thread) is held at once."""
+        deadline = time.perf_counter() + OVERRUN
+        if self._program is not None:
+            self._program.held = False
+        while not self._closing.is_set():
+            program = self._program
+            if program is None:
+                return
+            if not self._busy():
+                program.overrun = False
+                return
+            working = program.waiting is None  # not merely due to be woken in _pace
+            if program.overrun and working:
+                self._hold(program, step)
+                return
+            if time.perf_counter() >= deadline:
+                if not working:
+                    self._hold(program, step)
+                    return
+                program.overrun = True
+                if not self._overrun_said:
+                    self._overrun_said = True
+                    _log.warning("virtual controller: program %s took more than %g s of wall "
+                                 "time for one step; it is held (its time stands still) until "
+                                 "it has done that step's work, the streams go on meanwhile",
+                                 program.name, OVERRUN)
+                return
+            self._wake.wait(min(deadline - time.perf_counter(), LOCKSTEP_POLL))
+
+    def _hold(self, program: _Program, step: float) -> None:
+        """Publish the current step with ``program``'s time standing still (as while paused):
+        its state stays the one it has reached (caller holds the lock)."""
+        program.paused_total += step
+        program.held = True
+        self.stats.held += 1
 
     def _fell_behind(self, seconds: float) -> None:
         """Count ``seconds`` of wall time the controller gave up; say so the first time."""
@@ -922,7 +982,8 @@ class VirtualController:
                       RobotMode.POWER_ON: JointMode.BOOTING}.get(self._robot_mode,
                                                                  JointMode.POWER_OFF)
         program = self._program
-        speed_scaling = 0.0 if program is not None and program.paused_at is not None else 1.0
+        speed_scaling = 0.0 if program is not None and (program.paused_at is not None
+                                                        or program.held) else 1.0
         return Snapshot(
             time=now, q=_frozen(q), qd=_frozen(qd), qdd=_frozen(qdd), tcp=_frozen(tcp),
             tcp_speed=_frozen(tcp_speed), tcp_offset=_frozen(self._tcp_offset),
