@@ -818,14 +818,21 @@ class VirtualController:
                 self._fell_behind(-left)
             with self._wake:
                 self._time = tick * step
-                program = self._program
-                if program is not None and program.waiting is not None \
-                        and self._due(program, program.waiting):
+                if self._waiting_is_due():
                     self._wake.notify_all()  # the program may run to this step
                 self._wait_for_program(step)
                 # computed in the same hold of the lock: no program starts or ends between
                 snapshot, subscribers = self._compute(self._time)
             self._emit(snapshot, subscribers)
+
+    def _waiting_is_due(self) -> bool:
+        """Whether the running program waits in :meth:`_pace` for a time that has come
+        (caller holds the lock). A method, not a line in :meth:`_clock`: a local variable of
+        the clock's loop would keep the last program (its tree and closures) alive until the
+        next step, past the runner's collection of it."""
+        program = self._program
+        return program is not None and program.waiting is not None \
+            and self._due(program, program.waiting)
 
     def _wait_for_program(self, step: float) -> None:
         """Wait until the running program has done its work due by the current step, at most
