@@ -23,7 +23,9 @@ def test_demo_story_records_the_program_it_sent(tmp_path):
     # program at the first controller step (8 ms at speed 4) at or after the planned cycle
     # time; the recording sees each end of the run only at its samples, one every
     # speed / frequency = 32 ms of controller time (125 Hz), up to 32 - 8 ms after the step
-    # it shows. So observed - planned lies in [-24 ms, 32 ms).
+    # it shows. So observed - planned lies in [-24 ms, 32 ms). (Only a step whose work took
+    # the sim more than OVERRUN = 0.25 s of wall time would hold the program and lengthen
+    # it: this program's steps take milliseconds, also on a loaded machine.)
     period, step = 4.0 / 125.0, 4.0 * 0.002
     error = result.observed_time - result.planned_time
     assert -(period - step) - 1e-9 <= error < period + 1e-9

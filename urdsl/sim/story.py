@@ -51,7 +51,9 @@ class StoryResult:
     difference between recorded and planned joints (rad) over the run; ``samples``: RTDE
     samples recorded; ``sent``: False when the check found errors and nothing was sent;
     ``behind``: wall seconds the controller gave up keeping ``speed`` because the machine was
-    too slow (its controller time, and so ``observed_time``, is not affected).
+    too slow (its controller time, and so ``observed_time``, is not affected); ``held``:
+    controller steps the program was held because one step's work took it too long in wall
+    time (each makes ``observed_time`` one step longer; see :data:`urdsl.sim.controller.OVERRUN`).
     """
 
     program: Path
@@ -64,6 +66,7 @@ class StoryResult:
     max_deviation: float = float("nan")
     sent: bool = False
     behind: float = 0.0
+    held: int = 0
     messages: list[str] = field(default_factory=list)
 
     def paths(self) -> list[Path]:
@@ -199,6 +202,7 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
         recorder.join(10)
         result.messages = [f"{m.kind}: {m.text}" for m in sim.messages]
         result.behind = sim.stats.behind
+        result.held = sim.stats.held
     if "error" in recording:
         result.messages.append(f"recorder: {recording['error']}")
 
@@ -232,6 +236,9 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
         lines.append(f"the machine was too slow for speed x{speed:g}: the controller ran "
                      f"{result.behind:.2f} s of wall time behind (its controller time, in "
                      "lockstep with the program, is not affected)")
+    if result.held:
+        lines.append(f"the program overran its controller step and was held for {result.held} "
+                     f"steps ({result.held * sim.step_time * speed:.3f} s of controller time)")
     if result.messages:
         lines += ["controller messages:"] + [f"  {m}" for m in result.messages]
     result.report.write_text("\n".join(lines) + "\n", encoding="utf-8")
