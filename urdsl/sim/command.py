@@ -15,6 +15,8 @@ Run a virtual Universal Robots controller on this machine: the dashboard server 
 primary/secondary/realtime interfaces (30001-30003, read-only 30011-30013) and RTDE (30004),
 serving one simulated arm. URScript sent to 30001-30003 runs in real time (or --speed times
 faster) through urdsl's interpreter; RTDE, realtime and primary clients see the arm move.
+Controller time advances in lockstep with the program: a machine too slow for --speed makes
+the controller run slower in wall time (it says so once), never skip a step.
 
 A new def program replaces the running one, sec programs run beside it, bare lines run as a
 one-off program. Syntax and runtime errors are reported on the primary interface (30001)

@@ -4,17 +4,36 @@ Threads
 -------
 * The **clock** computes a :class:`~urdsl.sim.state.Snapshot` every controller step (2 ms
   e-Series, 8 ms CB3, in wall time) and hands it to the subscribers (the network servers).
-  Controller time runs ``speed`` times wall time, so each step covers ``speed`` x the step
-  of robot time. The clock also watches the arm: a joint outside its limits or a link below
-  the floor (z < 0 in Base) is a protective stop.
+  Each step covers ``speed`` x the step of controller time. The clock also watches the arm:
+  a joint outside its limits or a link below the floor (z < 0 in Base) is a protective stop.
 * The **runner** takes programs from a queue, parses them and runs them through the one
   URScript interpreter (:class:`urdsl.runtime.Interpreter`) with a
-  :class:`urdsl.motion.planner.MotionPlanner` as its robot, paced to wall time: the
-  interpreter calls :meth:`VirtualController._pace` with the robot time it is about to
-  advance to, and the runner sleeps until then. A new ``def`` (or bare lines) stops the
+  :class:`urdsl.motion.planner.MotionPlanner` as its robot. The interpreter calls
+  :meth:`VirtualController._pace` with the robot time it is about to advance to, and the
+  runner waits there until the clock reaches it. A new ``def`` (or bare lines) stops the
   running program first; between programs the arm rests where the last one left it.
 * ``sec`` programs run at once in a thread of their own, beside the main program, against the
   same I/O and registers; they may read the robot state but not move it.
+
+**Lockstep.** Controller time is a count of steps, not a reading of the wall clock: the
+clock moves it on by one step, lets the interpreter run everything due up to that time, and
+only then computes and publishes the step's state, as a real controller runs its interpreter
+once per control frame. Every published step (realtime, RTDE, primary) therefore carries the
+controller time of the interpreter's state. When the interpreter (or the whole process) is
+too slow for ``speed``, controller time runs slower than ``speed`` x wall time, never ahead
+of the program: a delay of up to :data:`CATCH_UP` steps is made up by publishing the late
+steps back to back; a longer one is given up (``stats.behind``, a warning on the logger
+``urdsl.sim`` the first time), and the controller goes on from there, more slowly in wall
+time. No step is ever skipped.
+
+**Overruns.** A real controller stops a program that does not finish its work within a frame;
+urdsl runs it to the end (a 100,000-line program without a move runs in one frame), but the
+streams must not stall meanwhile. When the program has not finished a step's work after
+:data:`OVERRUN` s of wall time, the clock publishes the step anyway, and goes on publishing
+steps while the program works, with the program held: its time stands still (as while
+paused, ``speed_scaling`` 0) until it has caught up, so the arm and the program still agree;
+the program then takes that much longer in controller time (``stats.held`` steps, a warning
+the first time).
 
 Everything the world sees goes through :meth:`snapshot` and the messages given to the
 message subscribers: runtime exceptions (with line and column), ``textmsg`` texts, popups,
@@ -25,6 +44,7 @@ from __future__ import annotations
 
 import gc
 import itertools
+import logging
 import math
 import queue
 import threading
@@ -64,8 +84,20 @@ UNLOCK_DELAY = 5.0
 (docs/controller-facts.md §13)."""
 
 CATCH_UP = 50
-"""Controller steps (100 ms on e-Series) the clock publishes late, back to back, after a
-delay of the process; after a longer pause it skips ahead and counts the steps missed."""
+"""Steps (100 ms of wall time on e-Series) the clock publishes late, back to back, to make up
+a delay of the process or of the interpreter; a longer delay is not made up: the controller
+goes on from where it is, behind ``speed`` x wall time (never skipping a step)."""
+
+OVERRUN = 0.25
+"""Wall time (s) the clock waits for the program's work of one step before it holds the
+program and goes on publishing (module docstring, "Overruns"): far above what a loaded
+machine takes for a step's usual work, far below the timeouts of clients waiting for data."""
+
+LOCKSTEP_POLL = 0.05
+"""Longest single wait (s of wall time) of the clock for the interpreter and of the
+interpreter for the clock, between which the waiter looks again at stops and closing."""
+
+_log = logging.getLogger(__name__.rpartition(".")[0])  # "urdsl.sim"
 
 FOREVER = 1e12
 """Robot time limit (s) for programs: a controller runs a ``while True`` cell forever."""
@@ -87,6 +119,9 @@ class _Program:
     paused_at: float | None = None
     frozen_at: float | None = None  # program time at which a stop froze the arm
     stop: bool = False
+    waiting: float | None = None  # the program time the interpreter waits for in _pace
+    overrun: bool = False  # the interpreter overran a step: the clock holds it while busy
+    held: bool = False  # the state being published holds the program (time stands still)
 
     def program_time(self, now: float) -> float:
         if self.frozen_at is not None:
@@ -106,11 +141,17 @@ class _Job:
 
 @dataclass
 class Stats:
-    """Counters for benchmarks and tests: ``ticks`` published, ``missed_ticks`` skipped
-    because the clock fell behind, ``programs`` started, ``errors`` reported."""
+    """Counters for benchmarks and tests: ``ticks`` published (one per controller step, none
+    ever skipped), ``behind`` wall seconds the controller gave up keeping ``speed`` (it was
+    too slow: controller time fell behind ``speed`` x wall time by that much),
+    ``slowdowns`` how often that happened, ``held`` steps published while a program that
+    overran its step was held (:data:`OVERRUN`), ``programs`` started, ``errors``
+    reported."""
 
     ticks: int = 0
-    missed_ticks: int = 0
+    behind: float = 0.0
+    slowdowns: int = 0
+    held: int = 0
     programs: int = 0
     errors: int = 0
     protective_stops: int = 0
@@ -122,7 +163,8 @@ class VirtualController:
 
     ``robot``: model name (``urdsl.kinematics.MODELS``); ``version``: controller software
     (``"5.15"``; default 5.15 for e-Series arms, 3.15 for CB3 arms); ``speed``: how much faster
-    than real time programs run; ``start_joints`` (rad); ``programs_dir``: the folder the
+    than real time programs run (at most: controller time keeps in lockstep with the program,
+    see the module docstring); ``start_joints`` (rad); ``programs_dir``: the folder the
     dashboard's ``load`` reads; ``powered``: start powered on with brakes released (a real
     controller boots powered off: pass False to practise the start-up sequence);
     ``kinematics``: a robot model object to use instead of ``Robot.model(robot)``.
@@ -192,7 +234,9 @@ class VirtualController:
         self._closing = threading.Event()
         self._threads: list[threading.Thread] = []
         self._wall0 = time.perf_counter()
-        self._tick = 0
+        self._time = 0.0  # controller time of the current step (s), moved on by the clock
+        self._computed = 0.0  # controller time of the last state computed (s)
+        self._overrun_said = False
         self._prev_q = q.copy()
         self._prev_qd = np.zeros(6)
         self._prev_tcp = None
@@ -262,8 +306,10 @@ class VirtualController:
     # ---- time ----------------------------------------------------------------------------
 
     def now(self) -> float:
-        """Controller time (s since start; runs ``speed`` times wall time)."""
-        return (time.perf_counter() - self._wall0) * self.speed
+        """Controller time (s since start) of the current controller step: it advances one
+        step (``speed`` x 2 ms on e-Series, x 8 ms on CB3) per clock step, in lockstep with
+        the running program, so at most ``speed`` times as fast as wall time."""
+        return self._time
 
     # ---- state ---------------------------------------------------------------------------
 
@@ -526,19 +572,39 @@ class VirtualController:
         self._wake.notify_all()
 
     def _pace(self, program: _Program, robot_time: float) -> None:
-        """The interpreter's pace hook: wait until controller time reaches the program's
-        ``robot_time`` (s), standing still while paused, returning at once on a stop."""
+        """The interpreter's pace hook: wait until the clock's controller time reaches the
+        program's ``robot_time`` (s), standing still while paused, returning at once on a
+        stop. While it waits, the clock may publish the steps before ``robot_time``: the
+        program has done everything it had to do before then (see :meth:`_busy`)."""
         with self._wake:
-            while not program.stop and not self._closing.is_set():
-                if program.paused_at is not None:
-                    self._wake.wait(0.05)
-                    continue
-                due = program.t0 + program.paused_total + robot_time
-                wall_left = (due - self.now()) / self.speed
-                if wall_left <= 0:
-                    return
-                self._wake.wait(min(wall_left, 0.05))
+            if not program.stop and program.paused_at is None \
+                    and self._due(program, robot_time) and not self._closing.is_set():
+                return  # within the current step (speed > 1): no need to wake the clock
+            program.waiting = robot_time
+            self._wake.notify_all()  # the clock may be waiting for the program
+            try:
+                while not program.stop and not self._closing.is_set():
+                    if program.paused_at is None and self._due(program, robot_time):
+                        return
+                    self._wake.wait(LOCKSTEP_POLL)
+            finally:
+                program.waiting = None
             program.interpreter.request_stop()
+
+    def _due(self, program: _Program, robot_time: float) -> bool:
+        """Whether program time ``robot_time`` (s) has come at the current step (caller
+        holds the lock). A nanosecond of slack absorbs rounding: program time is counted in
+        interpreter frames, controller time in clock steps."""
+        return program.t0 + program.paused_total + robot_time <= self._time + 1e-9
+
+    def _busy(self) -> bool:
+        """Whether the running program still has work at the current controller step, so
+        that the step's state may not be published yet (caller holds the lock): it is not
+        waiting in :meth:`_pace` for a later time, nor paused, stopped or ended."""
+        program = self._program
+        if program is None or program.stop or program.paused_at is not None:
+            return False
+        return program.waiting is None or self._due(program, program.waiting)
 
     def _compiler(self) -> None:
         from ..script.parser import parse
@@ -583,6 +649,7 @@ class VirtualController:
                 with self._lock:
                     self._program = None
                     self._program_state = ProgramState.STOPPED
+                    self._wake.notify_all()  # the clock may be waiting for the program
             job.module = None
             del job
             if not self._closing.is_set():  # closing: leave it to the process's collector
@@ -631,12 +698,16 @@ class VirtualController:
             self._report_error(error)
             return
         with self._lock:
-            program.t0 = self.now()
+            # program time 0 is the first step whose state is still to be computed: the
+            # first PLAYING step shows the arm at program time 0
+            program.t0 = self._time if self._computed < self._time \
+                else self._time + self.step_time * self.speed
             self._program = program
             self._program_state = ProgramState.PLAYING
             self._last_program_name = name
             self.stats.programs += 1
         try:
+            self._pace(program, 0.0)  # the program's first statements run at that step
             result = program.interpreter.run()
         finally:
             gc.unfreeze()  # the program's objects may be collected again
@@ -657,6 +728,7 @@ class VirtualController:
                 self._tcp_offset = np.asarray(planner.tcp, dtype=float).copy()
             self._program = None
             self._program_state = ProgramState.STOPPED
+            self._wake.notify_all()  # the clock may be waiting for the program
         self._publish_env_messages()
         if result.error is not None:
             self._report_error(result.error)
@@ -726,25 +798,96 @@ class VirtualController:
     # ---- internals: the clock ------------------------------------------------------------
 
     def _clock(self) -> None:
+        """One controller step per ``step_time`` of wall time, each ``speed`` x
+        ``step_time`` of controller time, in lockstep with the program (module docstring)."""
         step_wall = self.step_time
+        step = self.step_time * self.speed
+        wall0 = self._wall0  # the wall time at which step 0 was due
         tick = 0
         while not self._closing.is_set():
             tick += 1
-            due = self._wall0 + tick * step_wall
-            left = due - time.perf_counter()
+            left = wall0 + tick * step_wall - time.perf_counter()
             if left > 0:
                 time.sleep(left)
-            else:
-                behind = int(-left / step_wall)
-                if behind > CATCH_UP:  # a long pause of the process: skip, do not burst
-                    tick += behind
-                    self.stats.missed_ticks += behind
-                # a short delay: publish the late steps back to back (every one of them
-                # carries its own controller time), as a client must not see gaps
-            self._step(tick * step_wall * self.speed)
+            elif -left > CATCH_UP * step_wall:
+                # too slow for ``speed`` (a long pause of the process, or a program that
+                # computes more than the machine manages per step): give the delay up and go
+                # on from here, slower in wall time; a shorter delay is made up by publishing
+                # the late steps back to back
+                wall0 -= left
+                self._fell_behind(-left)
+            with self._wake:
+                self._time = tick * step
+                if self._waiting_is_due():
+                    self._wake.notify_all()  # the program may run to this step
+                self._wait_for_program(step)
+                # computed in the same hold of the lock: no program starts or ends between
+                snapshot, subscribers = self._compute(self._time)
+            self._emit(snapshot, subscribers)
 
-    def _step(self, now: float) -> None:
-        """Compute and publish the state at controller time ``now`` (s)."""
+    def _waiting_is_due(self) -> bool:
+        """Whether the running program waits in :meth:`_pace` for a time that has come
+        (caller holds the lock). A method, not a line in :meth:`_clock`: a local variable of
+        the clock's loop would keep the last program (its tree and closures) alive until the
+        next step, past the runner's collection of it."""
+        program = self._program
+        return program is not None and program.waiting is not None \
+            and self._due(program, program.waiting)
+
+    def _wait_for_program(self, step: float) -> None:
+        """Wait until the running program has done its work due by the current step, at most
+        :data:`OVERRUN` s of wall time (caller holds the lock). A program still working on a
+        step's work then overran: this step shows it mid-way, and each further step while it
+        works holds it. A program that was not even woken within that time (a starved
+        thread) is held at once."""
+        deadline = time.perf_counter() + OVERRUN
+        if self._program is not None:
+            self._program.held = False
+        while not self._closing.is_set():
+            program = self._program
+            if program is None:
+                return
+            if not self._busy():
+                program.overrun = False
+                return
+            working = program.waiting is None  # not merely due to be woken in _pace
+            if program.overrun and working:
+                self._hold(program, step)
+                return
+            if time.perf_counter() >= deadline:
+                if not working:
+                    self._hold(program, step)
+                    return
+                program.overrun = True
+                if not self._overrun_said:
+                    self._overrun_said = True
+                    _log.warning("virtual controller: program %s took more than %g s of wall "
+                                 "time for one step; it is held (its time stands still) until "
+                                 "it has done that step's work, the streams go on meanwhile",
+                                 program.name, OVERRUN)
+                return
+            self._wake.wait(min(deadline - time.perf_counter(), LOCKSTEP_POLL))
+
+    def _hold(self, program: _Program, step: float) -> None:
+        """Publish the current step with ``program``'s time standing still (as while paused):
+        its state stays the one it has reached (caller holds the lock)."""
+        program.paused_total += step
+        program.held = True
+        self.stats.held += 1
+
+    def _fell_behind(self, seconds: float) -> None:
+        """Count ``seconds`` of wall time the controller gave up; say so the first time."""
+        self.stats.behind += seconds
+        self.stats.slowdowns += 1
+        if self.stats.slowdowns == 1:
+            _log.warning("virtual controller: fell %.0f ms of wall time behind speed x%g (this "
+                         "machine is too slow for it, or the process was held up): "
+                         "controller time goes on from here, slower than wall time; every "
+                         "step is still published, and programs keep their timing in "
+                         "controller time", seconds * 1000, self.speed)
+
+    def _compute(self, now: float) -> tuple[Snapshot, list[Callable[[Snapshot], None]]]:
+        """The state at controller time ``now`` (s) and the subscribers to give it to."""
         with self._lock:
             if self._mode_change is not None and now >= self._mode_change[0]:
                 self._robot_mode = self._mode_change[1]
@@ -766,7 +909,11 @@ class VirtualController:
             snapshot = self._make_snapshot(now, q, qd, qdd, dt)
             self._prev_q = q.copy()
             self._prev_qd = qd
-            subscribers = list(self._subscribers)
+            self._computed = now
+            return snapshot, list(self._subscribers)
+
+    def _emit(self, snapshot: Snapshot, subscribers: list[Callable[[Snapshot], None]]) -> None:
+        """Publish a step's state (outside the lock: subscribers encode and queue)."""
         self._publish_env_messages()
         with self._snapshot_ready:
             self._snapshot = snapshot
@@ -842,7 +989,8 @@ class VirtualController:
                       RobotMode.POWER_ON: JointMode.BOOTING}.get(self._robot_mode,
                                                                  JointMode.POWER_OFF)
         program = self._program
-        speed_scaling = 0.0 if program is not None and program.paused_at is not None else 1.0
+        speed_scaling = 0.0 if program is not None and (program.paused_at is not None
+                                                        or program.held) else 1.0
         return Snapshot(
             time=now, q=_frozen(q), qd=_frozen(qd), qdd=_frozen(qdd), tcp=_frozen(tcp),
             tcp_speed=_frozen(tcp_speed), tcp_offset=_frozen(self._tcp_offset),

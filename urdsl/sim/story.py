@@ -31,6 +31,16 @@ PROGRAMS = Path(__file__).resolve().parents[2] / "programs"
 FIELDS = ("timestamp", "actual_q", "actual_TCP_pose", "runtime_state")
 PLAYING, STOPPED = 2, 1
 
+AFTER = 1.0
+"""Controller time (s) the recording goes on after the program has ended (then a little
+wall time more, :data:`AFTER_WALL`), so that it holds the first STOPPED samples."""
+
+START_TIMEOUT = 30.0
+"""Wall time (s) the program may take to start on the controller (it is compiled first)."""
+
+AFTER_WALL = 0.5
+"""Wall time (s) the recorder gets to read what was published before it is stopped."""
+
 
 @dataclass
 class StoryResult:
@@ -39,7 +49,11 @@ class StoryResult:
     ``planned_time``: the checker's cycle time (s); ``observed_time``: how long the
     controller reported PLAYING (s of controller time); ``max_deviation``: largest
     difference between recorded and planned joints (rad) over the run; ``samples``: RTDE
-    samples recorded; ``sent``: False when the check found errors and nothing was sent.
+    samples recorded; ``sent``: False when the check found errors and nothing was sent;
+    ``behind``: wall seconds the controller gave up keeping ``speed`` because the machine was
+    too slow (its controller time, and so ``observed_time``, is not affected); ``held``:
+    controller steps the program was held because one step's work took it too long in wall
+    time (each makes ``observed_time`` one step longer; see :data:`urdsl.sim.controller.OVERRUN`).
     """
 
     program: Path
@@ -51,6 +65,8 @@ class StoryResult:
     observed_time: float = 0.0
     max_deviation: float = float("nan")
     sent: bool = False
+    behind: float = 0.0
+    held: int = 0
     messages: list[str] = field(default_factory=list)
 
     def paths(self) -> list[Path]:
@@ -110,6 +126,24 @@ def _plot(path: Path, rows: np.ndarray, start: float, trace, title: str) -> None
     plt.close(figure)
 
 
+def _wait_for_end(sim, timeout: float) -> None:
+    """Wait (at most ``timeout`` s of wall time) until the controller has run a program to
+    its end and :data:`AFTER` s of controller time more."""
+    from .state import ProgramState
+
+    deadline = time.monotonic() + timeout
+    try:
+        # a program that does not start (refused by the controller) ends the wait sooner
+        sim.wait_snapshot(lambda s: s.program_state == ProgramState.PLAYING,
+                          min(timeout, START_TIMEOUT))
+        ended = sim.wait_snapshot(lambda s: s.program_state == ProgramState.STOPPED,
+                                  max(deadline - time.monotonic(), 0.0)).time
+        sim.wait_snapshot(lambda s: s.time >= ended + AFTER,
+                          max(deadline - time.monotonic(), 0.0))
+    except TimeoutError:  # the report says what was recorded
+        pass
+
+
 def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float = 1.0,
                frequency: float = 125.0, programs: str | Path | None = None,
                timeout: float = 120.0) -> StoryResult:
@@ -118,6 +152,8 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
     ``speed``: how much faster than real time the controller runs the program;
     ``frequency``: RTDE recording rate (Hz, at most 500 on e-Series); ``timeout``: wall
     seconds the program may take on the controller before the story gives up on it.
+    The recording lasts as long as the program takes in controller time (plus
+    :data:`AFTER`), however slowly a loaded machine runs the controller in wall time.
     """
     from ..verify.run import CheckOptions, check_text
     from .controller import VirtualController
@@ -141,16 +177,16 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
     from ..robot.sender import send_program
 
     result.csv = out / "robot_data.csv"
-    duration = min(report.cycle_time / speed + 1.5, timeout)
     with VirtualController(robot=robot, speed=speed) as sim, \
             sim.serve(ports={k: 0 for k in STANDARD_PORTS}) as servers:
         recording: dict = {}
+        stop = threading.Event()
 
         def run_recorder() -> None:
             try:
                 recording["rows"] = record("127.0.0.1", result.csv, list(FIELDS),
-                                           frequency=frequency, duration=duration,
-                                           port=servers.ports["rtde"])
+                                           frequency=frequency, duration=timeout,
+                                           port=servers.ports["rtde"], stop=stop)
             except Exception as error:  # shown in the report, the story goes on
                 recording["error"] = error
 
@@ -160,8 +196,13 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
         # checked above; the recording watches it, so the sender need not follow it
         send_program(text, "127.0.0.1", servers.ports["secondary"], check=False, follow=False)
         result.sent = True
-        recorder.join(duration + 10)
+        _wait_for_end(sim, timeout)
+        time.sleep(AFTER_WALL)
+        stop.set()
+        recorder.join(10)
         result.messages = [f"{m.kind}: {m.text}" for m in sim.messages]
+        result.behind = sim.stats.behind
+        result.held = sim.stats.held
     if "error" in recording:
         result.messages.append(f"recorder: {recording['error']}")
 
@@ -191,6 +232,13 @@ def demo_story(out_dir: str | Path = "out", *, robot: str = "ur5e", speed: float
         f"{result.observed_time:.3f} s of controller time",
         f"largest gap between recorded and planned joints: {result.max_deviation:.2e} rad",
     ]
+    if result.behind:
+        lines.append(f"the machine was too slow for speed x{speed:g}: the controller ran "
+                     f"{result.behind:.2f} s of wall time behind (its controller time, in "
+                     "lockstep with the program, is not affected)")
+    if result.held:
+        lines.append(f"the program overran its controller step and was held for {result.held} "
+                     f"steps ({result.held * sim.step_time * speed:.3f} s of controller time)")
     if result.messages:
         lines += ["controller messages:"] + [f"  {m}" for m in result.messages]
     result.report.write_text("\n".join(lines) + "\n", encoding="utf-8")
