@@ -131,21 +131,9 @@ def _expand(names: list[str]) -> list[str]:
 def _expand_with_roots(names: list[str]) -> list[tuple[str, str | None]]:
     """Each file with the folder named on the command line it was found in (None for a
     file named itself): a folder named on the command line is one project."""
-    from .._cli import UsageError
-    from ..polyscope.command import collect_programs, report_skipped
+    from ..polyscope.command import expand_folders
 
-    files: list[tuple[str, str | None]] = []
-    for name in names:
-        if name != "-" and os.path.isdir(name):
-            found, skipped = collect_programs(name)
-            report_skipped(skipped, "linted")
-            if not found:
-                raise UsageError(f"no URScript files (*.script, *.urscript) or PolyScope "
-                                 f"programs (*.urp) in {name}")
-            files.extend((file, name) for file in found)
-        else:
-            files.append((name, None))
-    return files
+    return expand_folders(names, "linted")
 
 
 class _Projects:

@@ -11,7 +11,8 @@ from .compile import Compiled, CompileError, compile_program, parse_variables
 from .installation import Installation, InstallationError, find_installation, read_installation
 from .urp import Node, Program, UrpError, read_urp
 
-__all__ = ["add_commands", "collect_programs", "compile_urp", "load", "load_all"]
+__all__ = ["add_commands", "collect_programs", "compile_urp", "expand_folders", "load",
+           "load_all"]
 
 SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
 
@@ -50,6 +51,29 @@ def report_skipped(skipped: list[tuple[str, str]], verb: str) -> None:
               f"generated from it (with its URCaps' code), and is {verb} instead; name "
               f"{Path(urp).name} to {verb[:-2] if verb.endswith('ed') else verb} its program "
               "tree", file=sys.stderr)
+
+
+def expand_folders(names: list[str], verb: str) -> list[tuple[str, str | None]]:
+    """The files named on a command line, each with the folder named it was found in (None
+    for a file named itself): a folder stands for its programs (:func:`collect_programs`,
+    the ``.urp`` programs left out are named on standard error as ``verb``, e.g.
+    "linted"). Raises :class:`~urdsl._cli.UsageError` for a folder without programs."""
+    import os
+
+    from .._cli import UsageError
+
+    files: list[tuple[str, str | None]] = []
+    for name in names:
+        if name != "-" and os.path.isdir(name):
+            found, skipped = collect_programs(name)
+            report_skipped(skipped, verb)
+            if not found:
+                raise UsageError(f"no URScript files (*.script, *.urscript) or PolyScope "
+                                 f"programs (*.urp) in {name}")
+            files.extend((file, name) for file in found)
+        else:
+            files.append((name, None))
+    return files
 
 
 def _installation_for(program: Program, path: str | Path) -> Installation | None:

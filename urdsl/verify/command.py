@@ -184,25 +184,11 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def _expand_folders(names: list[str]) -> list[str]:
-    """The files named, a folder standing for its programs (``.urp`` and URScript files; a
-    ``.script`` PolyScope wrote beside a ``.urp`` is left out, with a note)."""
-    import os
+    """The files named, a folder standing for its programs (see
+    :func:`urdsl.polyscope.command.expand_folders`)."""
+    from ..polyscope.command import expand_folders
 
-    from .._cli import UsageError
-    from ..polyscope.command import collect_programs, report_skipped
-
-    files: list[str] = []
-    for name in names:
-        if name != "-" and os.path.isdir(name):
-            found, skipped = collect_programs(name)
-            report_skipped(skipped, "checked")
-            if not found:
-                raise UsageError(f"no URScript files (*.script, *.urscript) or PolyScope "
-                                 f"programs (*.urp) in {name}")
-            files.extend(found)
-        else:
-            files.append(name)
-    return files
+    return [file for file, _folder in expand_folders(names, "checked")]
 
 
 GRACE = 1.5
