@@ -7,20 +7,13 @@ XML, as read_urp accepts it); the expected forms are those of real PolyScope scr
 from __future__ import annotations
 
 import pytest
+from test_polyscope_programs import KINEMATICS  # the same UR5e arm
 
 from urdsl.polyscope.compile import CompileError, compile_program
 from urdsl.polyscope.installation import parse_installation
 from urdsl.polyscope.urp import parse_urp
 from urdsl.script import parse
 from urdsl.script.printer import format as print_tree
-
-KINEMATICS = """
-  <kinematics status="LINEARIZED" validChecksum="true">
-    <deltaTheta value="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
-    <a value="0.0, -0.425, -0.3922, 0.0, 0.0, 0.0"/>
-    <d value="0.1625, 0.0, 0.0, 0.1333, 0.0997, 0.0996"/>
-    <alpha value="1.5707963267948966, 0.0, 0.0, 1.5707963267948966, -1.5707963267948966, 0.0"/>
-  </kinematics>"""
 
 INSTALLATION = """<Installation name="cell">
   <IOs>

@@ -39,7 +39,6 @@ from xml.etree import ElementTree
 import numpy as np
 
 from ..script import parse
-from ..script.build import literal
 from ..script.diagnostics import ScriptError
 from ..script.nodes import (
     Assign,
@@ -79,7 +78,7 @@ from ..script.nodes import (
 )
 from ..script.printer import format as print_tree
 from .installation import Installation
-from .preamble import preamble
+from .preamble import _call, _num, _stmt, preamble
 from .urp import Expression, Kinematics, Node, Program
 
 __all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "parse_variables",
@@ -288,18 +287,6 @@ def _direction_helper() -> list[Item]:
                         (Param("feature"), Param("direction"), Param("position_distance")),
                         body)]
 _POPUP_TITLES = {"Message": "Message", "Warning": "Warning", "Error": "Error"}
-
-
-def _call(name: str, *args: Expr, **keywords: Expr) -> Call:
-    return Call(Name(name), tuple(args), tuple(Keyword(k, v) for k, v in keywords.items()))
-
-
-def _stmt(name: str, *args: Expr, **keywords: Expr) -> ExprStmt:
-    return ExprStmt(_call(name, *args, **keywords))
-
-
-def _num(value: float) -> Expr:
-    return literal(float(value))
 
 
 def compile_program(program: Program, installation: Installation | None = None,
