@@ -91,6 +91,11 @@ def test_lint_of_a_urp_with_urcap_code_warns_for_names_only_that_code_can_define
     out = capsys.readouterr().out
     assert "URS101 name 'grip_ok' is not defined; it may come from code only a URCap " \
            "generates (Example_Gripper)" in out and "Found 1 warning" in out
+    # a function only the URCap defines, too
+    program.write_text(_program(URCAP + '<Script type="Line"><expression>' + _chars("p_rel(1)")
+                                + "</expression></Script>"))
+    assert main(["lint", str(program)]) == 0
+    assert "URS102 unknown function 'p_rel'" in capsys.readouterr().out
     # without URCap code nothing can define it: still an error
     program.write_text(_program(body))
     assert main(["lint", str(program)]) == 1

@@ -157,15 +157,15 @@ def urcap_sources(generated: Generated) -> list[str]:
 
 
 def soften_urcap_names(generated: Generated, found: list) -> list:
-    """Lint findings of a compiled program with URCap code: a name defined nowhere in what
-    urdsl generated (URS101) may come from that code, so it is a warning naming the
-    URCaps rather than an error."""
+    """Lint findings of a compiled program with URCap code: a name or function defined
+    nowhere in what urdsl generated (URS101, URS102) may come from that code, so it is a
+    warning naming the URCaps rather than an error."""
     sources = urcap_sources(generated)
     if not sources:
         return found
     out = []
     for finding in found:
-        if finding.code == "URS101" and finding.severity == "error":
+        if finding.code in ("URS101", "URS102") and finding.severity == "error":
             finding = replace(finding, severity="warning", message=(
                 f"{finding.message}; it may come from code only a URCap generates "
                 f"({', '.join(sources)})"))
