@@ -158,6 +158,19 @@ def test_a_thread_busy_looping_without_sync():
     assert finding.span.line == 2
 
 
+def test_a_loop_of_one_waypoint_is_not_a_loop_without_time():
+    # PolyScope's looping Robot Program with a single MoveJ: after the first pass the arm is
+    # at its target, and each move still takes the planner a controller frame
+    report = check(f"""
+        {READY}
+        while True:
+          movej([0, -1.9, 1.9, -1.57, -1.57, 0])
+        end
+        """, max_time=2.0)
+    assert not [f for f in report.findings if f.code == "URS207"], report.render_text()
+    assert any(f.code == "URS312" for f in report.findings)  # it ran to --max-time
+
+
 def test_threads_left_running_and_time_limit():
     report = check(f"""
         thread beat():

@@ -132,7 +132,14 @@ def _plan(rt, node, plan) -> None:
         raise _ik_error(rt, node, error) from None
     except ValueError as error:
         raise rt.error("arithmetic", str(error), node) from None
-    rt.wait_until(resume)
+    if resume > rt.time:
+        rt.wait_until(resume)
+    else:
+        # a move that has nothing to do (the arm is at its target) still takes the motion
+        # planner a controller frame: a looping PolyScope program of one waypoint runs on
+        # the robot without "Runtime is too much behind" [U: inferred from that, not
+        # documented]
+        rt.sync()
 
 
 # ---- moves -----------------------------------------------------------------------------------
