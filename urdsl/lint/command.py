@@ -65,8 +65,9 @@ def add_commands(commands) -> None:
         description=_LINT_DESCRIPTION, epilog=_LINT_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("files", nargs="+", metavar="FILE",
-                   help="URScript file or folder (searched for *.script, *.urscript); "
-                   "'-' reads stdin")
+                   help="URScript file, PolyScope program (.urp) or folder (searched "
+                   "for *.script, *.urscript and *.urp; a .urp with PolyScope's .script "
+                   "beside it is left out for that .script); '-' reads stdin")
     p.add_argument("--select", action="append", type=_codes, metavar="CODES",
                    help="run only these rules: codes, prefixes (URS1) or names, "
                    "comma-separated (default: all, or the configured selection)")

@@ -75,7 +75,9 @@ def add_commands(commands) -> None:
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="a URScript file (.script), a DSL program (.py; a .py file is run "
                    "as Python, with your permissions, to build its program) or a PolyScope "
-                   "program (.urp: compiled, checked on its arm with its installation)")
+                   "program (.urp: compiled, checked on its arm with its installation), "
+                   "or a folder of them (a .urp with PolyScope's .script beside it is left "
+                   "out for that .script)")
     p.add_argument("--robot", metavar="MODEL",
                    help="robot model: ur3, ur5, ur10, ur3e, ur5e, ur10e, ur16e, ur20, ur30, "
                    "ur7e, ur12e, ur15, ur18, ur8long (default: the model whose kinematics "
