@@ -20,7 +20,7 @@ from .kinematics.models import model_spec
 from .versions import ControllerVersion
 
 __all__ = ["EXIT_OK", "EXIT_PROBLEMS", "EXIT_USAGE", "UsageError", "InputFile", "read_input",
-           "load_cell", "error", "robot_model", "controller_version"]
+           "write_script", "load_cell", "error", "robot_model", "controller_version"]
 
 EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE = 0, 1, 2
 
@@ -57,6 +57,21 @@ def read_input(name: str) -> InputFile:
         return InputFile(label, data.decode("utf-8"), "utf-8", path)
     except UnicodeDecodeError:
         return InputFile(label, data.decode("latin-1"), "latin-1", path)
+
+
+def write_script(text: str, output: str | None) -> None:
+    """Write a compiled script to the file ``output`` (saying so on standard error), or to
+    standard output when ``output`` is empty; raise :class:`UsageError` when it cannot."""
+    if not output:
+        sys.stdout.write(text)
+        return
+    from pathlib import Path
+
+    try:
+        Path(output).write_text(text, encoding="utf-8")
+    except OSError as problem:
+        raise UsageError(f"cannot write {output}: {problem.strerror}") from None
+    print(f"wrote {output} ({text.count(chr(10))} lines)", file=sys.stderr)
 
 
 def error(message: str) -> None:

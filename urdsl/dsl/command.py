@@ -89,7 +89,7 @@ def add_commands(commands) -> None:
 
 
 def cmd_compile(args: argparse.Namespace) -> int:
-    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, write_script
 
     suffix = Path(args.program).suffix.lower()
     if suffix == ".urp":  # a PolyScope program: compiled as PolyScope does
@@ -107,12 +107,5 @@ def cmd_compile(args: argparse.Namespace) -> int:
     except (DslError, ProgramFileError) as error:
         print(str(error), file=sys.stderr)
         return EXIT_PROBLEMS
-    if args.output:
-        try:
-            Path(args.output).write_text(text, encoding="utf-8")
-        except OSError as error:
-            raise UsageError(f"cannot write {args.output}: {error.strerror}") from None
-        print(f"wrote {args.output} ({text.count(chr(10))} lines)", file=sys.stderr)
-    else:
-        sys.stdout.write(text)
+    write_script(text, args.output)
     return EXIT_OK

@@ -133,7 +133,7 @@ def load_all(path: str | Path) -> tuple[Program, Installation | None, Compiled]:
 
 def compile_urp(path: str, output: str | None) -> int:
     """``urdsl compile X.urp [-o X.script]``: the exit status."""
-    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError
+    from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, write_script
 
     if not Path(path).is_file():
         raise UsageError(f"cannot read {path}: No such file")
@@ -143,14 +143,7 @@ def compile_urp(path: str, output: str | None) -> int:
     except (UrpError, CompileError) as error:
         print(str(error), file=sys.stderr)
         return EXIT_PROBLEMS
-    if output:
-        try:
-            Path(output).write_text(text, encoding="utf-8")
-        except OSError as error:
-            raise UsageError(f"cannot write {output}: {error.strerror}") from None
-        print(f"wrote {output} ({text.count(chr(10))} lines)", file=sys.stderr)
-    else:
-        sys.stdout.write(text)
+    write_script(text, output)
     return EXIT_OK
 
 
