@@ -496,9 +496,11 @@ def test_stoppable_moves_are_those_in_a_thread_killed_under_a_condition():
     assert sorted(span.line for span in stoppable_moves(module)) == [2]
 
 
-def test_a_waypoint_out_of_reach_is_reported_even_when_a_condition_may_stop_the_move():
-    # "Until" on a waypoint (an expression ends the move early): its target is a real
-    # destination, 20 cm beyond the reach of a UR5e
+def test_a_stoppable_move_to_a_target_out_of_reach_is_a_warning_not_an_error():
+    # "Until" on a waypoint, or a search move toward a point past a box wall, killed when an
+    # input or tool contact fires: its target is 20 cm beyond the reach of a UR5e. Whether
+    # the arm gets to the edge of its workspace depends on the outside world (the input),
+    # unknown offline: a warning that says so, and the line is checked up to that edge
     report = check("""
         global move_thread_flag_7=0
         thread move_thread_7():
@@ -522,8 +524,48 @@ def test_a_waypoint_out_of_reach_is_reported_even_when_a_condition_may_stop_the_
           sync()
         end
         """)
+    assert not {"URS301", "URS302"} & set(report.codes()), report.render_text()
+    (finding,) = [f for f in report.findings if f.code == "URS210" and f.span.line == 5]
+    assert finding.severity == "warning"
+    assert "out of reach by" in finding.message and "condition" in finding.message
+    (move,) = [m for m in report.moves if m.span.line == 5]
+    assert move.duration > 0.5  # the line up to the edge of the workspace is still checked
+
+
+def test_the_same_waypoint_out_of_reach_without_a_condition_is_an_error():
+    report = check("""
+        movel(p[0.95, 0.2, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)
+        """)
     (finding,) = only(report, "URS301")
-    assert finding.span.line == 5
+    assert finding.span.line == 1
+
+
+FREEDRIVE = f"""
+    {READY}
+    freedrive_mode()
+    popup("Move the tool to the corner, then press Continue", blocking=True)
+    end_freedrive_mode()
+    corner = get_actual_tcp_pose()
+    movel(pose_trans(corner, p[0, 0, -1.5, 0, 0, 0]), a=1.2, v=0.1)
+    """
+
+
+def test_where_the_operator_left_the_arm_in_freedrive_is_unknown():
+    # the operator placed the tool by hand: a path computed from where it stands is not
+    # checked against where the simulated arm happens to be (a warning says why)
+    report = check(FREEDRIVE)
+    assert "URS301" not in report.codes(), report.render_text()
+    (warning,) = [f for f in report.findings if f.code == "URS210" and f.span.line == 6]
+    assert "freedrive at line 2" in warning.message and "by hand" in warning.message
+
+
+def test_a_move_to_a_known_target_after_freedrive_is_checked_again():
+    text = textwrap.dedent(FREEDRIVE).lstrip("\n") + textwrap.dedent(f"""\
+        {READY}
+        movel(pose_trans(get_actual_tcp_pose(), p[0, 0, -1.5, 0, 0, 0]), a=1.2, v=0.1)
+        """)
+    (finding,) = only(check(text), "URS301")
+    assert finding.span.line == 8
 
 
 def test_where_a_direction_move_stops_is_unknown_until_a_move_to_a_known_target():

@@ -35,7 +35,10 @@ test; PolyScope follows the kill with ``stopl``). When such a move aims far beyo
 reach (1.5 times it, :data:`urdsl.motion.planner.FAR_TARGET`) the planner checks it only up
 to where it could stop (:meth:`urdsl.motion.planner.MotionPlanner.movel`): the far target is
 not reported as URS301/URS302, while everything on the path up to the workspace's edge is
-still checked; a stoppable move to a waypoint just out of reach is still an error. "Until
+still checked. A stoppable move to a nearer target out of reach (a search past a box wall,
+an "Until" on a waypoint) is checked the same way, and its target is a URS210 warning rather
+than URS301: whether the arm gets to the workspace's edge depends on the condition
+(:meth:`urdsl.motion.planner.MotionPlanner._beyond_reach`). "Until
 distance" moves stop at a real, reachable destination and keep being checked to it. [U] The
 exact scripts of other PolyScope versions may differ; any thread killed under a condition
 counts. A move stopped by a ``stopl`` from a watcher thread, with no kill, is not recognised

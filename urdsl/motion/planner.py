@@ -180,6 +180,9 @@ class MotionPlanner:
         # the span of the last move, if it was such a move cut where the arm could follow it:
         # where the arm really stops depends on its condition (contact, an input)
         self.stopped_at: Span | None = None
+        # the span of the last freedrive_mode()/teach_mode() since the last move: the
+        # operator has moved the arm by hand, where to is unknown offline
+        self.hand_moved_at: Span | None = None
         self._tcp: np.ndarray | None = None
         self._pending: Segment | None = None  # the last move, if it may still blend
         self._q_end = self.q_start.copy()  # joints at the end of the last resolved move
@@ -347,10 +350,15 @@ class MotionPlanner:
         two profiles (see :func:`line_profile`)."""
         pose_from = self._end_matrix()
         params = {"a": a, "v": v, "t": t}
-        if span in self.stoppable and self._far(pose):
-            pose, stopped = self._until_out_of_reach(pose_from, pose)
-            if stopped:
-                params["until"] = True  # checked up to where it could stop
+        if span in self.stoppable:
+            beyond = None if self._far(pose) else self._beyond_reach(pose)
+            if beyond is not None or self._far(pose):
+                target = pose
+                pose, stopped = self._until_out_of_reach(pose_from, pose)
+                if stopped:
+                    params["until"] = True  # checked up to where it could stop
+                    if beyond is not None:
+                        self.warnings.append(self._search_warning(target, beyond, span, now))
         if v_rot is None:
             v_rot = ROTATION_PER_METRE * v
         if a_rot is None:
@@ -364,11 +372,40 @@ class MotionPlanner:
     def _far(self, pose: np.ndarray) -> bool:
         """Whether a target (4x4) lies further from the base than :data:`FAR_TARGET` times
         the model's reach: no taught waypoint does, while a Direction node aims 1000 m
-        away. A move that a condition stops but whose target is merely out of reach (an
-        "Until" on a waypoint moved by hand) is still reported as unreachable."""
+        away (see :meth:`_beyond_reach` for stoppable moves to nearer unreachable targets)."""
         spec = getattr(self.kinematics, "spec", None)
         reach = getattr(spec, "reach", None) or STOP_SEARCH / (2.0 * FAR_TARGET)
         return float(np.linalg.norm(pose[:3, 3])) > FAR_TARGET * reach
+
+    def _beyond_reach(self, pose: np.ndarray) -> KinematicsError | None:
+        """Why a stoppable move's target (4x4) has no joint solution, or None when it has.
+
+        A search move (``movel`` toward a point past the box wall, killed on tool contact)
+        aims beyond the arm's reach on purpose: where it stops depends on the outside world
+        (the contact, an input), unknown offline. Such a move is checked up to where the arm
+        could follow it, and the unreachable target is a warning (URS210), not URS301: on the
+        controller the arm stops at the condition or, if it never holds, at the edge of its
+        workspace [U: the controller plans a movel's path as it goes and does not refuse an
+        unreachable target up front, as PolyScope's Direction node, whose target is 1000 m
+        away, shows]."""
+        try:
+            self.ik(pose)
+        except KinematicsError as error:
+            return error
+        return None
+
+    def _search_warning(self, target: np.ndarray, why: KinematicsError, span: Span,
+                        now: float) -> MotionWarning:
+        """The URS210 note for a stoppable move whose target (4x4) is out of reach."""
+        where = ", ".join(f"{x:.4f}" for x in target[:3, 3])
+        distance = getattr(why, "distance", 0.0) or 0.0
+        reason = (f"out of reach by {distance * 1000:.1f} mm" if distance > 0
+                  else "reachable only outside the joint limits")
+        return MotionWarning(
+            "condition", f"the target of this move at [{where}] m is {reason}: the arm gets "
+            "there only if the condition that stops the move (tool contact, an input) has not "
+            "held by then, which depends on the outside world; checked up to where the arm "
+            "could follow the line", span, now)
 
     def _until_out_of_reach(self, pose_from: np.ndarray, pose: np.ndarray
                             ) -> tuple[np.ndarray, bool]:
@@ -533,7 +570,8 @@ class MotionPlanner:
     # ---- planning --------------------------------------------------------------------------
 
     def _add(self, segment: Segment, now: float) -> float:
-        self.stopped_at = None  # a move to a known target: the arm's position is known again
+        # a move to a known target: the arm's position is known again
+        self.stopped_at = self.hand_moved_at = None
         previous = self._pending
         radius = segment.radius
         previous_radius = previous.radius if previous is not None else 0.0

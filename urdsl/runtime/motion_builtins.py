@@ -223,14 +223,38 @@ def _stop(rt, node, a, aRot="a"):  # noqa: N803
 
 
 def _stopped_by_condition(rt, arm) -> Unknown | None:
-    """After a move that a condition stops (PolyScope's Direction node: until tool contact,
-    an input), where the arm is depends on that condition: unknown offline, until a move to a
-    known target."""
-    span = getattr(arm, "stopped_at", None)
-    if span is None or not rt.unknown:
+    """Where the arm is when something outside the program decided it, unknown offline
+    until a move to a known target:
+
+    - after a move that a condition stops (PolyScope's Direction node: until tool contact,
+      an input), where the arm is depends on that condition;
+    - after ``freedrive_mode()`` or ``teach_mode()`` the operator moves the arm by hand
+      (PolyScope programs put the tool "close to the corner" this way, behind a popup that
+      says so), and it stays where they left it after ``end_freedrive_mode()``."""
+    if not rt.unknown:
         return None
-    return Unknown(f"the arm's position after the move at line {span.line}, which a "
-                   "condition stops", span)
+    span = getattr(arm, "stopped_at", None)
+    if span is not None:
+        return Unknown(f"the arm's position after the move at line {span.line}, which a "
+                       "condition stops", span)
+    span = getattr(arm, "hand_moved_at", None)
+    if span is not None:
+        return Unknown(f"the arm's position after freedrive at line {span.line}, where "
+                       "the operator moves the arm by hand", span)
+    return None
+
+
+@implements("freedrive_mode", "teach_mode", "freedrive_mode_no_incorrect_payload_check")
+def _freedrive(rt, node, **_arguments):
+    """The arm is free to be moved by hand: from now on where it is, is unknown offline
+    until a move to a known target (:func:`_stopped_by_condition`)."""
+    if rt.robot is not None:
+        rt.robot.hand_moved_at = node.span
+
+
+@implements("end_freedrive_mode", "end_teach_mode")
+def _end_freedrive(rt, node):
+    """The arm is held again where the operator left it (still unknown offline)."""
 
 
 @implements("get_actual_joint_positions", "get_target_joint_positions")
@@ -270,6 +294,8 @@ def _tcp_speed(rt, node):
 @implements("get_forward_kin")
 def _forward_kin(rt, node, q="current_joint_positions", tcp="active_tcp"):
     arm = _arm(rt, node)
+    if isinstance(q, str) and (unknown := _stopped_by_condition(rt, arm)) is not None:
+        return unknown
     joints = arm.joints_at(rt.time) if isinstance(q, str) else _numbers(rt, node, q, 6, "q")
     offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
     return _to_pose(arm.kinematics.fk(joints, tcp=offset))
@@ -417,7 +443,7 @@ def _wrench_trans(rt, node, T_from_to, w_from):  # noqa: N803 - the catalog's pa
 @implements("get_actual_tool_flange_pose")
 def _flange_pose(rt, node):
     arm = _arm(rt, node)
-    return _to_pose(arm.kinematics.fk(arm.joints_at(rt.time)))
+    return _stopped_by_condition(rt, arm) or _to_pose(arm.kinematics.fk(arm.joints_at(rt.time)))
 
 
 @implements("get_target_waypoint")

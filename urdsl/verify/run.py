@@ -210,9 +210,9 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
         report.events = [e for e in result.events if e.time <= result.error.time]
     if result.error is not None:
         report.findings.append(_runtime_finding(result.error, module, result.warnings))
-    for warning in planner.warnings:
-        report.findings.append(Finding.of("URS309", warning.message, warning.span,
-                                          warning.time))
+    for warning in planner.warnings:  # Overlapping Blends, or a stoppable move's far target
+        code = "URS210" if warning.code == "condition" else "URS309"
+        report.findings.append(Finding.of(code, warning.message, warning.span, warning.time))
     if result.threads_left_running:
         names = ", ".join(result.threads_left_running)
         report.findings.append(Finding.of(
