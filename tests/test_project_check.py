@@ -150,3 +150,92 @@ def test_a_name_the_controller_may_define_is_taken_from_the_project(tmp_path, ca
     assert status == 0, report["findings"]
     assert report["findings"] == []
     assert "pi" in report["context"] and "down" in report["context"]
+
+
+# ---- files that neither include each other: what their run leaves in a global is unknown ----
+
+READY = "movej([0, -1.9, 1.9, -1.57, -1.57, 0])"
+
+
+def test_a_global_another_file_sets_again_is_unknown_not_its_first_value(tmp_path, capsys):
+    # a hand-written copy of an export borrows the gripper's globals: the export gives the
+    # mass 0.0 and sets it later (its preamble runs a setup this file does not run)
+    (tmp_path / "export.script").write_text(
+        "global tool_mass = 0.0\ndef setup():\n  tool_mass = 1.45\nend\n")
+    (tmp_path / "mine.script").write_text("share = 2.0 / tool_mass\ntextmsg(share)\n")
+    status, report = check(capsys, str(tmp_path / "mine.script"))
+    assert status == 0, report["findings"]
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    assert "tool_mass" in report["context"]
+
+
+def test_a_constant_another_file_gives_once_keeps_its_value(tmp_path, capsys):
+    (tmp_path / "setup.script").write_text(
+        "def init():\n  global dist = 3.0\nend\n")
+    (tmp_path / "use.script").write_text(
+        f"{READY}\nmovel(pose_add(get_actual_tcp_pose(), p[0, 0, -dist, 0, 0, 0]))\n")
+    status, report = check(capsys, str(tmp_path / "use.script"))
+    assert status == 1  # 3 m down: the constant is known, and the move out of reach
+    assert [f["code"] for f in report["findings"] if f["severity"] == "error"] == ["URS301"]
+
+
+def test_a_pose_the_operator_set_in_another_file_is_unknown(tmp_path, capsys):
+    # init.script asks the operator to place the arm in freedrive and records the pose; a
+    # routine in another file that moves there is not checked from the default start
+    (tmp_path / "init.script").write_text(
+        "def save_start():\n  freedrive_mode()\n"
+        '  popup("Move the tool to the first cube", blocking=True)\n'
+        "  end_freedrive_mode()\n  global start_p = get_actual_tcp_pose()\nend\n")
+    (tmp_path / "routine.script").write_text(
+        f"{READY}\nmovel(pose_trans(start_p, p[0, 0, -2.0, 0, 0, 0]), a=1.2, v=0.25)\n")
+    status, report = check(capsys, str(tmp_path / "routine.script"))
+    assert status == 0, report["findings"]
+    (warning,) = [f for f in report["findings"] if f["code"] == "URS210"]
+    assert "start_p" in warning["message"] and "init.script" in warning["message"]
+
+
+def test_check_of_a_file_sees_its_folders_subfolders(tmp_path, capsys):
+    # as `urdsl lint` of the folder does: a function of an export kept in a subfolder
+    (tmp_path / "material").mkdir()
+    (tmp_path / "material" / "export.script").write_text(
+        'def export():\n  $ 1 "Robot Program"\n  def gripper_open(width):\n'
+        "    textmsg(width)\n  end\n  gripper_open(50)\nend\n")
+    (tmp_path / "routine.script").write_text("gripper_open(20)\n")
+    status, report = check(capsys, str(tmp_path / "routine.script"))
+    assert status == 0, report["findings"]
+    assert "material/export.script" in report["context"]
+
+
+def test_a_program_above_that_includes_the_neighbours_joins_the_project(tmp_path, capsys):
+    # MAIN includes CONTROL/move.script but not CONTROL/log.script (its Script node is
+    # disabled); log.script still reads MAIN's globals
+    (tmp_path / "CONTROL").mkdir()
+    (tmp_path / "CONTROL" / "move.script").write_text("textmsg(count)\ncount = count + 1\n")
+    (tmp_path / "CONTROL" / "log.script").write_text("textmsg(cell_name)\n")
+    (tmp_path / "MAIN.script").write_text(
+        'def MAIN():\n  $ 1 "Robot Program"\n  global count = 0\n  global cell_name = "A"\n'
+        '  $ 2 "Script: move.script"\n  textmsg(count)\n  count = count + 1\nend\n')
+    status, report = check(capsys, str(tmp_path / "CONTROL" / "log.script"))
+    assert status == 0, report["findings"]
+    assert "MAIN.script" in report["context"]
+
+
+def test_a_few_common_lines_spread_over_a_program_do_not_make_it_a_host(tmp_path, capsys):
+    from urdsl.project.model import Project
+
+    (tmp_path / "endless.script").write_text("i = 0\nwhile True:\n  i = i + 1\n  sync()\nend\n")
+    (tmp_path / "other.script").write_text(
+        'def other():\n  $ 1 "Robot Program"\n  i = 0\n  textmsg("a")\n  textmsg("b")\n'
+        '  textmsg("c")\n  textmsg("d")\n  while True:\n    textmsg("e")\n    textmsg("f")\n'
+        '    textmsg("g")\n    textmsg("h")\n    i = i + 1\n    textmsg("i")\n'
+        '    textmsg("j")\n    textmsg("k")\n    textmsg("l")\n    sync()\n  end\nend\n')
+    project = Project.discover(tmp_path / "endless.script")
+    text = (tmp_path / "endless.script").read_text()
+    assert project.context(tmp_path / "endless.script", text, "endless.script").hosts == []
+    # the same lines inlined as one block do
+    (tmp_path / "other.script").write_text(
+        'def other():\n  $ 1 "Robot Program"\n  textmsg("a")\n  i = 0\n  while True:\n'
+        "    i = i + 1\n    sync()\n  end\nend\n")
+    project = Project.discover(tmp_path / "endless.script")
+    assert [h.filename for h in project.context(
+        tmp_path / "endless.script", text, "endless.script").hosts] != []

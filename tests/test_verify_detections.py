@@ -616,3 +616,28 @@ def test_a_file_that_only_defines_says_nothing_ran(text, names):
 def test_a_program_that_runs_is_not_told_nothing_ran(text):
     report = check_text(text, "prog.script", options=CheckOptions(timeout=None))
     assert "URS314" not in report.codes()
+
+
+def test_the_path_of_a_move_from_where_an_unknown_move_left_the_arm_is_not_checked():
+    fast = "movej([3.0, -1.9, 1.9, -1.57, -1.57, 0], t=0.2)"  # the base: 3 rad in 0.2 s
+    (error,) = only(check(f"{READY}\n{fast}"), "URS304")
+    assert error.span.line == 2
+    report = check(f"""
+        {READY}
+        goal = read_input_integer_register(0)
+        movej([goal, -1.9, 1.9, -1.57, -1.57, 0])
+        {fast}
+        """)
+    assert "URS304" not in report.codes(), report.render_text()
+    (note,) = [f for f in report.findings if f.code == "URS210" and f.span.line == 4]
+    assert "move at line 3 to an unknown target" in note.message
+    assert "path is not checked" in note.message
+
+
+def test_a_builtin_that_is_not_simulated_gives_a_list_of_its_own_length():
+    # set_payload(m, cog) takes three numbers: get_target_payload_cog() gives three
+    report = check(f"""
+        {READY}
+        set_payload(1.2, get_target_payload_cog())
+        """)
+    assert not [f for f in report.findings if f.severity == "error"], report.render_text()

@@ -183,6 +183,9 @@ class MotionPlanner:
         # the span of the last freedrive_mode()/teach_mode() since the last move: the
         # operator has moved the arm by hand, where to is unknown offline
         self.hand_moved_at: Span | None = None
+        # the span of the last move to an unknown target (not planned; the check's unknown
+        # device values): where the arm went is unknown
+        self.unknown_move_at: Span | None = None
         self._tcp: np.ndarray | None = None
         self._pending: Segment | None = None  # the last move, if it may still blend
         self._q_end = self.q_start.copy()  # joints at the end of the last resolved move
@@ -368,6 +371,18 @@ class MotionPlanner:
         if params.get("until"):
             self.stopped_at = span  # where the arm ends depends on the condition
         return end
+
+    def unknown_start(self) -> str | None:
+        """What left the arm where it is, when that place is unknown offline (a move that a
+        condition stopped, the operator's hand in freedrive, a move to an unknown target);
+        None when the arm is where the planned moves put it."""
+        if self.stopped_at is not None:
+            return f"the move at line {self.stopped_at.line}, which a condition stops,"
+        if self.hand_moved_at is not None:
+            return f"freedrive at line {self.hand_moved_at.line}"
+        if self.unknown_move_at is not None:
+            return f"the move at line {self.unknown_move_at.line} to an unknown target"
+        return None
 
     def _far(self, pose: np.ndarray) -> bool:
         """Whether a target (4x4) lies further from the base than :data:`FAR_TARGET` times
@@ -570,8 +585,11 @@ class MotionPlanner:
     # ---- planning --------------------------------------------------------------------------
 
     def _add(self, segment: Segment, now: float) -> float:
+        start = self.unknown_start()
+        if start is not None:  # its path from there is not known; its target is
+            segment.params["from_unknown"] = start
         # a move to a known target: the arm's position is known again
-        self.stopped_at = self.hand_moved_at = None
+        self.stopped_at = self.hand_moved_at = self.unknown_move_at = None
         previous = self._pending
         radius = segment.radius
         previous_radius = previous.radius if previous is not None else 0.0

@@ -123,8 +123,9 @@ def in_context(path: str | Path, text: str, module: n.Module, filename: str | No
         note += f" ({len(chosen)} definition(s): {', '.join(d.name for d in chosen[:8])}" + \
             (", ..." if len(chosen) > 8 else "") + ")"
     if without_value:
-        note += ("; the project gives " + ", ".join(without_value) + " a value only inside a "
-                 "function or loop, from values not known before this file runs")
+        note += ("; the project gives " + ", ".join(dict.fromkeys(without_value)) + " a value "
+                 "only inside a function or loop or in a file that does not include this one, "
+                 "from values not known before this file runs")
     return CheckContext(combined, tuple(chosen), hosts, note)
 
 
@@ -142,6 +143,67 @@ def _given_later(statement: n.Stmt | None, name: str, resolvable) -> n.Stmt | No
             resolvable(c, _CALL) for c in calls) and all(resolvable(t, _THREAD) for t in threads):
         return declaration
     return None
+
+
+def _opaque(definition: Definition) -> n.Declare:
+    """``global name = <unknown>`` for a global the project defines in another file with a
+    value that is not known when this file runs (see :func:`_settled`)."""
+    source = (f"'{definition.name}', which {definition.where} sets where this file does not "
+              "run it")
+    return n.Declare("global", definition.name, n.Opaque(source, definition.span),
+                     span=definition.span)
+
+
+def _settled(script, name: str, statement: n.Stmt | None) -> bool:
+    """Whether a global of a file that neither includes this one nor is included by it has a
+    value known here: given once in that file, by a constant expression (``global speed =
+    0.25``, at its first level or in a function; a name in it is such a global too). A global
+    the other file sets again, or
+    computes from the arm or a device (``init_pos = get_actual_tcp_pose()`` after the
+    operator placed the arm), holds whatever that file's run left in it: unknown offline."""
+    return _settled_in(script, name, statement, frozenset())
+
+
+def _settled_in(script, name: str, statement: n.Stmt | None, seen: frozenset[str]) -> bool:
+    if statement is None or name in seen or _writes(script).get(name, 0) != 1:
+        return False
+    value = getattr(statement, "value", None)
+    if value is None:
+        return False
+    seen = seen | {name}
+    for node in n.walk(value):
+        if isinstance(node, n.Name):  # another settled global of that file (``-pi/2``)
+            other = script.top_level.get(node.id) or script.assigned_later.get(node.id)
+            if not _settled_in(script, node.id, other, seen):
+                return False
+        elif not isinstance(node, _CONSTANT_NODES):
+            return False
+    return True
+
+
+_CONSTANT_NODES = (n.Number, n.String, n.Bool, n.NoneLit, n.Pose, n.List, n.Paren,
+                   n.UnaryOp, n.BinOp)
+
+
+_WRITES: dict[int, tuple[object, dict[str, int]]] = {}
+
+
+def _writes(script) -> dict[str, int]:
+    """How many statements of ``script`` give each variable a value (cached per file)."""
+    cached = _WRITES.get(id(script))
+    if cached is not None and cached[0] is script:
+        return cached[1]
+    counts: dict[str, int] = {}
+    if script.module is not None:
+        for node in n.walk(script.module):
+            if isinstance(node, n.Assign) and isinstance(node.target, n.Name):
+                counts[node.target.id] = counts.get(node.target.id, 0) + 1
+            elif isinstance(node, n.Declare) and node.value is not None:
+                counts[node.name] = counts.get(node.name, 0) + 1
+    if len(_WRITES) > 512:
+        _WRITES.clear()
+    _WRITES[id(script)] = (script, counts)
+    return counts
 
 
 def _program_def(module: n.Module) -> n.FunctionDef | None:
@@ -168,10 +230,21 @@ def _collect(context: FileContext, module: n.Module) -> tuple[list[Definition], 
                 script = files.get(definition.filename)
                 if script is None:
                     continue
-                statement = script.top_level.get(name) or _given_later(
-                    script.assigned_later.get(name), name, resolvable)
-                if statement is None:
-                    continue  # no value that can be computed before the file runs
+                statement = script.top_level.get(name)
+                if relation == "other":
+                    first = statement or script.assigned_later.get(name)
+                    if not _settled(script, name, first):
+                        statement = None  # what the other file leaves in it is unknown here
+                    elif statement is None:
+                        statement = _given_later(first, name, resolvable)
+                elif statement is None:
+                    statement = _given_later(script.assigned_later.get(name), name,
+                                             resolvable)
+                if statement is None:  # a value that cannot be computed before the file runs
+                    without_value.append(name)
+                    if relation != "other":
+                        continue  # a host's: undefined when this file runs (the test above)
+                    statement = _opaque(definition)
                 return dataclasses.replace(definition, node=statement,
                                            span=statement.span)  # type: ignore[attr-defined]
             return definition
@@ -187,9 +260,6 @@ def _collect(context: FileContext, module: n.Module) -> tuple[list[Definition], 
         visited.add((use, name))
         definition = pick(name, kinds, use)
         if definition is None:
-            if use == "read" and any(d.kind == "global" for _r, d in
-                                     context.definitions(name, kinds)):
-                without_value.append(name)
             return
         follow(_alone(definition.node) if definition.kind in ("function", "thread")
                else n.Module((definition.node,)))

@@ -234,11 +234,13 @@ class Project:
     @classmethod
     def discover(cls, path: str | Path, include: tuple[str | Path, ...] | list = (),
                  use_config: bool = True) -> Project:
-        """The project of ``path``: a folder's whole tree; for a file, its folder (not its
-        subfolders), or, when a program in a folder up to three levels above includes the
-        file (PolyScope keeps script files in subfolders of the programs folder), that
-        folder's tree. With the ``include`` files and the configured includes. Files that
-        cannot be read are left out; a bad configuration raises :class:`ProjectError`."""
+        """The project of ``path``: a folder's whole tree; for a file, its folder's tree (as
+        ``urdsl lint`` of that folder sees it; only the folder itself when its tree holds
+        more than :data:`MAX_TREE_FILES` project files), or, when a program in a folder up to
+        three levels above includes the file (PolyScope keeps script files in subfolders of
+        the programs folder), that folder's tree. With the ``include`` files and the
+        configured includes. Files that cannot be read are left out; a bad configuration
+        raises :class:`ProjectError`."""
         path = Path(path)
         if path.is_dir():
             root = path
@@ -251,10 +253,22 @@ class Project:
                     found += [p for p in _listing(above) if _key(p) not in keys]
         else:
             root = path.parent if str(path.parent) else Path(".")
-            found = _listing(root)
+            found = _tree(root, MAX_TREE_FILES + 1)
+            if len(found) > MAX_TREE_FILES:  # a home or temporary folder, not a project
+                found = _listing(root)
             if path.is_file() and _key(path) not in {_key(p) for p in found}:
                 found.append(path)
             above = _host_folder(path, found)
+            if above is None and path.suffix in SCRIPT_SUFFIXES:
+                # no program includes the file, but one further up includes its neighbours
+                # (PolyScope's script-file subfolders): add that program, as `urdsl lint` of
+                # the folder does
+                here = [p for p in found if p.parent == path.parent
+                        and p.suffix in SCRIPT_SUFFIXES]
+                beside = _folder_above(path.parent, here, here) if len(here) > 1 else None
+                if beside is not None:
+                    keys = {_key(p) for p in found}
+                    found += [p for p in _listing(beside) if _key(p) not in keys]
             if above is not None:  # the program that includes the file is further up
                 root = above
                 tree = _tree(above, MAX_TREE_FILES + 1)
@@ -353,13 +367,23 @@ def _wanted(path: Path) -> bool:
     return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix == VARIABLES_SUFFIX)
 
 
+MAX_TREE_VISITS = 50_000
+"""Entries a bounded tree search looks at before it stops (a home folder is no project)."""
+
+
 def _tree(folder: Path, limit: int | None = None) -> list[Path]:
-    """The project files in ``folder``'s tree (hidden folders left out), at most ``limit``."""
+    """The project files in ``folder``'s tree (hidden folders left out), at most ``limit``;
+    with a ``limit``, the search also stops after :data:`MAX_TREE_VISITS` entries and then
+    returns ``limit`` + 1 files' worth of "too many" (more than ``limit`` paths)."""
     if not folder.is_dir():
         return []
     found: list[Path] = []
+    visited = 0
     with contextlib.suppress(OSError):
         for p in folder.rglob("*"):
+            visited += 1
+            if limit is not None and visited > MAX_TREE_VISITS:
+                return found + [folder] * (limit + 1 - len(found))  # too large: no project
             if _wanted(p) and not any(part.startswith(".")
                                       for part in p.parts[len(folder.parts):]):
                 found.append(p)
@@ -625,7 +649,55 @@ def _includes(host: ScriptFile, fragment: ScriptFile) -> bool:
         if not any(d.kind == "function" for d in host.definitions.get(fragment.program, [])):
             return False
         return _share(lines, host.code_lines) >= _SUBPROGRAM_SHARE
-    return len(lines) >= 2 and _share(lines, host.code_lines) >= _INLINE_SHARE
+    return (len(lines) >= 2 and _share(lines, host.code_lines) >= _INLINE_SHARE
+            and _in_order(lines, host) >= _INLINE_SHARE)
+
+
+_GAP = 3
+"""Host code lines that may stand between two lines of an inlined file (lines edited since)."""
+_MAX_STARTS = 200
+
+
+def _in_order(lines: tuple[str, ...], host: ScriptFile) -> float:
+    """The largest share of ``lines`` that ``host`` holds in their order, one after the other
+    (at most :data:`_GAP` other lines between two of them): PolyScope inlines a script file
+    as one block, so a few common lines (``i = 0``, ``sync()``) spread over an unrelated
+    program do not make it a host."""
+    within = host.code_line_list
+    index = _line_positions(host)
+    best = 0
+    starts: list[int] = []
+    for first in lines[:3]:
+        starts.extend(index.get(first, ())[:_MAX_STARTS])
+    for start in sorted(set(starts))[:_MAX_STARTS]:
+        position, matched = start, 0
+        for line in lines:
+            for ahead in range(position, min(position + _GAP + 1, len(within))):
+                if within[ahead] == line:
+                    matched += 1
+                    position = ahead + 1
+                    break
+        best = max(best, matched)
+        if best == len(lines):
+            break
+    return best / len(lines)
+
+
+_POSITIONS: dict[int, tuple[object, dict[str, list[int]]]] = {}
+
+
+def _line_positions(host: ScriptFile) -> dict[str, list[int]]:
+    """Where each code line of ``host`` stands in its list (cached per file)."""
+    cached = _POSITIONS.get(id(host))
+    if cached is not None and cached[0] is host:
+        return cached[1]
+    positions: dict[str, list[int]] = {}
+    for number, line in enumerate(host.code_line_list):
+        positions.setdefault(line, []).append(number)
+    if len(_POSITIONS) > 512:
+        _POSITIONS.clear()
+    _POSITIONS[id(host)] = (host, positions)
+    return positions
 
 
 def _share(lines: tuple[str, ...], within: frozenset[str]) -> float:

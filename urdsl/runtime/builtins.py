@@ -138,7 +138,7 @@ class BuiltinTable:
                       node.span)
         kind = row.returns[0] if row.returns else "None"
         if kind == "Array":  # nearly all of them return a 6-vector (joints, wrench, speeds)
-            return ListValue([0.0] * 6)
+            return ListValue([0.0] * _ARRAY_LENGTHS.get(row.name, 6))
         if kind == "Pose":
             return PoseValue([0.0] * 6)
         if kind == "Matrix":  # the 6x6 ones: mass matrix, Jacobians
@@ -166,6 +166,15 @@ class BuiltinTable:
         if type(receiver) is Unknown:
             return receiver
         raise rt.error("type", f"a {type_name(receiver)} has no method '{method}'", node)
+
+
+_ARRAY_LENGTHS = {
+    # the script manual: "the 3d coordinates of the COG (CoGx, CoGy, CoGz)" and "X, Y, and Z
+    # composant of the measured acceleration"; the other array getters give six numbers
+    "get_target_payload_cog": 3,
+    "get_tool_accelerometer_reading": 3,
+}
+"""Length of the neutral list a builtin that is not simulated returns, where it is not 6."""
 
 
 class _RemoteHandle:

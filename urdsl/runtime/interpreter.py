@@ -907,6 +907,11 @@ class _Compiler:
     def e_NoneLit(self, node):
         return lambda frame: None
 
+    def e_Opaque(self, node: n.Opaque):
+        """A value from another file of the project that is not known here: unknown."""
+        value = Unknown(node.source, node.span)
+        return lambda frame: value
+
     def e_Paren(self, node):
         return self.expr(node.expr)
 

@@ -241,6 +241,10 @@ def _stopped_by_condition(rt, arm) -> Unknown | None:
     if span is not None:
         return Unknown(f"the arm's position after freedrive at line {span.line}, where "
                        "the operator moves the arm by hand", span)
+    span = getattr(arm, "unknown_move_at", None)
+    if span is not None:
+        return Unknown(f"the arm's position after the move at line {span.line} to an "
+                       "unknown target", span)
     return None
 
 

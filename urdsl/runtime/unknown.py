@@ -201,9 +201,11 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
         frame = name.startswith(("servo", "speed"))
         took = f"{rt.config.step_time:g}" if frame else f"{UNCHECKED_MOVE_TIME:g}"
         rt.warn_once(f"this move depends on {found.source}, which is unknown offline; the "
-                     f"move is not checked (taken as {took} s where the arm stays)", node)
+                     f"move is not checked (taken as {took} s)", node)
         if rt.robot is not None:
             rt.robot.stop_blending(rt.time)
+            # where the arm went is unknown until a move to a known target
+            rt.robot.unknown_move_at = node.span
         if frame:
             rt.sync()
         else:

@@ -20,7 +20,7 @@ from typing import NamedTuple, TypeAlias
 
 __all__ = [
     "Source", "Span", "NO_SPAN", "Node",
-    "Expr", "Number", "String", "Bool", "NoneLit", "Name", "Pose", "List", "Paren",
+    "Expr", "Number", "String", "Bool", "NoneLit", "Opaque", "Name", "Pose", "List", "Paren",
     "UnaryOp", "BinOp", "Keyword", "Call", "Index", "Attribute", "Run",
     "Stmt", "ExprStmt", "Assign", "Declare", "Return", "Halt", "Break", "Continue",
     "EnterCritical", "ExitCritical", "Join", "Kill", "If", "Elif", "While", "Param",
@@ -169,6 +169,16 @@ class Bool(Expr):
 class NoneLit(Expr):
     """``None``."""
 
+    span: Span = _span
+
+
+@dataclass(frozen=True, slots=True)
+class Opaque(Expr):
+    """A value no script text spells: what the checker puts where a definition from another
+    file of the project has a value it cannot know when this file runs (never parsed, never
+    printed). The interpreter gives an unknown value described by ``source``."""
+
+    source: str
     span: Span = _span
 
 

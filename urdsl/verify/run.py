@@ -305,6 +305,37 @@ def _assigned(module, name: str) -> bool:
     return False
 
 
+PATH_CODES = frozenset({"URS302", "URS303", "URS304", "URS305", "URS306", "URS307", "URS308"})
+"""Findings about the way a move goes (not its target), which depend on where it starts."""
+
+
+def _from_unknown_start(findings: list[Finding], planner) -> list[Finding]:
+    """Path findings of moves that start where the arm's position is unknown offline (after
+    a move a condition stopped, freedrive, a move to an unknown target) are not errors: the
+    planner drew that path from where the arm was last known. One URS210 note per such move
+    says so; its target is still checked (URS301)."""
+    starts = [s for s in planner.segments if s.params.get("from_unknown")]
+    if not starts:
+        return findings
+    kept: list[Finding] = []
+    noted: set = set()
+    for finding in findings:
+        moment = finding.time
+        segment = None if finding.code not in PATH_CODES or moment is None else next(
+            (s for s in starts if s.start - 1e-9 <= moment <= s.end + 1e-9), None)
+        if segment is None:
+            kept.append(finding)
+            continue
+        if segment.span not in noted:
+            noted.add(segment.span)
+            kept.append(Finding.of(
+                "URS210", f"this move starts where {segment.params['from_unknown']} left "
+                "the arm, which is unknown offline: its path is not checked, its target is "
+                f"({finding.code} on the path drawn from where the arm was last known is not "
+                "reported)", segment.span, segment.start))
+    return kept
+
+
 def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: float | None,
                     span) -> list[Finding]:
     """The trace checks, in order; once ``deadline`` (``time.monotonic()``) has passed the
@@ -330,6 +361,7 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
                 f"not checked: {skipped}", span, None, "use --timeout to allow more time"))
             break
         findings += check.run(ctx)
+    findings = _from_unknown_start(findings, planner)
     for label, reached in ctx.partial.items():
         findings.append(Finding.of(
             "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s; "
