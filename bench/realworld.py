@@ -203,10 +203,16 @@ def extract(projects: list[Project], repos: Path, out: Path) -> int:
 
 
 def urdsl_command() -> list[str]:
-    """How to start urdsl's command line with this interpreter."""
+    """How to start urdsl's command line with this interpreter.
+
+    ``-P`` keeps the working directory off the child's module path: without it, running the
+    script from one checkout with another checkout's interpreter (to measure a baseline) would
+    import the urdsl of the working directory, not the one installed for that interpreter.
+    """
     if importlib.util.find_spec("urdsl.__main__") is not None:
-        return [sys.executable, "-m", "urdsl"]
-    return [sys.executable, "-c", "import sys; from urdsl.cli import main; sys.exit(main())"]
+        return [sys.executable, "-P", "-m", "urdsl"]
+    return [sys.executable, "-P", "-c",
+            "import sys; from urdsl.cli import main; sys.exit(main())"]
 
 
 @dataclass
