@@ -288,3 +288,38 @@ def test_states_compare_as_states_and_keep_their_field_names():
     assert hash(state) == hash(realtime_state("5.10", q_actual=Q))
     assert state._replace(robot_mode=3).robot_mode == 3
     assert decode_realtime(encode_realtime(state)).q_actual == Q
+
+
+def test_a_chunk_as_long_as_one_layout_holding_a_shorter_packet_is_framed_by_its_size():
+    # 1220 bytes (the 5.10 length) that hold a 1116-byte packet and the start of the next
+    first = packet(1116, {756: (7.0,)})
+    decoder = RealtimeDecoder()
+    (state,) = decoder.feed(first + first[:104])
+    assert state.version == "3.10" and state.robot_mode == 7 and decoder.pending == 104
+    assert decoder.feed(first[104:]) == [state]
+
+
+@pytest.mark.parametrize(("value", "offset", "field"), [
+    (math.nan, 756, "robot_mode"), (math.inf, 764, "joint_modes"),
+    (-math.inf, 1212, "payload_inertia"), (1.5, 1108, "safety_status")])
+def test_a_whole_packet_with_a_bad_integer_breaks_the_stream(value, offset, field):
+    # the decoder's fast path (one chunk, one whole packet) checks exactly as decode_realtime
+    data = packet(1220, {offset: (value,)})
+    decoder = RealtimeDecoder()
+    if field == "payload_inertia":  # a measured value: any double is taken as it is
+        assert decoder.feed(data)[0].payload_inertia[-1] == value
+        return
+    with pytest.raises(ProtocolError, match=f"{field} at offset {offset} should hold an "
+                                            f"integer, got {value!r}"):
+        decoder.feed(data)
+    with pytest.raises(ProtocolError, match="reconnect"):
+        decoder.feed(packet(1220, {}))
+
+
+def test_a_told_version_labels_whole_packets_and_refuses_shorter_ones():
+    decoder = RealtimeDecoder(version="5.7")
+    (state,) = decoder.feed(packet(1116, {1108: (1.0,)}))
+    assert state.version == "5.7" and state.safety_status == 1
+    assert RealtimeDecoder().feed(packet(1116, {}))[0].version == "3.10"
+    with pytest.raises(ProtocolError, match="version 5.10 packet has at least 1220 bytes"):
+        RealtimeDecoder(version="5.10").feed(packet(1116, {}))

@@ -445,3 +445,13 @@ def test_v1_output_package_has_no_recipe_id_and_bad_values_are_refused():
     assert client.receive_data(data) == [DataPackage(None, {"timestamp": 1.5, "robot_mode": 7})]
     with pytest.raises(ProtocolError, match="data package for recipe None"):
         server.output_package([1.5, 2**40])
+
+
+def test_recipe_names_are_data_not_code():
+    # a remote client picks the names; the generated reader binds them, never compiles them
+    names = ("x': 1}; raise SystemExit #", "k0", "flat[0]", "\n\t\\")
+    recipe = Recipe(7, names, ("DOUBLE", "VECTOR3D", "INT32", "BOOL"))
+    values = dict(zip(names, (1.5, (1.0, 2.0, 3.0), -4, True), strict=True))
+    data = encode_rtde(DataPackage(7, values), recipe=recipe)
+    assert decode_rtde(data, sender="client", recipes={7: recipe}) == DataPackage(7, values)
+    assert decode_rtde(data, sender="server", recipes={7: recipe}).values == values

@@ -35,8 +35,9 @@ from __future__ import annotations
 
 import operator
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass
-from types import MappingProxyType
+from types import FunctionType, MappingProxyType
 from typing import NamedTuple
 
 from ..versions import ControllerVersion
@@ -52,7 +53,6 @@ PORT = 30003
 READ_ONLY_PORT = 30013
 
 _HEADER = struct.Struct(">i")
-_unpack_size = _HEADER.unpack_from
 
 
 @dataclass(frozen=True)
@@ -194,10 +194,11 @@ class RealtimeState(NamedTuple):
 
 
 def _int_error(layout: RealtimeLayout, values: tuple[float, ...]) -> ProtocolError:
-    """The error for the first integer field of ``values`` that holds no integer."""
+    """The error for the first integer field that holds no integer; ``values`` is the
+    packet unpacked whole (the size field, then the doubles)."""
     for name, begin, end in layout._ints:
         for index in range(begin, end):
-            value = values[index]
+            value = values[1 + index]
             if value != value or value in (_INF, -_INF) or int(value) != value:
                 offset = _HEADER.size + 8 * index
                 return ProtocolError(f"field {name} at offset {offset} should hold an "
@@ -236,18 +237,24 @@ class RealtimeLayout:
         self._compile()
 
     def _compile(self) -> None:
-        """Build ``_read``, this layout's decoder: one ``unpack_from`` of all doubles, one
-        conversion of the integer fields (checked: each double must hold an integer), and
-        the :class:`RealtimeState` assembled from a few C-level ``itemgetter`` calls (one
-        per run of fields taken from the same source) — no loop over fields per packet.
-        The source is generated from the table."""
+        """Build this layout's decoders: one ``unpack`` of the whole packet (size field and
+        doubles), one conversion of the integer fields (checked: each double must hold an
+        integer), and the :class:`RealtimeState` assembled from a few C-level
+        ``itemgetter`` calls (one per run of fields taken from the same source) — no loop
+        over fields per packet. The source is generated from the table.
+
+        ``_read(data, start, label, size, tail)`` decodes the packet at ``start`` of a
+        buffer; ``_whole(data)`` a bytes object that is exactly one packet of this layout
+        (``None`` when its size field disagrees: the caller takes the general path)."""
         ints = {name: (begin, end) for name, begin, end in self._ints}
         int_slot = {}  # name -> (first, end) in the converted integers
         k = 0
         for name, begin, end in self._ints:
             int_slot[name] = (k, k + end - begin)
             k += end - begin
-        floats = {name: (begin, end) for name, begin, end in self._spans if name not in ints}
+        # indices into the whole packet unpacked: the size field is value 0, double k is k + 1
+        floats = {name: (begin + 1, end + 1) for name, begin, end in self._spans
+                  if name not in ints}
         # each field of the state: (source, key); sources: f doubles, n integers, None absent
         plan: list[tuple[str, object]] = []
         for name in RealtimeState._fields:
@@ -261,9 +268,11 @@ class RealtimeLayout:
             else:
                 begin, end = span
                 plan.append((source, begin if end - begin == 1 else slice(begin, end)))
+        whole = struct.Struct(f">i{self.doubles}d")
         namespace: dict[str, object] = {
-            "unpack_from": self.struct.unpack_from, "int_error": _int_error, "layout": self,
-            "new": tuple.__new__, "State": RealtimeState, "trunc": float.__trunc__}
+            "unpack_from": whole.unpack_from, "unpack": whole.unpack, "int_error": _int_error,
+            "layout": self, "new": tuple.__new__, "State": RealtimeState,
+            "trunc": float.__trunc__, "NAME": self.name, "EMPTY": b""}
         items = []
         run: list[tuple[str, object]] = []
 
@@ -288,23 +297,29 @@ class RealtimeLayout:
                 flush()
             run.append(entry)
         flush()
-        int_indices = [i for _, begin, end in self._ints for i in range(begin, end)]
+        int_indices = [1 + i for _, begin, end in self._ints for i in range(begin, end)]
         if len(int_indices) > 1:
             namespace["get_ints"] = operator.itemgetter(*int_indices)
             fetch = "get_ints(f)"
         else:  # itemgetter of one key would return a bare value
             fetch = f"(f[{int_indices[0]}],)"
-        source = (
-            "def read(data, start, label, size, tail):\n"
-            "    f = unpack_from(data, start + 4)\n"
+        # i != n: the float's comparison handles an int directly (n != i tries int's first)
+        body = (
             f"    i = {fetch}\n"
             "    try:\n"
             "        n = tuple(map(trunc, i))\n"
             "    except (ValueError, OverflowError):\n"
             "        n = None\n"
-            "    if n != i:\n"
+            "    if i != n:\n"
             "        raise int_error(layout, f)\n"
             f"    return new(State, ({', '.join(items)}))\n")
+        source = (
+            "def read(data, start, label, size, tail):\n"
+            "    f = unpack_from(data, start)\n" + body
+            + f"\ndef whole(data, label=NAME, size={self.size}, tail=EMPTY):\n"
+            "    f = unpack(data)\n"
+            "    if f[0] != size:\n"
+            "        return None\n" + body)
         # the encoder: every field of the table by name, vectors spread, in one pack call;
         # None (some value is missing, of the wrong type or length) leaves the diagnosis to
         # encode_realtime's field-by-field path
@@ -321,8 +336,15 @@ class RealtimeLayout:
         namespace["pack"] = struct.Struct(f">i{self.doubles}d").pack
         exec(source, namespace)  # noqa: S102 - generated from the layout table above
         self._read = namespace["read"]
+        self._whole = namespace["whole"]
         self._write = namespace["write"]
         self._source = source
+
+    def _whole_labelled(self, label: str) -> Callable[[bytes], RealtimeState | None]:
+        """``_whole`` labelling its states ``label`` (a version the decoder was told)."""
+        whole = self._whole
+        return FunctionType(whole.__code__, whole.__globals__, whole.__name__,
+                            (label, *whole.__defaults__[1:]))
 
     def slot(self, name: str) -> slice:
         """Where field ``name`` sits in the packet's array of doubles (after the size field);
@@ -539,12 +561,13 @@ class RealtimeDecoder:
 
     def __init__(self, version: str | None = None) -> None:
         if version is None:
-            exact = {layout.size: (layout._read, layout.name) for layout in LAYOUTS.values()}
+            exact = {layout.size: layout._whole for layout in LAYOUTS.values()}
         else:
             layout = layout_for_version(version)  # fail early on a version we do not know
-            exact = {layout.size: (layout._read, version)}
+            exact = {layout.size: layout._whole_labelled(version)}
         self.version = version
-        # the common case: a whole packet of a layout's exact size → (its decoder, label)
+        # the common case: a chunk that is one whole packet of a layout's exact size → the
+        # decoder of that layout (which checks the size field itself)
         self._exact = exact
         self._buffer = bytearray()
         self._error: ProtocolError | None = None
@@ -591,17 +614,16 @@ class RealtimeDecoder:
 
     def feed(self, data: bytes) -> list[RealtimeState]:
         """Add received bytes; return every packet they complete, oldest first."""
-        if not self._buffer and len(data) >= 4 and self._error is None:
+        if self._error is None and not self._buffer:
             # the common case: exactly one whole packet of a known layout, decoded in place
-            (size,) = _unpack_size(data)
-            if size == len(data):
-                plan = self._exact.get(size)
-                if plan is not None:
-                    try:
-                        state = plan[0](data, 0, plan[1], size, b"")
-                    except ProtocolError as exc:
-                        self._error = exc
-                        raise
+            whole = self._exact.get(len(data))
+            if whole is not None:
+                try:
+                    state = whole(data)
+                except ProtocolError as exc:
+                    self._error = exc
+                    raise
+                if state is not None:  # None: the size field says otherwise
                     self.decoded += 1
                     return [state]
         frames = self._take(data)

@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 import struct
 from collections import deque
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
 from typing import ClassVar, NamedTuple
@@ -94,13 +94,15 @@ def _reader(plan: list[tuple[str, int, int]], body: str, with_id: bool):
     One ``struct.unpack`` of the whole package — it requires the exact length — and one
     dict display, as a hand-written decoder would have; generated from the recipe's plan.
     The generated source holds only identifiers and integers: the names (which a remote
-    client chose) are bound as default values ``k0``, ``k1``, ..., never written into it."""
+    client chose) are bound as default values ``k0``, ``k1``, ..., never written into it;
+    so are the vectors' slices (``s0``, ...: built once, not per package)."""
     whole = struct.Struct((">HBB" if with_id else ">HB") + body)
     skip = 3 if with_id else 2
-    keys = {f"k{number}": name for number, (name, _, _) in enumerate(plan)}
+    keys: dict[str, object] = {f"k{number}": name for number, (name, _, _) in enumerate(plan)}
+    keys.update({f"s{number}": slice(skip + index, skip + index + count)
+                 for number, (_, index, count) in enumerate(plan) if count > 1})
     items = ", ".join(
-        f"k{number}: flat[{skip + index}]" if count == 1
-        else f"k{number}: flat[{skip + index}:{skip + index + count}]"
+        f"k{number}: flat[{skip + index}]" if count == 1 else f"k{number}: flat[s{number}]"
         for number, (_, index, count) in enumerate(plan))
     defaults = "".join(f", {key}={key}" for key in keys)
     source = (
@@ -130,7 +132,11 @@ class Recipe:
     _struct: struct.Struct | None = field(default=None, init=False, repr=False, compare=False)
     _plan: tuple[tuple[str, int, int], ...] = field(default=(), init=False, repr=False,
                                                     compare=False)
-    _readers: tuple | None = field(default=None, init=False, repr=False, compare=False)
+    # the generated readers of whole data packages with / without (v1 output) a recipe id
+    _read_id: Callable[[bytes], DataPackage | None] | None = field(
+        default=None, init=False, repr=False, compare=False)
+    _read_v1: Callable[[bytes], DataPackage | None] | None = field(
+        default=None, init=False, repr=False, compare=False)
     _packers: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -151,9 +157,8 @@ class Recipe:
         object.__setattr__(self, "_struct", struct.Struct("".join(fmt)))
         object.__setattr__(self, "_plan", tuple(plan))
         body = "".join(fmt[1:])
-        # indexed by "has a recipe id" (False: a v1 output package)
-        object.__setattr__(self, "_readers", (_reader(plan, body, False),
-                                              _reader(plan, body, True)))
+        object.__setattr__(self, "_read_v1", _reader(plan, body, False))
+        object.__setattr__(self, "_read_id", _reader(plan, body, True))
         # whole data packages from the values (recipe id first when there is one): the
         # header's size and type are constants of the recipe
         object.__setattr__(self, "_packers", tuple(
@@ -520,10 +525,11 @@ def decode_rtde(package: bytes, *, sender: str, protocol: int = 2,
         raise ValueError(f"sender must be 'client' or 'server', not {sender!r}")
     if recipes:  # a data package of a known recipe: the fast path
         try:
-            read = recipes[package[3] if with_id else None]._readers[with_id]  # type: ignore
-        except (KeyError, IndexError, TypeError):  # no such recipe, too short, unusable
+            read = (recipes[package[3]]._read_id if with_id  # type: ignore[index]
+                    else recipes[None]._read_v1)
+        except (KeyError, IndexError, TypeError):  # no such recipe, too short
             read = None
-        if read is not None:
+        if read is not None:  # None: an unusable recipe
             message = read(package)
             if message is not None:
                 return message
