@@ -216,6 +216,32 @@ def test_direction_in_a_variable_feature_and_until_blend():
     assert "movel(towardsPos, a=1.2, v=0.25)" in compiled(DIRECTION.format(kind="STOP"))
 
 
+def test_direction_without_a_feature_moves_in_its_moves_feature():
+    # CubeFinishApril2022 (mswaidan/finishing-line): a Direction with no <feature> under a
+    # MoveL in the plane feature CubeFront; PolyScope labels it "Direction: CubeFront Z+"
+    # and writes CubeFront's pose, not the base's p[0, ...]
+    lines = compiled("""
+        <Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Cube"/>
+          <children>
+            <gui.program.direction.MoveDirectionNode selectedDirection="ZPlus"
+                toolParams="0.2, 1.2">
+              <children>
+                <Until type="DISTANCE" allowActions="false" deceleration="3.0"
+                       distanceNodeType="STOP">
+                  <Distance>0.1</Distance>
+                  <motionParameters blendRadius="0.0"/>
+                </Until>
+              </children>
+            </gui.program.direction.MoveDirectionNode>
+          </children>
+        </Move>""")
+    assert '$ 3 "Direction: Cube Z+"' in lines
+    assert "local towardsPos = calculate_point_to_move_towards(" \
+           "p[-0.65, -0.29, 0.15, 1.19, 1.2, 1.23], [0.0, 0.0, 1.0], 0.1)" in lines
+    assert "movel(towardsPos, a=1.2, v=0.2)" in lines
+
+
 def test_tool_contact_without_retraction_stops_where_it_touched():
     lines = compiled(DIRECTION.format(kind="STOP"))
     found = lines.index("if (stepsToRetract > 0):")

@@ -993,6 +993,15 @@ class _Compiler:
         selected = node.attrs.get("selectedDirection")
         expression = node.fields.get("expression")
         feature = node.fields.get("feature")
+        variable_feature = node.fields.get("feature_name")
+        if "feature" not in node.fields and move is not None:
+            # a Direction without its own <feature> moves in its Move's feature (seen: under
+            # a MoveL in a plane feature PolyScope labels it and writes that feature's pose)
+            feature = move.fields.get("feature")
+        if feature and feature not in _BASE_FEATURES and feature not in _TOOL_FEATURES:
+            # a named feature: its pose written in place, as for a variable one (PolyScope
+            # never writes a feature's name here in the real scripts)
+            variable_feature, feature = feature, None
         frame = "Tool" if feature in _TOOL_FEATURES else (
             "Base" if feature in (None, *_BASE_FEATURES) else str(feature))
         if selected:
@@ -1005,7 +1014,6 @@ class _Compiler:
             label = f"Direction: {frame}"
         else:
             return self.n_unknown(node)
-        variable_feature = node.fields.get("feature_name")
         if variable_feature:
             # a variable feature: its pose in the installation, written in place (seen); its
             # name when the installation does not have it [U]
