@@ -29,6 +29,12 @@ INSTALLATION = """<Installation name="cell">
     <tcp name="Flange" offset="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
     <tcp name="Sander" offset="0.003, 0.11, 0.098, -0.785, 0.0, 0.0"/>
   </TCPSettings>
+  <PayloadSettings>
+    <Payload name="Gripper" mass="1.0" defaultPayload="true" centerOfGravity="0.0, 0.0, 0.05"
+             inertiaParameters="0.001, 0.001, 0.001, 0.0, 0.0, 0.0"/>
+    <Payload name="Part" mass="3.02" defaultPayload="false" centerOfGravity="0.012, 0.022, 0.058"
+             inertiaParameters="0.009713, 0.009713, 0.009713, 0.0, 0.0, 0.0"/>
+  </PayloadSettings>
   <Features>
     <wrapper>
       <GeomPoseNode name="Cube" isVariable="true">
@@ -240,6 +246,23 @@ def test_direction_without_a_feature_moves_in_its_moves_feature():
     assert "local towardsPos = calculate_point_to_move_towards(" \
            "p[-0.65, -0.29, 0.15, 1.19, 1.2, 1.23], [0.0, 0.0, 1.0], 0.1)" in lines
     assert "movel(towardsPos, a=1.2, v=0.2)" in lines
+
+
+def test_set_payload_selects_a_payload_of_the_installation():
+    # CubeFinishApril2022 (mswaidan/finishing-line): <SetPayload workpieceName="SandSpray"/>
+    # is written '$ 6 "Set Payload: SandSpray"' and the payload's set_target_payload
+    body = """<SetPayload workpieceName="Part"/>"""
+    lines = compiled(body)
+    assert after(lines, '$ 2 "Set Payload: Part"', 1) == [
+        "set_target_payload(3.02, [0.012, 0.022, 0.058], "
+        "[0.009713, 0.009713, 0.009713, 0.0, 0.0, 0.0])"]
+    # the installation's default payload is the preamble's, not the one the node selects
+    assert lines.count("set_target_payload(1.0, [0.0, 0.0, 0.05], "
+                       "[0.001, 0.001, 0.001, 0.0, 0.0, 0.0])") == 1
+    # without the installation the payload is unknown: the node is kept and named
+    unknown = compiled(body, installation=False)
+    assert "# urdsl: PolyScope node <SetPayload> is not compiled" in unknown
+    assert not any(line.startswith("set_target_payload") for line in unknown)
 
 
 def test_tool_contact_without_retraction_stops_where_it_touched():

@@ -78,7 +78,7 @@ from ..script.nodes import (
 )
 from ..script.printer import format as print_tree
 from .installation import Installation
-from .preamble import _call, _num, _stmt, preamble
+from .preamble import _call, _num, _stmt, payload_statements, preamble
 from .urp import Expression, Kinematics, Node, Program
 
 __all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "parse_variables",
@@ -778,6 +778,19 @@ class _Compiler:
         if kind == "NoAction":
             return [self.marker(node, "Set")]
         return self.n_unknown(node)
+
+    def n_SetPayload(self, node: Node) -> list[Item]:
+        """A Set Payload node that selects one of the installation's payloads by name
+        (``workpieceName``): marker "Set Payload: NAME", then the statement the preamble
+        writes for a payload (seen: ``set_target_payload(mass, cog, inertia)``). Another
+        variant, or a payload the installation does not have, stays an unknown node."""
+        name = node.attrs.get("workpieceName")
+        payloads = getattr(self.installation, "payloads", ()) or ()
+        payload = next((p for p in payloads if p.name == name), None)
+        if not name or payload is None or self.installation is None:
+            return self.n_unknown(node)
+        return [self.marker(node, f"Set Payload: {name}"),
+                *payload_statements(self.installation, payload, self.version)]
 
     def analog_full_scale(self, index: int) -> float:
         """What an analog output's value (as the Set node stores it: V, or mA) is at the

@@ -34,7 +34,7 @@ from ..script.nodes import (
     ThreadDef,
     While,
 )
-from .installation import Installation
+from .installation import Installation, Payload
 from .urp import Expression, Program
 
 __all__ = ["BLOCKS", "initial_values", "preamble", "preamble_blocks", "step_counter"]
@@ -278,17 +278,7 @@ def _installation_blocks(installation: Installation, major: int) -> dict[str, li
     blocks["modbus"] = _modbus(installation)
     payload = installation.payload
     if payload is not None:
-        raw = settings.get(f"Payload/{payload.name}")
-        if raw is not None and raw.get("inertiaParameters"):
-            inertia = tuple(float(v) for v in raw["inertiaParameters"].split(","))
-            blocks["payload"] = [_stmt("set_target_payload", _num(payload.mass),
-                                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))),
-                                       List(tuple(_num(v) for v in inertia)))]
-        elif payload.cog is None and major < 5:
-            blocks["payload"] = [_stmt("set_payload", _num(payload.mass))]
-        else:
-            blocks["payload"] = [_stmt("set_payload", _num(payload.mass),
-                                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))))]
+        blocks["payload"] = payload_statements(installation, payload, major)
     tcp = installation.tcp
     if tcp is not None:
         blocks["tcp"] = [_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset)))]
@@ -375,3 +365,21 @@ def step_counter(program: Program) -> list[Item]:
             Assign(Name(count), BinOp("+", Name(count), _num(1.0))),
             _stmt("sync"))),)),
         ExprStmt(Run(thread))]
+
+
+def payload_statements(installation: Installation, payload: Payload, major: int) -> list[Item]:
+    """What PolyScope writes to select one of the installation's payloads (mass kg, centre
+    of gravity m, inertia kg m²): ``set_target_payload`` when the installation gives its
+    inertia, else ``set_payload`` (PolyScope 3 without a centre of gravity: the mass
+    alone). Used by the preamble (the default payload) and a Set Payload node."""
+    raw = installation.settings.get(f"Payload/{payload.name}") if installation.settings \
+        else None
+    if raw is not None and raw.get("inertiaParameters"):
+        inertia = tuple(float(v) for v in raw["inertiaParameters"].split(","))
+        return [_stmt("set_target_payload", _num(payload.mass),
+                      List(tuple(_num(v) for v in payload.cog or (0, 0, 0))),
+                      List(tuple(_num(v) for v in inertia)))]
+    if payload.cog is None and major < 5:
+        return [_stmt("set_payload", _num(payload.mass))]
+    return [_stmt("set_payload", _num(payload.mass),
+                  List(tuple(_num(v) for v in payload.cog or (0, 0, 0))))]
