@@ -42,7 +42,9 @@ counted, and the exact share is given over all pairs and over those with their
 installation.
 
 Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back;
-``extra``: projects found later, used to find the variants the tune pairs lack),
+``extra``: projects found later, used to find the variants the tune pairs lack; ``tune2``:
+projects found after those, two of every three in the order they were added, the third
+``held``),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most. ``--show N`` prints the first differing lines of N programs.
 """
@@ -339,7 +341,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repos", type=Path, default=Path("/work/.mirror"),
                         help="folder of owner+name git dirs")
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
-    parser.add_argument("--split", choices=("tune", "held", "extra", "all"), default="all")
+    parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "all"),
+                        default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
     parser.add_argument("--script-files", choices=("file", "cache"), default="file",
                         help="a Script node's file: read it from the repository as of the "
