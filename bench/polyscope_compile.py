@@ -9,15 +9,15 @@ the same folder when it is there.
 
 Both scripts are parsed and printed canonically, statement by statement: comments and URCap
 blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare to
-1e-9, PolyScope's generated ids (``_3f89b84f_1daa_...``) are masked, and ``$`` markers
-compare by number and flag (their label text is in the language PolyScope ran in, which the
-.urp does not record). For the same reason a ``popup`` title that is PolyScope's own title
-of a Popup node in another language ("Erreur", "Meldung": see ``POPUP_TITLES``, the
-languages seen) compares as its English one ("Error", "Message") when the popup's
-warning/error flags are that type's; a title the user wrote is compared as written. Two
-views: the whole program, and the program part (the top-level statements from the first
-waypoint global, definition or marker on: what the program tree, not the installation,
-generates).
+1e-9, PolyScope's generated ids (``_3f89b84f_1daa_...``, the N of a ``SinglePulseN`` thread)
+are masked, and ``$`` markers compare by number and flag (their label text is in the
+language PolyScope ran in, which the .urp does not record). For the same reason a ``popup``
+title that is PolyScope's own title of a Popup node in another language ("Erreur",
+"Meldung": see ``POPUP_TITLES``, the languages seen) compares as its English one ("Error",
+"Message") when the popup's warning/error flags are that type's; a title the user wrote is
+compared as written. Two views: the whole program, and the program part (the top-level
+statements from the first waypoint global, definition or marker on: what the program tree,
+not the installation, generates).
 
 The installation is the one the program names (``installationRelativePath``). A Script
 node's file is read from the repository as it was in the last commit that changed the
@@ -88,6 +88,9 @@ from urdsl.script.nodes import (  # noqa: E402
 from urdsl.script.printer import format as print_tree  # noqa: E402
 
 _ID = re.compile(r"_[0-9a-f]{8}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{4}_[0-9a-f]{12}")
+_PULSE = re.compile(r"\b([Ss]inglePulse)\d+\b")
+"""A single pulse thread's number: a counter PolyScope keeps across the programs it
+compiles (CA-Giken/docker-noetic-capc: 2, 3 in SUB_109 and 397-402 in SUB_104RXF)."""
 _NUMBER = re.compile(r"(?<![\w.])(\d+\.\d*|\.\d+|\d+)(e-?\d+)?(?![\w.])", re.IGNORECASE)
 _NEGATIVE_ZERO = re.compile(r"(?<![\w.)\]])-0(?![\w.])")
 """A number that rounds to zero keeps no sign (PolyScope writes -1.2E-16 where urdsl
@@ -213,7 +216,7 @@ def canonical_lines(module: Module) -> list[str]:
     for line in text.splitlines():
         if not line.strip():
             continue
-        line = _ID.sub("_ID", line)
+        line = _PULSE.sub(r"\1_N", _ID.sub("_ID", line))
         marker = _MARKER.match(line)
         if marker:
             line = f"{marker.group(1)}$ {marker.group(2)}{marker.group(3)}"

@@ -188,6 +188,15 @@ def test_events_share_one_thread_started_before_the_robot_program():
     assert lines.index("eventThread = run EventThread()") < lines.index('$ 1 "Robot Program"')
 
 
+WAYPOINT_MOVE = f"""
+        <Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            {WAYPOINT.format(name="Start")}
+          </children>
+        </Move>"""
+
+
 DIRECTION = """
         <Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true">
           <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
@@ -263,6 +272,32 @@ def test_set_payload_selects_a_payload_of_the_installation():
     unknown = compiled(body, installation=False)
     assert "# urdsl: PolyScope node <SetPayload> is not compiled" in unknown
     assert not any(line.startswith("set_target_payload") for line in unknown)
+
+
+def test_single_digital_pulse_is_a_thread_started_in_place():
+    # CA-Giken/docker-noetic-capc MAIN: '$ 586 "... =HI:Pulse 1.0"', thread SinglePulse660
+    # (PolyScope's number is a counter across programs; urdsl counts from 1 in the program)
+    pulse = """<Set type="SingleDigitalPulseActionState">
+          <SingleDigitalPulseActionState hiPulseInSeconds="{t}">
+            <pin referencedName="digital_out[{n}]"/>
+          </SingleDigitalPulseActionState>
+        </Set>"""
+    lines = compiled(pulse.format(t="0.1", n=0) + pulse.format(t="1.5", n=2))
+    assert after(lines, '$ 2 "Set digital_out[0]=HI:Pulse 0.1"', 6) == [
+        "thread SinglePulse1():", "set_standard_digital_out(0, True)", "sleep(0.1)",
+        "set_standard_digital_out(0, False)", "end", "singlePulse1 = run SinglePulse1()"]
+    assert after(lines, '$ 3 "Set digital_out[2]=HI:Pulse 1.5"', 6)[2] == "sleep(1.5)"
+    assert "singlePulse2 = run SinglePulse2()" in lines
+
+
+def test_names_beyond_ascii_are_written_as_polyscope_does():
+    # CA-Giken/docker-noetic-capc: a thread "スレッド_2" is u12473u12524u12483u12489_2
+    lines = compiled(WAYPOINT_MOVE.replace('name="Start"', 'name="点_1"'),
+                     others="""<Thread><children>
+          <Wait type="Sleep"><waitTime>0.5</waitTime></Wait></children></Thread>""")
+    assert "global u28857_1_p = p[" in " ".join(lines)
+    assert any(line.startswith("movej(get_inverse_kin(u28857_1_p") or
+               line.startswith("movej(u28857_1_q") for line in lines), lines
 
 
 def test_tool_contact_without_retraction_stops_where_it_touched():

@@ -27,6 +27,7 @@ Marker labels are the English ones; PolyScope writes them in the language it run
 
 from __future__ import annotations
 
+import dataclasses
 import gzip
 import math
 import posixpath
@@ -171,6 +172,40 @@ def _matrix_to_rotvec(m: np.ndarray) -> np.ndarray:
             axis = -axis  # not quite a half turn: the antisymmetric part gives the sign
         return axis * angle
     return axis / sin2 * angle
+
+
+_NAME_FIELDS = {Name: "id", Run: "thread", Declare: "name", Param: "name",
+                FunctionDef: "name", ThreadDef: "name"}
+"""The node fields that hold a name the program defines or uses."""
+
+
+def ascii_name(name: str) -> str:
+    """A name as PolyScope writes it in a script: each character beyond ASCII becomes
+    ``u`` and its code point in decimal (seen: a thread "スレッド_2" is
+    ``u12473u12524u12483u12489_2``, a waypoint "ウェイポイント_1" ``u12454…u12488_1_p``)."""
+    return "".join(c if ord(c) < 128 else f"u{ord(c)}" for c in name)
+
+
+def _ascii_names(item):
+    """``item`` (a URScript tree) with every name made ASCII by :func:`ascii_name`; strings,
+    comments and marker labels are kept as written."""
+    if isinstance(item, tuple):
+        return tuple(_ascii_names(part) for part in item)
+    if not dataclasses.is_dataclass(item) or isinstance(item, type):
+        return item
+    changes = {}
+    for spec in dataclasses.fields(item):
+        value = getattr(item, spec.name)
+        if spec.name == "span":
+            continue
+        if isinstance(value, str):
+            if _NAME_FIELDS.get(type(item)) == spec.name and not value.isascii():
+                changes[spec.name] = ascii_name(value)
+        elif isinstance(value, tuple) or dataclasses.is_dataclass(value):
+            new = _ascii_names(value)
+            if new is not value:
+                changes[spec.name] = new
+    return dataclasses.replace(item, **changes) if changes else item
 
 
 def waypoint_pose(q, tcp, kinematics: Kinematics) -> tuple[float, ...]:
@@ -364,6 +399,7 @@ class _Compiler:
         self.labels: dict[int, str] = {}
         self.pins = dict(getattr(installation, "io_names", ()) or ())
         self.version = program.major_version or 5
+        self.pulses = 0  # single pulse threads written so far
 
     # -- numbering
     def _number_tree(self, node: Node) -> None:
@@ -417,7 +453,8 @@ class _Compiler:
         name = re.sub(r"[^A-Za-z0-9_]", "", program.name) or "program"
         if name[0].isdigit():
             name = "_" + name
-        return Compiled(Module((FunctionDef(name, (), tuple(body)),)), self.numbers, self.labels)
+        module = _ascii_names(Module((FunctionDef(name, (), tuple(body)),)))
+        return Compiled(module, self.numbers, self.labels)
 
     def _all_nodes(self, suppressed: bool = False):
         """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
@@ -775,6 +812,8 @@ class _Compiler:
                           _num(value / self.analog_full_scale(index)))]
         if kind == "ExpressionOutput":
             return self.set_expression(node)
+        if kind == "SingleDigitalPulseActionState":
+            return self.set_pulse(node)
         if kind == "NoAction":
             return [self.marker(node, "Set")]
         return self.n_unknown(node)
@@ -791,6 +830,32 @@ class _Compiler:
             return self.n_unknown(node)
         return [self.marker(node, f"Set Payload: {name}"),
                 *payload_statements(self.installation, payload, self.version)]
+
+    def set_pulse(self, node: Node) -> list[Item]:
+        """A Set node's single digital pulse: a thread sets the output high, sleeps the
+        pulse's length (s) and sets it low; the program starts it and goes on, as PolyScope
+        writes it (seen: ``hiPulseInSeconds``, standard outputs and boolean output
+        registers). PolyScope numbers these threads ``SinglePulseN`` from a counter it
+        keeps across the programs it compiles (one project shows 2, 3 in one program and
+        397-402 in another), which no file records: urdsl counts them in the program from
+        1. A low pulse is not seen and stays an unknown node."""
+        pulse = node.fields.get("pulse") or {}
+        length = _floats_or_none(pulse.get("hiPulseInSeconds"))
+        if not length:
+            return self.n_unknown(node)
+        pin = str(node.fields.get("pin"))
+        bank, index = self.resolve_pin(pin, node)
+        function = _SET_FUNCTIONS.get(bank)
+        if function is None:
+            raise self.error(node, f"cannot set the I/O {pin!r}")
+        self.pulses += 1
+        name = f"SinglePulse{self.pulses}"
+        body = (_stmt(function, Number(index), Bool(True)),
+                _stmt("sleep", _num(length[0])),
+                _stmt(function, Number(index), Bool(False)))
+        return [self.marker(node, f"Set {self.pin_label(pin)}=HI:Pulse {length[0]}"),
+                ThreadDef(name, body),
+                Assign(Name(f"singlePulse{self.pulses}"), Run(name))]
 
     def analog_full_scale(self, index: int) -> float:
         """What an analog output's value (as the Set node stores it: V, or mA) is at the

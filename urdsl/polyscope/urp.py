@@ -537,6 +537,11 @@ def _wait(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
 def _set(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["type"] = element.get("type", "NoAction")
     pin = element.find("pin")
+    pulse = element.find("SingleDigitalPulseActionState")
+    if pulse is not None:
+        # a single pulse: the pin and the pulse's length (s) are in this child
+        pin = pulse.find("pin")
+        node.fields["pulse"] = {key: value for key, value in pulse.attrib.items()}
     if pin is not None:
         node.fields["pin"] = reader.resolve(pin).get("referencedName")
     for key in ("digitalValue", "analogValue"):
