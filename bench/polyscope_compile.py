@@ -13,11 +13,11 @@ blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers co
 are masked, and ``$`` markers compare by number and flag (their label text is in the
 language PolyScope ran in, which the .urp does not record). For the same reason a ``popup``
 title that is PolyScope's own title of a Popup node in another language ("Erreur",
-"Meldung": see ``POPUP_TITLES``, the languages seen) compares as its English one ("Error",
-"Message") when the popup's warning/error flags are that type's; a title the user wrote is
-compared as written. Two views: the whole program, and the program part (the top-level
-statements from the first waypoint global, definition or marker on: what the program tree,
-not the installation, generates).
+"Meldung", "メッセージ": see ``POPUP_TITLES``, the languages seen) compares as its English one
+("Error", "Message") when the popup's warning/error flags are that type's; a title the user
+wrote is compared as written. Two views: the whole program, and the program part (the top-
+level statements from the first waypoint global, definition or marker on: what the program
+tree, not the installation, generates).
 
 The installation is the one the program names (``installationRelativePath``). A Script
 node's file is read from the repository as it was in the last commit that changed the
@@ -103,6 +103,8 @@ POPUP_TITLES = {
     "Erreur": "Error", "Avertissement": "Warning",
     # German (seen: "Meldung")
     "Fehler": "Error", "Warnung": "Warning", "Meldung": "Message",
+    # Japanese (seen: "メッセージ", CA-Giken/docker-noetic-capc)
+    "メッセージ": "Message",
 }
 """PolyScope's own Popup titles in the languages seen in real programs → the English title
 urdsl writes. A Popup node has no title of its own: PolyScope titles it with its type

@@ -18,6 +18,8 @@ from urdsl.script.printer import format as print_tree
 INSTALLATION = """<Installation name="cell">
   <IOs>
     <analogOutputDomain value="1, 0"/>
+    <GeneralPurposeBooleanRegisterOutputNames value="DONE, , "/>
+    <GeneralPurposeIntRegisterInputNames value=", PRG_NO"/>
     <ModbusUnits>
       <Unit ipAddress="192.168.1.18" sequentialMode="false">
         <ModbusSignal name="RUN" type="DIGITAL_INPUT" signalAddress="3" slaveAddress="255"/>
@@ -157,6 +159,64 @@ def test_modbus_signals_as_io():
         'modbus_set_output_signal("BRUSH", False)']
     assert after(lines, '$ 3 "Wait RUN=HI"', 1) == [
         'while (modbus_get_signal_status("RUN") == False):']
+
+
+def test_general_purpose_registers_as_io():
+    # CA-Giken/docker-noetic-capc: named RTDE registers (GPBO_..., GPII_...) and unnamed
+    # ones (GP_int_in[23]) in Set, Wait and expressions
+    lines = compiled("""
+        <Set type="DigitalOutput">
+          <pin referencedName="DONE"/>
+          <digitalValue>1</digitalValue>
+        </Set>
+        <Set type="ExpressionOutput">
+          <pin referencedName="GP_int_out[3]"/>
+          <expression><ExpressionToken token="7"/></expression>
+        </Set>
+        <Wait type="Condition">
+          <expression>
+            <ExpressionIO><pin referencedName="PRG_NO"/></ExpressionIO>
+            <ExpressionChar character="="/><ExpressionChar character="="/>
+            <ExpressionIO><pin referencedName="GP_int_in[23]"/></ExpressionIO>
+          </expression>
+        </Wait>""")
+    assert after(lines, '$ 2 "Set DONE=On"', 1) == ["write_output_boolean_register(0, True)"]
+    assert after(lines, '$ 3 "Set GP_int_out[3]=7"', 1) == [
+        "write_output_integer_register(3, 7)"]
+    assert "while (not (read_input_integer_register(1) == read_input_integer_register(23))):" \
+        in lines
+
+
+def test_timers_in_polyscopes_order():
+    # the order of a Java HashSet of their names (eight timers of CA-Giken MAIN and two of
+    # mswaidan modbustest are written so), not the order of the nodes
+    timer = """<Timer action="Start"><variable name="{}"/></Timer>"""
+    lines = compiled(timer.format("timer_brush") + timer.format("timer_dry"))
+    counting = [line for line in lines if line.endswith("_is_counting = False")]
+    assert counting == ["global timer_dry_is_counting = False",
+                        "global timer_brush_is_counting = False"]
+
+
+def test_base_feature_in_an_expression_is_its_pose():
+    lines = compiled("""
+        <Assignment valueSource="Expression">
+          <variable featureName="UF"/>
+          <expression>
+            <ExpressionGeomFeature><feature referencedName="Joint_0_name"/></ExpressionGeomFeature>
+          </expression>
+        </Assignment>""")
+    assert "global UF = p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]" in lines
+
+
+def test_names_beyond_ascii_in_an_expression():
+    # CA-Giken TEST_SPEED: "pose_sub(CurrPos_p, ウェイポイント_1_p)" in an assignment
+    lines = compiled("""
+        <Assignment valueSource="Expression">
+          <variable name="PoseSub"/>
+          <expression><ExpressionToken token="pose_sub(p0, 点_1_p)"/>
+          <ExpressionToken token=" # 点"/></expression>
+        </Assignment>""")
+    assert "global PoseSub = pose_sub(p0, u28857_1_p)" in lines
 
 
 def test_an_unknown_io_is_still_one_message():

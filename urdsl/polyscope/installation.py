@@ -217,7 +217,8 @@ class Installation:
     of the first point's tool z axis."""
     io_names: tuple[tuple[str, str], ...] = ()
     """The I/O names the user gave: (name, pin) pairs, pin as PolyScope refers to it
-    (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``)."""
+    (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``, the
+    general purpose registers ``GP_bool_in[0]``, ``GP_int_out[2]``, ``GP_float_in[1]``)."""
     safety: Safety | None = None
     """The safety configuration's normal-mode limits and planes (3.x and 5.x), when the
     file has them."""
@@ -370,6 +371,12 @@ _IO_BANKS = {
     "ToolDigitalInputNames": "tool_in", "ToolDigitalOutputNames": "tool_out",
     "AnalogInputNames": "analog_in", "AnalogOutputNames": "analog_out",
     "ToolAnalogInputNames": "tool_analog_in",
+    "GeneralPurposeBooleanRegisterInputNames": "GP_bool_in",
+    "GeneralPurposeBooleanRegisterOutputNames": "GP_bool_out",
+    "GeneralPurposeIntRegisterInputNames": "GP_int_in",
+    "GeneralPurposeIntRegisterOutputNames": "GP_int_out",
+    "GeneralPurposeFloatRegisterInputNames": "GP_float_in",
+    "GeneralPurposeFloatRegisterOutputNames": "GP_float_out",
 }
 """``<IOs>`` name lists (comma-separated, empty for an unnamed pin) and the pins they name."""
 

@@ -7,7 +7,6 @@ program's ``def``.
 
 from __future__ import annotations
 
-import re
 import uuid
 from xml.etree import ElementTree
 
@@ -39,10 +38,6 @@ from .installation import Installation, Payload
 from .urp import Expression, Program
 
 __all__ = ["BLOCKS", "initial_values", "preamble", "preamble_blocks", "step_counter"]
-
-_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-"""A name URScript accepts (ASCII letters, digits and underscores)."""
-
 
 def _call(name: str, *args: Expr, **keywords: Expr) -> Call:
     return Call(Name(name), tuple(args), tuple(Keyword(k, v) for k, v in keywords.items()))
@@ -181,11 +176,10 @@ def preamble_blocks(program: Program, installation: Installation | None,
             values.append(Comment(f" urdsl: installation variable {name} is not URScript"))
     if values:
         blocks.append(("variables", values))
-    # a feature whose name is not a URScript name (seen: "点_1", a Japanese "point") has
-    # no global: PolyScope leaves it out
+    # a name beyond ASCII ("点_1") is written as the compiler writes every name
+    # (``u28857_1``, seen), and sorted as written
     features = [Declare("global", name, Pose(tuple(_num(v) for v in pose)))
-                for name, pose in sorted(installation.features if installation else ())
-                if _IDENTIFIER.fullmatch(name)]
+                for name, pose in sorted(installation.features if installation else ())]
     if features:
         blocks.append(("features", features))
     urcaps: list[Item] = []

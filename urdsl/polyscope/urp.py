@@ -417,6 +417,10 @@ class _Reader:
                 return ("io", name or inner.get("referencedName", ""))
             if piece.tag == "ExpressionWaypoint":
                 return ("waypoint", name)
+            if piece.tag == "ExpressionGeomFeature" and name == "Joint_0_name":
+                # the base feature in an expression is its pose (seen: "UF:=Base" is
+                # written ``global UF=p[0.0,0.0,0.0,0.0,0.0,0.0]``)
+                return ("token", "p[0.0,0.0,0.0,0.0,0.0,0.0]")
             return ("var", name)
         return ("token", piece.get("name", ""))
 
