@@ -282,3 +282,22 @@ def test_initial_values_of_the_variables_setup_and_of_urcap_variables():
                                  "# urdsl: the initial value of bad is not compiled",
                                  "global part = True"]  # each name once
     assert list(blocks)[-1] == "initial"  # after the installation's blocks
+
+
+def test_ethernet_ip_watchdog_and_general_purpose_register_state():
+    # CA-Giken/docker-noetic-capc (5.13): EtherNet/IP enabled with the watchdog action
+    # IGNORE, and register 0's action PROGRAM_RUNNING
+    installation = b"""<Installation>
+  <IOs><GeneralPurposeBooleanRegisterOutputActions value="PROGRAM_RUNNING, NONE, NONE"/></IOs>
+  <Contributions><URCaps>
+    <Contributed ownerId="com.ur.urcap.ethernetip" id="EthernetIP" name="Ethernet/IP">
+      <data key="watchdogAction" value="IGNORE"/><data key="enabled" value="true"/>
+    </Contributed>
+  </URCaps></Contributions>
+</Installation>"""
+    blocks = _blocks(_urp("5.13.0"), installation)
+    assert blocks["io"] == ["set_runstate_gp_boolean_output_to_value(0, 3)"]
+    assert blocks["watchdog"] == ['rtde_set_watchdog("speed_slider_mask", 10.0, "ignore")']
+    # the adapter disabled (creativity-software/ur10-robot-draw-circle): no watchdog
+    disabled = installation.replace(b'value="true"', b'value="false"')
+    assert "watchdog" not in _blocks(_urp("5.13.0"), disabled)

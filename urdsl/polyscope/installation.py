@@ -517,6 +517,10 @@ def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
     for element in root.iter("Payload"):
         if element.get("inertiaParameters"):
             settings[f"Payload/{element.get('name', '')}"] = dict(element.attrib)
+    for element in root.iterfind("Contributions/URCaps/Contributed"):
+        if element.get("id") == "EthernetIP":  # the built-in EtherNet/IP adapter's data
+            settings["EthernetIP"] = {data.get("key", ""): data.get("value", "")
+                                      for data in element.iterfind("data")}
     return settings
 
 

@@ -131,6 +131,8 @@ _RUNSTATE = {"LOW_WHEN_PROGRAM_STOPPED": 1, "HIGH_WHEN_PROGRAM_STOPPED": 2,
              "HIGH_WHEN_PROGRAM_RUNNING_LOW_WHEN_STOPPED": 3}
 """Output actions when the program stops → the state number of ``set_runstate_*`` (1 seen;
 2 and 3 as the URScript manual numbers them [U])."""
+_GP_RUNSTATE = {"PROGRAM_RUNNING": 3}
+"""A general purpose boolean output register's action → its run state number (seen: 3)."""
 _RUNSTATE_BANKS = (("DigitalOutputActions", "standard"),
                    ("ConfigurableOutputActions", "configurable"),
                    ("ToolDigitalOutputActions", "tool"))
@@ -152,7 +154,8 @@ def preamble_blocks(program: Program, installation: Installation | None,
     """The preamble as (kind, statements) blocks in the order urdsl writes them. Kinds:
     ``verification`` (PolyScope 5.13 on: a hidden global, always first), the movable
     blocks of :data:`BLOCKS`, then ``variables`` (the installation variables) and
-    ``features`` (feature poses, by name), ``urcaps`` (a marked block per URCap
+    ``features`` (feature poses, by name), ``watchdog`` (the EtherNet/IP adapter's watchdog
+    when it is enabled), ``urcaps`` (a marked block per URCap
     installation node: its code only the URCap can generate, so the block is empty), then
     ``initial`` (the program's initial variable values, see :func:`initial_values`).
     Modbus signals' input/output actions are not written."""
@@ -182,6 +185,13 @@ def preamble_blocks(program: Program, installation: Installation | None,
                 for name, pose in sorted(installation.features if installation else ())]
     if features:
         blocks.append(("features", features))
+    ethernet_ip = (installation.settings or {}).get("EthernetIP", {}) if installation else {}
+    if ethernet_ip.get("enabled") == "true" and ethernet_ip.get("watchdogAction"):
+        # the EtherNet/IP adapter enabled: a watchdog on the speed slider input (seen with
+        # the action IGNORE; PAUSE and STOP written the same way [U])
+        blocks.append(("watchdog", [_stmt("rtde_set_watchdog", String("speed_slider_mask"),
+                                          _num(10.0),
+                                          String(ethernet_ip["watchdogAction"].lower()))]))
     urcaps: list[Item] = []
     for name, vendor, title in installation.urcaps if installation else ():
         urcaps.extend((Comment(" begin: URCap Installation Node"),
@@ -322,6 +332,13 @@ def _io(settings: dict[str, dict[str, str]]) -> list[Item]:
     for bank, index, state in states:
         items.append(_stmt(f"set_runstate_{bank}_digital_output_to_value", Number(index),
                            Number(state)))
+    # a general purpose boolean output register's action: only its state is written (seen:
+    # PROGRAM_RUNNING at register 0 as ``set_runstate_gp_boolean_output_to_value(0, 3)``)
+    actions = settings.get("IOs/GeneralPurposeBooleanRegisterOutputActions", {}).get("value", "")
+    for index, action in enumerate(a.strip() for a in actions.split(",")):
+        if action in _GP_RUNSTATE:
+            items.append(_stmt("set_runstate_gp_boolean_output_to_value", Number(index),
+                               Number(_GP_RUNSTATE[action])))
     return items
 
 
