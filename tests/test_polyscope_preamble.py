@@ -160,7 +160,8 @@ def test_modbus_signals(five):
 
 
 def test_the_step_counter_and_the_verification_global_of_recent_versions(five):
-    assert five["verification"] == ["global _hidden_verificationVariable = 0"]  # 5.13 on
+    assert five["verification"] == ["global _hidden_verificationVariable = 0"]  # 5.12 on
+    assert "verification" in _blocks(_urp("5.12.4.1101661"), _installation5())
     assert five["steps"][0].startswith("step_count_")
     older = _blocks(_urp("5.11.9.1010452"), _installation5())
     assert "verification" not in older and "steps" in older

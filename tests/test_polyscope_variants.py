@@ -390,3 +390,14 @@ def test_urscript_saved_as_urp_is_named_as_such():
         parse_urp(b"textmsg(get_actual_joint_positions())\nsleep(0.5)\n", "main_cycle.urp")
     with pytest.raises(UrpError, match="not well-formed XML"):
         parse_urp(b"textmsg(1\n", "broken.urp")
+
+
+def test_polyscope_before_3_15_writes_markers_without_flags():
+    # josepquintana/UR5-Motion-Planning scripts/test (3.8.0): '$ 2 "MoveJ"',
+    # '$ 3 "Waypoint_1"' and no marker for the Robot Program; 3.15 on write both
+    old = [line for line in compiled(WAYPOINT_MOVE, version="3.8.0.61336")
+           if line.startswith("$")]
+    assert old == ['$ 2 "MoveJ"', '$ 3 "Start"']
+    new = [line for line in compiled(WAYPOINT_MOVE, version="3.15.3.106223")
+           if line.startswith("$")]
+    assert new == ['$ 1 "Robot Program"', '$ 2 "MoveJ"', '$ 3 "Start" "breakAfter"']

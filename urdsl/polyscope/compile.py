@@ -79,7 +79,7 @@ from ..script.nodes import (
 )
 from ..script.printer import format as print_tree
 from .installation import Installation
-from .preamble import _call, _num, _stmt, payload_statements, preamble
+from .preamble import _call, _num, _stmt, _version, payload_statements, preamble
 from .urp import Expression, Kinematics, Node, Program
 
 __all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "parse_variables",
@@ -456,6 +456,10 @@ class _Compiler:
         self.pins = dict(getattr(installation, "io_names", ()) or ())
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
+        saved = _version(program.saved_in or program.created_in)
+        # PolyScope before 3.15 (seen: 3.8.0; 3.15.3 on write them) writes its markers
+        # without the breakAfter/noBreak flags and no marker for the Robot Program node
+        self.flags = not (saved[0] == 3 and saved < (3, 15))
 
     # -- numbering
     def _number_tree(self, node: Node) -> None:
@@ -570,7 +574,7 @@ class _Compiler:
     def marker(self, node: Node, label: str, flag: str | None = None) -> Marker:
         label = label.replace('"', "'")
         self.labels[self.number(node)] = label
-        return Marker(self.number(node), label, flag)
+        return Marker(self.number(node), label, flag if self.flags else None)
 
     # -- preamble
     def preamble(self) -> list[Item]:
@@ -668,7 +672,8 @@ class _Compiler:
                 *self.block(node.children)]
 
     def n_MainProgram(self, node: Node) -> list[Item]:
-        return [self.marker(node, "Robot Program"), *self.block(node.children)]
+        marker = [self.marker(node, "Robot Program")] if self.flags else []
+        return [*marker, *self.block(node.children)]
 
     def n_SpecialSequence(self, node: Node) -> list[Item]:
         return [self.marker(node, node.attrs.get("type", "BeforeStart")),
@@ -1336,7 +1341,7 @@ class _Compiler:
         if all(child.kind == "Placeholder" or child.suppressed for child in node.children):
             return []  # PolyScope writes nothing for a Force node with an empty body
         # in force mode the program may not stop at a node: every marker inside is noBreak
-        body = [_no_break(item) for item in self.block(node.children)]
+        body = [_no_break(item) if self.flags else item for item in self.block(node.children)]
         return [self.marker(node, "Force"), _stmt("sleep", _num(0.02)), _stmt("zero_ftsensor"),
                 _stmt("force_mode", frame, List(tuple(Number(int(v)) for v in selection)),
                       List(tuple(_num(v) for v in wrench)), Number(kind),

@@ -152,7 +152,7 @@ them in this order."""
 def preamble_blocks(program: Program, installation: Installation | None,
                     variables: list[tuple[str, str]]) -> list[tuple[str, list[Item]]]:
     """The preamble as (kind, statements) blocks in the order urdsl writes them. Kinds:
-    ``verification`` (PolyScope 5.13 on: a hidden global, always first), the movable
+    ``verification`` (PolyScope 5.12 on: a hidden global, always first), the movable
     blocks of :data:`BLOCKS`, then ``variables`` (the installation variables) and
     ``features`` (feature poses, by name), ``watchdog`` (the EtherNet/IP adapter's watchdog
     when it is enabled), ``urcaps`` (a marked block per URCap
@@ -162,7 +162,7 @@ def preamble_blocks(program: Program, installation: Installation | None,
     blocks: list[tuple[str, list[Item]]] = []
     saved = _version(program.saved_in or program.created_in)
     major = program.major_version or saved[0] or 5
-    if saved >= (5, 13):
+    if saved >= (5, 12):  # seen from 5.12.4 on; 5.11.10 does not write it
         blocks.append(("verification", [Declare("global", "_hidden_verificationVariable",
                                                 Number(0))]))
     movable: dict[str, list[Item]] = {"steps": step_counter(program)}
