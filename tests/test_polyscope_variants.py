@@ -401,3 +401,23 @@ def test_polyscope_before_3_15_writes_markers_without_flags():
     new = [line for line in compiled(WAYPOINT_MOVE, version="3.15.3.106223")
            if line.startswith("$")]
     assert new == ['$ 1 "Robot Program"', '$ 2 "MoveJ"', '$ 3 "Start" "breakAfter"']
+
+
+def test_switch_variables_count_per_function():
+    # CA-Giken MAIN: Switch nodes in two subprograms and the Robot Program are each switch_1
+    switch = """<Switch>
+          <expression><ExpressionToken token="{}"/></expression>
+          <children><Case caseValue="1"><children>
+            <Wait type="Sleep"><waitTime>0.1</waitTime></Wait>
+          </children></Case></children>
+        </Switch>"""
+    body = f"""<CallSubProgram>
+          <subprogram name="Sub" keepHidden="false" keepSynchronizedWithDisk="false">
+            <children>{switch.format("a")}</children>
+          </subprogram>
+        </CallSubProgram>
+        {switch.format("b")}"""
+    lines = compiled(body, others='<SubProgram reference="../MainProgram/children/'
+                                  'CallSubProgram/subprogram"/>')
+    assert "switch_1 = a" in lines and "switch_1 = b" in lines
+    assert not any(line.startswith("switch_2") for line in lines)

@@ -505,6 +505,7 @@ class _Compiler:
             body.extend(self.thread(thread))
         events = [node for node in program.others if node.kind == "Event" and not node.suppressed]
         body.extend(self.event_thread(events))
+        self.switches = 0
         main = self.node(program.main)
         if program.main.attrs.get("runOnlyOnce") == "true":
             body.extend(main)
@@ -687,6 +688,10 @@ class _Compiler:
         return [self.marker(node, text), Comment(f" {text}")]
 
     def n_Switch(self, node: Node) -> list[Item]:
+        """A Switch node: its value in ``switch_N``, then an if/elif chain over the cases.
+        N counts the Switch nodes of one function (a subprogram, a thread, the Robot
+        Program) from 1 (seen: three Switch nodes in three functions of CA-Giken MAIN are
+        all ``switch_1``; two in one function counting on is [U])."""
         self.switches += 1
         variable = f"switch_{self.switches}"
         expression = node.fields["expression"]
@@ -1019,11 +1024,13 @@ class _Compiler:
 
     def subprogram(self, node: Node) -> list[Item]:
         name = node.name or "subprogram"
+        self.switches = 0  # a function's Switch nodes count from 1 (see n_Switch)
         body = [self.marker(node, name, "noBreak"), *self.block(node.children)]
         return [FunctionDef(name, (), tuple(body))]
 
     def thread(self, node: Node) -> list[Item]:
         name = node.name or "Thread"
+        self.switches = 0
         body = self.block(node.children)
         if node.attrs.get("runOnlyOnce") != "true":
             body = [While(Paren(Bool(True)), tuple(body))]
