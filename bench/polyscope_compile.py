@@ -206,7 +206,10 @@ def _clean(module: Module) -> Module:
 
 
 def _number(match: re.Match) -> str:
-    value = float(match.group(0))
+    """A number rounded to 1e-9, after rounding to 1e-12 as PolyScope prints waypoint poses
+    (``1.191543262500``): so that a value and its 12-decimal print do not fall on two sides
+    of a 1e-9 step (mswaidan/finishing-line SandCube5's ``Clear_p``)."""
+    value = round(float(match.group(0)), 12)
     return f"{round(value, 9):.9f}".rstrip("0").rstrip(".") or "0"
 
 
