@@ -302,3 +302,21 @@ def test_ethernet_ip_watchdog_and_general_purpose_register_state():
     # the adapter disabled (creativity-software/ur10-robot-draw-circle): no watchdog
     disabled = installation.replace(b'value="true"', b'value="false"')
     assert "watchdog" not in _blocks(_urp("5.13.0"), disabled)
+
+
+def test_modbus_output_choices_come_after_all_signals():
+    # mswaidan/finishing-line modbustest: every modbus_set_runstate_dependent_choice after
+    # the last signal's modbus_add_signal and update frequency
+    installation = b"""<Installation><IOs><ModbusUnits>
+  <Unit ipAddress="10.0.0.7" sequentialMode="false">
+    <ModbusSignal name="out" type="REGISTER_OUTPUT" slaveAddress="255" updateFrequency="50"
+      signalAddress="101" modificationChoice="0"/>
+    <ModbusSignal name="in" type="DIGITAL_INPUT" slaveAddress="255" updateFrequency="10"
+      signalAddress="3" modificationChoice="0"/>
+  </Unit></ModbusUnits></IOs></Installation>"""
+    assert _blocks(_urp(), installation)["modbus"] == [
+        'modbus_add_signal("10.0.0.7", 255, 101, 3, "out", False)',
+        'modbus_set_signal_update_frequency("out", 50)',
+        'modbus_add_signal("10.0.0.7", 255, 3, 0, "in", False)',
+        'modbus_set_signal_update_frequency("in", 10)',
+        'modbus_set_runstate_dependent_choice("out", 0)']

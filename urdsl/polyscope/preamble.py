@@ -346,6 +346,7 @@ def _modbus(installation: Installation) -> list[Item]:
     """Each Modbus signal: added, its update frequency (Hz) set, and for an output what it
     does when the program stops."""
     items: list[Item] = []
+    choices: list[Item] = []
     for signal in installation.modbus:
         if signal.kind not in _MODBUS_KINDS:
             items.append(Comment(f" urdsl: Modbus signal {signal.name} of type "
@@ -361,9 +362,11 @@ def _modbus(installation: Installation) -> list[Item]:
                                Number(int(frequency)) if frequency == int(frequency)
                                else _num(frequency)))
         if signal.kind.endswith("OUTPUT") and signal.choice is not None:
-            items.append(_stmt("modbus_set_runstate_dependent_choice", name,
-                               Number(signal.choice)))
-    return items
+            choices.append(_stmt("modbus_set_runstate_dependent_choice", name,
+                                 Number(signal.choice)))
+    # the outputs' choices come after all the signals (seen: mswaidan/finishing-line
+    # modbustest, nine output signals among twenty-six)
+    return items + choices
 
 
 def step_counter(program: Program) -> list[Item]:
