@@ -195,6 +195,9 @@ def test_timers_in_polyscopes_order():
     counting = [line for line in lines if line.endswith("_is_counting = False")]
     assert counting == ["global timer_dry_is_counting = False",
                         "global timer_brush_is_counting = False"]
+    # each timer's global, by name, comes before (mswaidan modbustest, CA-Giken MAIN)
+    globals_ = [line for line in lines if line.startswith("global timer_")]
+    assert globals_[:2] == ["global timer_brush = 0", "global timer_dry = 0"]
 
 
 def test_base_feature_in_an_expression_is_its_pose():

@@ -482,7 +482,15 @@ class _Compiler:
             self._number_tree(node)
         body: list[Item] = []
         body.extend(self.preamble())
-        timers: list[str] = []
+        timers = [node.name for node in self._all_nodes(suppressed=True)
+                  if node.kind == "Timer" and node.name and not node.suppressed]
+        # each timer's global, by name, before the waypoint globals (seen: CA-Giken MAIN,
+        # mswaidan modbustest), unless the preamble declares it (a timer in the variables
+        # setup is written once, with that value: GapeCobot/Soudure)
+        declared = {item.name for item in body if isinstance(item, Declare)}
+        body.extend(Declare("global", name, Number(0)) for name in sorted(set(timers))
+                    if name not in declared)
+        timers = []
         direction_helper = False
         for node in self._all_nodes(suppressed=True):
             if node.suppressed:
