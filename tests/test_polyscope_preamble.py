@@ -320,3 +320,17 @@ def test_modbus_output_choices_come_after_all_signals():
         'modbus_add_signal("10.0.0.7", 255, 3, 0, "in", False)',
         'modbus_set_signal_update_frequency("in", 10)',
         'modbus_set_runstate_dependent_choice("out", 0)']
+
+
+def test_polyscope_3_5_tcp_settings_and_tool_voltage():
+    # Sander-ONeil/robotics-project-2023 (3.5): the TCP settings under their class name,
+    # the tool voltage (V) on the root
+    installation = b"""<Installation toolOutputVoltage="0">
+  <com.ur.view.tcp.domain.TCPSettingsImpl activePose="TCP" toolPayload="1.6">
+    <availablePoses><tcp name="TCP" offset="0.0, 0.0, 0.0, 0.0, 2.2217, -2.218"/></availablePoses>
+  </com.ur.view.tcp.domain.TCPSettingsImpl>
+</Installation>"""
+    blocks = _blocks(_urp("3.5.0.10584"), installation)
+    assert blocks["tcp"] == ["set_tcp(p[0.0, 0.0, 0.0, 0.0, 2.2217, -2.218])"]
+    assert blocks["payload"] == ["set_payload(1.6)"]
+    assert blocks["tool"] == ["set_tool_voltage(0)"]

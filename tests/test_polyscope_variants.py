@@ -404,6 +404,32 @@ def test_polyscope_before_3_15_writes_markers_without_flags():
     new = [line for line in compiled(WAYPOINT_MOVE, version="3.15.3.106223")
            if line.startswith("$")]
     assert new == ['$ 1 "Robot Program"', '$ 2 "MoveJ"', '$ 3 "Start" "breakAfter"']
+    # 3.5.0 (Sander-ONeil/robotics-project-2023): the Robot Program marker, no flags
+    oldest = [line for line in compiled(WAYPOINT_MOVE, version="3.5.0.10584")
+              if line.startswith("$")]
+    assert oldest == ['$ 1 "Robot Program"', '$ 2 "MoveJ"', '$ 3 "Start"']
+
+
+def test_polyscope_3_move_without_a_tcp_goes_to_the_joint_angles():
+    # Sander-ONeil/robotics-project-2023 (3.5): useActiveTCP="false", no <tcp>, no
+    # positionType: movej([q]) and movel([q]); a move with the active TCP (3.8) goes to
+    # get_inverse_kin(pose, qnear=q)
+    move = """<Move motionType="{motion}" speed="0.25" acceleration="1.2" useActiveTCP="{active}">
+          <children>
+            <Waypoint type="Fixed" name="W" kinematicsFlags="3">
+              <motionParameters/>
+              <position joints="0.1, -1.5, 1.5, -1.5, -1.5, 0.0"
+                        pose="0.4, -0.1, 0.3, 0.0, 3.1, 0.0"/>
+              <poseInFeatureCoordinates pose="0.4, -0.1, 0.3, 0.0, 3.1, 0.0"/>
+            </Waypoint>
+          </children>
+        </Move>"""
+    for motion, function in (("MoveJ", "movej"), ("MoveL", "movel")):
+        lines = compiled(move.format(motion=motion, active="false"), version="3.5.0.10584")
+        assert f"{function}([0.1, -1.5, 1.5, -1.5, -1.5, 0.0], a=1.2, v=0.25)" in lines
+    lines = compiled(move.format(motion="MoveJ", active="true"), version="3.8.0.61336")
+    assert "movej(get_inverse_kin(p[0.4, -0.1, 0.3, 0.0, 3.1, 0.0], " \
+           "qnear=[0.1, -1.5, 1.5, -1.5, -1.5, 0.0]), a=1.2, v=0.25)" in lines
 
 
 def test_switch_variables_count_per_function():

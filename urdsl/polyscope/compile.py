@@ -457,9 +457,11 @@ class _Compiler:
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
         saved = _version(program.saved_in or program.created_in)
-        # PolyScope before 3.15 (seen: 3.8.0; 3.15.3 on write them) writes its markers
-        # without the breakAfter/noBreak flags and no marker for the Robot Program node
+        # PolyScope before 3.15 (seen: 3.5.0 and 3.8.0; 3.15.3 on write them) writes its
+        # markers without the breakAfter/noBreak flags; 3.8.0 (not 3.5.0, not 3.15) writes
+        # no marker for the Robot Program node [U: between 3.5 and 3.15]
         self.flags = not (saved[0] == 3 and saved < (3, 15))
+        self.main_marker = not ((3, 6) <= saved < (3, 15))
 
     # -- numbering
     def _number_tree(self, node: Node) -> None:
@@ -681,7 +683,7 @@ class _Compiler:
                 *self.block(node.children)]
 
     def n_MainProgram(self, node: Node) -> list[Item]:
-        marker = [self.marker(node, "Robot Program")] if self.flags else []
+        marker = [self.marker(node, "Robot Program")] if self.main_marker else []
         return [*marker, *self.block(node.children)]
 
     def n_SpecialSequence(self, node: Node) -> list[Item]:
@@ -1391,6 +1393,11 @@ class _Compiler:
             pose_expr, q_expr = self.fixed_values(node)
             pose_expr = self.in_variable_feature(node, move, pose_expr)
             if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
+                target = q_expr
+            elif "positionType" not in move.attrs and motion in ("MoveJ", "MoveL") and \
+                    move.attrs.get("useActiveTCP") == "false" and not move.fields.get("tcp"):
+                # PolyScope 3 (no positionType): a move that uses no TCP goes to the
+                # waypoint's joint angles, a MoveL too (seen: 3.5 ``movel([q], ...)``)
                 target = q_expr
             elif motion == "MoveJ":
                 target = _call("get_inverse_kin", pose_expr, qnear=q_expr)

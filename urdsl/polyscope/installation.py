@@ -312,6 +312,8 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
     payloads: list[Payload] = []
     active_payload = None
     settings = root.find("TCPSettings")
+    if settings is None:  # PolyScope 3.4-3.5: the class name as the tag
+        settings = root.find("com.ur.view.tcp.domain.TCPSettingsImpl")
     if settings is not None:
         active_tcp = settings.get("activePose")
         for element in settings.iter("tcp"):
@@ -509,6 +511,9 @@ def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
         element = root.find(tag)
         if element is not None:
             settings[tag] = dict(element.attrib)
+    if "ToolCommSettings" not in settings and root.get("toolOutputVoltage") is not None:
+        # PolyScope 3.4-3.5: the tool voltage (V) as an attribute of the root
+        settings["ToolCommSettings"] = {"toolOutputVoltage": root.get("toolOutputVoltage", "")}
     ios = root.find("IOs")
     if ios is not None:
         for element in ios:

@@ -82,7 +82,8 @@ _BAUD = {"BAUD_9600": 9600, "BAUD_19200": 19200, "BAUD_38400": 38400, "BAUD_5760
 _PARITY = {"NONE": 0, "ODD": 1, "EVEN": 2}
 _STOP_BITS = {"ONE": 1, "TWO": 2}
 _OUTPUT_MODE = {"SINKING": 1, "SOURCING": 2, "PUSH_PULL": 3}
-_VOLTAGE = {"ZERO": 0, "TWELVE": 12, "TWENTY_FOUR": 24}
+_VOLTAGE = {"ZERO": 0, "TWELVE": 12, "TWENTY_FOUR": 24, "0": 0, "12": 12, "24": 24}
+"""The tool output voltage as installations write it (PolyScope 3.4-3.5: the volts)."""
 
 
 def _baud(text: str) -> int:
