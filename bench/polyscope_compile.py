@@ -428,6 +428,10 @@ def main(argv: list[str] | None = None) -> int:
         except CompileError as error:
             st["errors"][str(error).split("error: ", 1)[-1][:150]] += 1
             continue
+        except ScriptError as error:  # a compiler bug: what it wrote is not URScript
+            st["errors"]["compiled script does not parse: "
+                         + str(error).split("error: ", 1)[-1][:100]] += 1
+            continue
         theirs = canonical_lines(theirs_tree)
         ours = canonical_lines(ours_tree)
         names = frozenset(node.name for root in program.top for node in root.walk()
