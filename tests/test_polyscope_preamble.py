@@ -160,7 +160,8 @@ def test_modbus_signals(five):
 
 
 def test_the_step_counter_and_the_verification_global_of_recent_versions(five):
-    assert five["verification"] == ["global _hidden_verificationVariable = 0"]  # 5.13 on
+    assert five["verification"] == ["global _hidden_verificationVariable = 0"]  # 5.12 on
+    assert "verification" in _blocks(_urp("5.12.4.1101661"), _installation5())
     assert five["steps"][0].startswith("step_count_")
     older = _blocks(_urp("5.11.9.1010452"), _installation5())
     assert "verification" not in older and "steps" in older
@@ -282,3 +283,54 @@ def test_initial_values_of_the_variables_setup_and_of_urcap_variables():
                                  "# urdsl: the initial value of bad is not compiled",
                                  "global part = True"]  # each name once
     assert list(blocks)[-1] == "initial"  # after the installation's blocks
+
+
+def test_ethernet_ip_watchdog_and_general_purpose_register_state():
+    # CA-Giken/docker-noetic-capc (5.13): EtherNet/IP enabled with the watchdog action
+    # IGNORE, and register 0's action PROGRAM_RUNNING
+    installation = b"""<Installation>
+  <IOs><GeneralPurposeBooleanRegisterOutputActions value="PROGRAM_RUNNING, NONE, NONE"/></IOs>
+  <Contributions><URCaps>
+    <Contributed ownerId="com.ur.urcap.ethernetip" id="EthernetIP" name="Ethernet/IP">
+      <data key="watchdogAction" value="IGNORE"/><data key="enabled" value="true"/>
+    </Contributed>
+  </URCaps></Contributions>
+</Installation>"""
+    blocks = _blocks(_urp("5.13.0"), installation)
+    assert blocks["io"] == ["set_runstate_gp_boolean_output_to_value(0, 3)"]
+    assert blocks["watchdog"] == ['rtde_set_watchdog("speed_slider_mask", 10.0, "ignore")']
+    # the adapter disabled (creativity-software/ur10-robot-draw-circle): no watchdog
+    disabled = installation.replace(b'value="true"', b'value="false"')
+    assert "watchdog" not in _blocks(_urp("5.13.0"), disabled)
+
+
+def test_modbus_output_choices_come_after_all_signals():
+    # mswaidan/finishing-line modbustest: every modbus_set_runstate_dependent_choice after
+    # the last signal's modbus_add_signal and update frequency
+    installation = b"""<Installation><IOs><ModbusUnits>
+  <Unit ipAddress="10.0.0.7" sequentialMode="false">
+    <ModbusSignal name="out" type="REGISTER_OUTPUT" slaveAddress="255" updateFrequency="50"
+      signalAddress="101" modificationChoice="0"/>
+    <ModbusSignal name="in" type="DIGITAL_INPUT" slaveAddress="255" updateFrequency="10"
+      signalAddress="3" modificationChoice="0"/>
+  </Unit></ModbusUnits></IOs></Installation>"""
+    assert _blocks(_urp(), installation)["modbus"] == [
+        'modbus_add_signal("10.0.0.7", 255, 101, 3, "out", False)',
+        'modbus_set_signal_update_frequency("out", 50)',
+        'modbus_add_signal("10.0.0.7", 255, 3, 0, "in", False)',
+        'modbus_set_signal_update_frequency("in", 10)',
+        'modbus_set_runstate_dependent_choice("out", 0)']
+
+
+def test_polyscope_3_5_tcp_settings_and_tool_voltage():
+    # Sander-ONeil/robotics-project-2023 (3.5): the TCP settings under their class name,
+    # the tool voltage (V) on the root
+    installation = b"""<Installation toolOutputVoltage="0">
+  <com.ur.view.tcp.domain.TCPSettingsImpl activePose="TCP" toolPayload="1.6">
+    <availablePoses><tcp name="TCP" offset="0.0, 0.0, 0.0, 0.0, 2.2217, -2.218"/></availablePoses>
+  </com.ur.view.tcp.domain.TCPSettingsImpl>
+</Installation>"""
+    blocks = _blocks(_urp("3.5.0.10584"), installation)
+    assert blocks["tcp"] == ["set_tcp(p[0.0, 0.0, 0.0, 0.0, 2.2217, -2.218])"]
+    assert blocks["payload"] == ["set_payload(1.6)"]
+    assert blocks["tool"] == ["set_tool_voltage(0)"]

@@ -18,6 +18,8 @@ from urdsl.script.printer import format as print_tree
 INSTALLATION = """<Installation name="cell">
   <IOs>
     <analogOutputDomain value="1, 0"/>
+    <GeneralPurposeBooleanRegisterOutputNames value="DONE, , "/>
+    <GeneralPurposeIntRegisterInputNames value=", PRG_NO"/>
     <ModbusUnits>
       <Unit ipAddress="192.168.1.18" sequentialMode="false">
         <ModbusSignal name="RUN" type="DIGITAL_INPUT" signalAddress="3" slaveAddress="255"/>
@@ -29,6 +31,12 @@ INSTALLATION = """<Installation name="cell">
     <tcp name="Flange" offset="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>
     <tcp name="Sander" offset="0.003, 0.11, 0.098, -0.785, 0.0, 0.0"/>
   </TCPSettings>
+  <PayloadSettings>
+    <Payload name="Gripper" mass="1.0" defaultPayload="true" centerOfGravity="0.0, 0.0, 0.05"
+             inertiaParameters="0.001, 0.001, 0.001, 0.0, 0.0, 0.0"/>
+    <Payload name="Part" mass="3.02" defaultPayload="false" centerOfGravity="0.012, 0.022, 0.058"
+             inertiaParameters="0.009713, 0.009713, 0.009713, 0.0, 0.0, 0.0"/>
+  </PayloadSettings>
   <Features>
     <wrapper>
       <GeomPoseNode name="Cube" isVariable="true">
@@ -153,6 +161,67 @@ def test_modbus_signals_as_io():
         'while (modbus_get_signal_status("RUN") == False):']
 
 
+def test_general_purpose_registers_as_io():
+    # CA-Giken/docker-noetic-capc: named RTDE registers (GPBO_..., GPII_...) and unnamed
+    # ones (GP_int_in[23]) in Set, Wait and expressions
+    lines = compiled("""
+        <Set type="DigitalOutput">
+          <pin referencedName="DONE"/>
+          <digitalValue>1</digitalValue>
+        </Set>
+        <Set type="ExpressionOutput">
+          <pin referencedName="GP_int_out[3]"/>
+          <expression><ExpressionToken token="7"/></expression>
+        </Set>
+        <Wait type="Condition">
+          <expression>
+            <ExpressionIO><pin referencedName="PRG_NO"/></ExpressionIO>
+            <ExpressionChar character="="/><ExpressionChar character="="/>
+            <ExpressionIO><pin referencedName="GP_int_in[23]"/></ExpressionIO>
+          </expression>
+        </Wait>""")
+    assert after(lines, '$ 2 "Set DONE=On"', 1) == ["write_output_boolean_register(0, True)"]
+    assert after(lines, '$ 3 "Set GP_int_out[3]=7"', 1) == [
+        "write_output_integer_register(3, 7)"]
+    assert "while (not (read_input_integer_register(1) == read_input_integer_register(23))):" \
+        in lines
+
+
+def test_timers_in_polyscopes_order():
+    # the order of a Java HashSet of their names (eight timers of CA-Giken MAIN and two of
+    # mswaidan modbustest are written so), not the order of the nodes
+    timer = """<Timer action="Start"><variable name="{}"/></Timer>"""
+    lines = compiled(timer.format("timer_brush") + timer.format("timer_dry"))
+    counting = [line for line in lines if line.endswith("_is_counting = False")]
+    assert counting == ["global timer_dry_is_counting = False",
+                        "global timer_brush_is_counting = False"]
+    # each timer's global, by name, comes before (mswaidan modbustest, CA-Giken MAIN)
+    globals_ = [line for line in lines if line.startswith("global timer_")]
+    assert globals_[:2] == ["global timer_brush = 0", "global timer_dry = 0"]
+
+
+def test_base_feature_in_an_expression_is_its_pose():
+    lines = compiled("""
+        <Assignment valueSource="Expression">
+          <variable featureName="UF"/>
+          <expression>
+            <ExpressionGeomFeature><feature referencedName="Joint_0_name"/></ExpressionGeomFeature>
+          </expression>
+        </Assignment>""")
+    assert "global UF = p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]" in lines
+
+
+def test_names_beyond_ascii_in_an_expression():
+    # CA-Giken TEST_SPEED: "pose_sub(CurrPos_p, ウェイポイント_1_p)" in an assignment
+    lines = compiled("""
+        <Assignment valueSource="Expression">
+          <variable name="PoseSub"/>
+          <expression><ExpressionToken token="pose_sub(p0, 点_1_p)"/>
+          <ExpressionToken token=" # 点"/></expression>
+        </Assignment>""")
+    assert "global PoseSub = pose_sub(p0, u28857_1_p)" in lines
+
+
 def test_an_unknown_io_is_still_one_message():
     with pytest.raises(CompileError, match="NOPE"):
         compiled("""<Set type="ExpressionOutput"><pin referencedName="NOPE"/>
@@ -180,6 +249,15 @@ def test_events_share_one_thread_started_before_the_robot_program():
         "elif (get_standard_digital_in(2) == True):", '$ 6 "Set digital_out[0]=Off"',
         "set_standard_digital_out(0, False)", "end"]
     assert lines.index("eventThread = run EventThread()") < lines.index('$ 1 "Robot Program"')
+
+
+WAYPOINT_MOVE = f"""
+        <Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            {WAYPOINT.format(name="Start")}
+          </children>
+        </Move>"""
 
 
 DIRECTION = """
@@ -216,6 +294,75 @@ def test_direction_in_a_variable_feature_and_until_blend():
     assert "movel(towardsPos, a=1.2, v=0.25)" in compiled(DIRECTION.format(kind="STOP"))
 
 
+def test_direction_without_a_feature_moves_in_its_moves_feature():
+    # CubeFinishApril2022 (mswaidan/finishing-line): a Direction with no <feature> under a
+    # MoveL in the plane feature CubeFront; PolyScope labels it "Direction: CubeFront Z+"
+    # and writes CubeFront's pose, not the base's p[0, ...]
+    lines = compiled("""
+        <Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Cube"/>
+          <children>
+            <gui.program.direction.MoveDirectionNode selectedDirection="ZPlus"
+                toolParams="0.2, 1.2">
+              <children>
+                <Until type="DISTANCE" allowActions="false" deceleration="3.0"
+                       distanceNodeType="STOP">
+                  <Distance>0.1</Distance>
+                  <motionParameters blendRadius="0.0"/>
+                </Until>
+              </children>
+            </gui.program.direction.MoveDirectionNode>
+          </children>
+        </Move>""")
+    assert '$ 3 "Direction: Cube Z+"' in lines
+    assert "local towardsPos = calculate_point_to_move_towards(" \
+           "p[-0.65, -0.29, 0.15, 1.19, 1.2, 1.23], [0.0, 0.0, 1.0], 0.1)" in lines
+    assert "movel(towardsPos, a=1.2, v=0.2)" in lines
+
+
+def test_set_payload_selects_a_payload_of_the_installation():
+    # CubeFinishApril2022 (mswaidan/finishing-line): <SetPayload workpieceName="SandSpray"/>
+    # is written '$ 6 "Set Payload: SandSpray"' and the payload's set_target_payload
+    body = """<SetPayload workpieceName="Part"/>"""
+    lines = compiled(body)
+    assert after(lines, '$ 2 "Set Payload: Part"', 1) == [
+        "set_target_payload(3.02, [0.012, 0.022, 0.058], "
+        "[0.009713, 0.009713, 0.009713, 0.0, 0.0, 0.0])"]
+    # the installation's default payload is the preamble's, not the one the node selects
+    assert lines.count("set_target_payload(1.0, [0.0, 0.0, 0.05], "
+                       "[0.001, 0.001, 0.001, 0.0, 0.0, 0.0])") == 1
+    # without the installation the payload is unknown: the node is kept and named
+    unknown = compiled(body, installation=False)
+    assert "# urdsl: PolyScope node <SetPayload> is not compiled" in unknown
+    assert not any(line.startswith("set_target_payload") for line in unknown)
+
+
+def test_single_digital_pulse_is_a_thread_started_in_place():
+    # CA-Giken/docker-noetic-capc MAIN: '$ 586 "... =HI:Pulse 1.0"', thread SinglePulse660
+    # (PolyScope's number is a counter across programs; urdsl counts from 1 in the program)
+    pulse = """<Set type="SingleDigitalPulseActionState">
+          <SingleDigitalPulseActionState hiPulseInSeconds="{t}">
+            <pin referencedName="digital_out[{n}]"/>
+          </SingleDigitalPulseActionState>
+        </Set>"""
+    lines = compiled(pulse.format(t="0.1", n=0) + pulse.format(t="1.5", n=2))
+    assert after(lines, '$ 2 "Set digital_out[0]=HI:Pulse 0.1"', 6) == [
+        "thread SinglePulse1():", "set_standard_digital_out(0, True)", "sleep(0.1)",
+        "set_standard_digital_out(0, False)", "end", "singlePulse1 = run SinglePulse1()"]
+    assert after(lines, '$ 3 "Set digital_out[2]=HI:Pulse 1.5"', 6)[2] == "sleep(1.5)"
+    assert "singlePulse2 = run SinglePulse2()" in lines
+
+
+def test_names_beyond_ascii_are_written_as_polyscope_does():
+    # CA-Giken/docker-noetic-capc: a thread "スレッド_2" is u12473u12524u12483u12489_2
+    lines = compiled(WAYPOINT_MOVE.replace('name="Start"', 'name="点_1"'),
+                     others="""<Thread><children>
+          <Wait type="Sleep"><waitTime>0.5</waitTime></Wait></children></Thread>""")
+    assert "global u28857_1_p = p[" in " ".join(lines)
+    assert any(line.startswith("movej(get_inverse_kin(u28857_1_p") or
+               line.startswith("movej(u28857_1_q") for line in lines), lines
+
+
 def test_tool_contact_without_retraction_stops_where_it_touched():
     lines = compiled(DIRECTION.format(kind="STOP"))
     found = lines.index("if (stepsToRetract > 0):")
@@ -246,3 +393,60 @@ def test_urscript_saved_as_urp_is_named_as_such():
         parse_urp(b"textmsg(get_actual_joint_positions())\nsleep(0.5)\n", "main_cycle.urp")
     with pytest.raises(UrpError, match="not well-formed XML"):
         parse_urp(b"textmsg(1\n", "broken.urp")
+
+
+def test_polyscope_before_3_15_writes_markers_without_flags():
+    # josepquintana/UR5-Motion-Planning scripts/test (3.8.0): '$ 2 "MoveJ"',
+    # '$ 3 "Waypoint_1"' and no marker for the Robot Program; 3.15 on write both
+    old = [line for line in compiled(WAYPOINT_MOVE, version="3.8.0.61336")
+           if line.startswith("$")]
+    assert old == ['$ 2 "MoveJ"', '$ 3 "Start"']
+    new = [line for line in compiled(WAYPOINT_MOVE, version="3.15.3.106223")
+           if line.startswith("$")]
+    assert new == ['$ 1 "Robot Program"', '$ 2 "MoveJ"', '$ 3 "Start" "breakAfter"']
+    # 3.5.0 (Sander-ONeil/robotics-project-2023): the Robot Program marker, no flags
+    oldest = [line for line in compiled(WAYPOINT_MOVE, version="3.5.0.10584")
+              if line.startswith("$")]
+    assert oldest == ['$ 1 "Robot Program"', '$ 2 "MoveJ"', '$ 3 "Start"']
+
+
+def test_polyscope_3_move_without_a_tcp_goes_to_the_joint_angles():
+    # Sander-ONeil/robotics-project-2023 (3.5): useActiveTCP="false", no <tcp>, no
+    # positionType: movej([q]) and movel([q]); a move with the active TCP (3.8) goes to
+    # get_inverse_kin(pose, qnear=q)
+    move = """<Move motionType="{motion}" speed="0.25" acceleration="1.2" useActiveTCP="{active}">
+          <children>
+            <Waypoint type="Fixed" name="W" kinematicsFlags="3">
+              <motionParameters/>
+              <position joints="0.1, -1.5, 1.5, -1.5, -1.5, 0.0"
+                        pose="0.4, -0.1, 0.3, 0.0, 3.1, 0.0"/>
+              <poseInFeatureCoordinates pose="0.4, -0.1, 0.3, 0.0, 3.1, 0.0"/>
+            </Waypoint>
+          </children>
+        </Move>"""
+    for motion, function in (("MoveJ", "movej"), ("MoveL", "movel")):
+        lines = compiled(move.format(motion=motion, active="false"), version="3.5.0.10584")
+        assert f"{function}([0.1, -1.5, 1.5, -1.5, -1.5, 0.0], a=1.2, v=0.25)" in lines
+    lines = compiled(move.format(motion="MoveJ", active="true"), version="3.8.0.61336")
+    assert "movej(get_inverse_kin(p[0.4, -0.1, 0.3, 0.0, 3.1, 0.0], " \
+           "qnear=[0.1, -1.5, 1.5, -1.5, -1.5, 0.0]), a=1.2, v=0.25)" in lines
+
+
+def test_switch_variables_count_per_function():
+    # CA-Giken MAIN: Switch nodes in two subprograms and the Robot Program are each switch_1
+    switch = """<Switch>
+          <expression><ExpressionToken token="{}"/></expression>
+          <children><Case caseValue="1"><children>
+            <Wait type="Sleep"><waitTime>0.1</waitTime></Wait>
+          </children></Case></children>
+        </Switch>"""
+    body = f"""<CallSubProgram>
+          <subprogram name="Sub" keepHidden="false" keepSynchronizedWithDisk="false">
+            <children>{switch.format("a")}</children>
+          </subprogram>
+        </CallSubProgram>
+        {switch.format("b")}"""
+    lines = compiled(body, others='<SubProgram reference="../MainProgram/children/'
+                                  'CallSubProgram/subprogram"/>')
+    assert "switch_1 = a" in lines and "switch_1 = b" in lines
+    assert not any(line.startswith("switch_2") for line in lines)

@@ -27,6 +27,7 @@ Marker labels are the English ones; PolyScope writes them in the language it run
 
 from __future__ import annotations
 
+import dataclasses
 import gzip
 import math
 import posixpath
@@ -78,7 +79,7 @@ from ..script.nodes import (
 )
 from ..script.printer import format as print_tree
 from .installation import Installation
-from .preamble import _call, _num, _stmt, preamble
+from .preamble import _call, _num, _stmt, _version, payload_statements, preamble
 from .urp import Expression, Kinematics, Node, Program
 
 __all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "parse_variables",
@@ -173,6 +174,90 @@ def _matrix_to_rotvec(m: np.ndarray) -> np.ndarray:
     return axis / sin2 * angle
 
 
+def _java_hash(text: str) -> int:
+    """Java's ``String.hashCode`` (UTF-16 code units), as an unsigned 32-bit number."""
+    value = 0
+    for unit in text.encode("utf-16-be").hex(" ", 2).split():
+        value = (31 * value + int(unit, 16)) & 0xFFFFFFFF
+    return value
+
+
+def java_hash_order(names: list[str]) -> list[str]:
+    """``names`` (given in the order they were added) in the order a Java ``HashSet`` of
+    them iterates: by bucket (the hash with its high half folded in, modulo a table of 16
+    slots doubled while more than 3/4 full), then in the order added. PolyScope writes a
+    program's timers in this order (seen: eight timers of CA-Giken/docker-noetic-capc
+    MAIN and two of mswaidan/finishing-line modbustest, both as this gives)."""
+    size = 16
+    while len(names) > size * 3 // 4:
+        size *= 2
+
+    def bucket(name: str) -> int:
+        value = _java_hash(name)
+        return (value ^ (value >> 16)) & (size - 1)
+
+    return sorted(names, key=bucket)  # a stable sort keeps the order added in a bucket
+
+
+_NAME_FIELDS = {Name: "id", Run: "thread", Declare: "name", Param: "name",
+                FunctionDef: "name", ThreadDef: "name"}
+"""The node fields that hold a name the program defines or uses."""
+
+
+def ascii_name(name: str) -> str:
+    """A name as PolyScope writes it in a script: each character beyond ASCII becomes
+    ``u`` and its code point in decimal (seen: a thread "スレッド_2" is
+    ``u12473u12524u12483u12489_2``, a waypoint "ウェイポイント_1" ``u12454…u12488_1_p``)."""
+    return "".join(c if ord(c) < 128 else f"u{ord(c)}" for c in name)
+
+
+def _ascii_code(text: str) -> str:
+    """URScript text with the characters beyond ASCII outside strings and comments written
+    as :func:`ascii_name` writes them (a name typed in PolyScope's own language, e.g. the
+    waypoint "ウェイポイント_1_p" in an expression)."""
+    if text.isascii():
+        return text
+    out: list[str] = []
+    quote: str | None = None
+    comment = False
+    for c in text:
+        if comment:
+            comment = c != "\n"
+        elif quote:
+            quote = None if c == quote else quote
+        elif c in "\"'":
+            quote = c
+        elif c == "#":
+            comment = True
+        elif ord(c) >= 128:
+            out.append(f"u{ord(c)}")
+            continue
+        out.append(c)
+    return "".join(out)
+
+
+def _ascii_names(item):
+    """``item`` (a URScript tree) with every name made ASCII by :func:`ascii_name`; strings,
+    comments and marker labels are kept as written."""
+    if isinstance(item, tuple):
+        return tuple(_ascii_names(part) for part in item)
+    if not dataclasses.is_dataclass(item) or isinstance(item, type):
+        return item
+    changes = {}
+    for spec in dataclasses.fields(item):
+        value = getattr(item, spec.name)
+        if spec.name == "span":
+            continue
+        if isinstance(value, str):
+            if _NAME_FIELDS.get(type(item)) == spec.name and not value.isascii():
+                changes[spec.name] = ascii_name(value)
+        elif isinstance(value, tuple) or dataclasses.is_dataclass(value):
+            new = _ascii_names(value)
+            if new is not value:
+                changes[spec.name] = new
+    return dataclasses.replace(item, **changes) if changes else item
+
+
 def waypoint_pose(q, tcp, kinematics: Kinematics) -> tuple[float, ...]:
     """The TCP pose (x, y, z in m, rotation vector in rad, in the base frame) of joint angles
     ``q`` (rad) with TCP offset ``tcp`` on the arm described by ``kinematics`` (standard DH;
@@ -191,11 +276,14 @@ def waypoint_pose(q, tcp, kinematics: Kinematics) -> tuple[float, ...]:
 
 # ---- the compiler --------------------------------------------------------------------------
 
-_PIN = re.compile(r"^([a-z_]+)\[(\d+)\]$")
+_PIN = re.compile(r"^([A-Za-z_]+)\[(\d+)\]$")
 _SET_FUNCTIONS = {
     "digital_out": "set_standard_digital_out", "configurable_out": "set_configurable_digital_out",
     "tool_out": "set_tool_digital_out", "analog_out": "set_standard_analog_out",
     "config_out": "set_configurable_digital_out",
+    # the general purpose registers (RTDE), as PolyScope writes them (seen: bool and int)
+    "GP_bool_out": "write_output_boolean_register", "GP_int_out": "write_output_integer_register",
+    "GP_float_out": "write_output_float_register",
 }
 _GET_FUNCTIONS = {
     "digital_in": "get_standard_digital_in", "digital_out": "get_standard_digital_out",
@@ -205,6 +293,9 @@ _GET_FUNCTIONS = {
     "tool_in": "get_tool_digital_in", "tool_out": "get_tool_digital_out",
     "analog_in": "get_standard_analog_in", "tool_analog_in": "get_tool_analog_in",
     "analog_out": "get_standard_analog_out",
+    "GP_bool_in": "read_input_boolean_register", "GP_bool_out": "read_output_boolean_register",
+    "GP_int_in": "read_input_integer_register", "GP_int_out": "read_output_integer_register",
+    "GP_float_in": "read_input_float_register", "GP_float_out": "read_output_float_register",
 }
 _BASE_FEATURES = frozenset(("Joint_0_name", "Base", "base"))
 """Names PolyScope gives the base frame in a move's feature reference."""
@@ -364,6 +455,13 @@ class _Compiler:
         self.labels: dict[int, str] = {}
         self.pins = dict(getattr(installation, "io_names", ()) or ())
         self.version = program.major_version or 5
+        self.pulses = 0  # single pulse threads written so far
+        saved = _version(program.saved_in or program.created_in)
+        # PolyScope before 3.15 (seen: 3.5.0 and 3.8.0; 3.15.3 on write them) writes its
+        # markers without the breakAfter/noBreak flags; 3.8.0 (not 3.5.0, not 3.15) writes
+        # no marker for the Robot Program node [U: between 3.5 and 3.15]
+        self.flags = not (saved[0] == 3 and saved < (3, 15))
+        self.main_marker = not ((3, 6) <= saved < (3, 15))
 
     # -- numbering
     def _number_tree(self, node: Node) -> None:
@@ -386,7 +484,15 @@ class _Compiler:
             self._number_tree(node)
         body: list[Item] = []
         body.extend(self.preamble())
-        timers: list[str] = []
+        timers = [node.name for node in self._all_nodes(suppressed=True)
+                  if node.kind == "Timer" and node.name and not node.suppressed]
+        # each timer's global, by name, before the waypoint globals (seen: CA-Giken MAIN,
+        # mswaidan modbustest), unless the preamble declares it (a timer in the variables
+        # setup is written once, with that value: GapeCobot/Soudure)
+        declared = {item.name for item in body if isinstance(item, Declare)}
+        body.extend(Declare("global", name, Number(0)) for name in sorted(set(timers))
+                    if name not in declared)
+        timers = []
         direction_helper = False
         for node in self._all_nodes(suppressed=True):
             if node.suppressed:
@@ -409,6 +515,7 @@ class _Compiler:
             body.extend(self.thread(thread))
         events = [node for node in program.others if node.kind == "Event" and not node.suppressed]
         body.extend(self.event_thread(events))
+        self.switches = 0
         main = self.node(program.main)
         if program.main.attrs.get("runOnlyOnce") == "true":
             body.extend(main)
@@ -417,7 +524,8 @@ class _Compiler:
         name = re.sub(r"[^A-Za-z0-9_]", "", program.name) or "program"
         if name[0].isdigit():
             name = "_" + name
-        return Compiled(Module((FunctionDef(name, (), tuple(body)),)), self.numbers, self.labels)
+        module = _ascii_names(Module((FunctionDef(name, (), tuple(body)),)))
+        return Compiled(module, self.numbers, self.labels)
 
     def _all_nodes(self, suppressed: bool = False):
         """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
@@ -446,7 +554,7 @@ class _Compiler:
             raise self.error(node, "the node has no expression (PolyScope shows it as not "
                                    "defined and will not run the program)")
         try:
-            module = parse(text, self.program.path)
+            module = parse(_ascii_code(text), self.program.path)
         except ScriptError as error:
             raise self.error(node, f"the expression {text.strip()!r} is not URScript "
                                    f"({str(error).splitlines()[0]})") from None
@@ -477,7 +585,7 @@ class _Compiler:
     def marker(self, node: Node, label: str, flag: str | None = None) -> Marker:
         label = label.replace('"', "'")
         self.labels[self.number(node)] = label
-        return Marker(self.number(node), label, flag)
+        return Marker(self.number(node), label, flag if self.flags else None)
 
     # -- preamble
     def preamble(self) -> list[Item]:
@@ -501,9 +609,11 @@ class _Compiler:
                 Declare("global", f"{name}_q", List(tuple(_num(v) for v in q)))]
 
     def timer_thread(self, timers: list[str]) -> list[Item]:
-        """The globals and the thread that count PolyScope's timers."""
+        """The globals and the thread that count PolyScope's timers, in the order PolyScope
+        keeps them (:func:`java_hash_order`)."""
         if not timers:
             return []
+        timers = java_hash_order(timers)
         items: list[Item] = [Declare("global", f"{name}_is_counting", Bool(False))
                              for name in timers]
         body: list[Item] = [
@@ -573,7 +683,8 @@ class _Compiler:
                 *self.block(node.children)]
 
     def n_MainProgram(self, node: Node) -> list[Item]:
-        return [self.marker(node, "Robot Program"), *self.block(node.children)]
+        marker = [self.marker(node, "Robot Program")] if self.main_marker else []
+        return [*marker, *self.block(node.children)]
 
     def n_SpecialSequence(self, node: Node) -> list[Item]:
         return [self.marker(node, node.attrs.get("type", "BeforeStart")),
@@ -587,6 +698,10 @@ class _Compiler:
         return [self.marker(node, text), Comment(f" {text}")]
 
     def n_Switch(self, node: Node) -> list[Item]:
+        """A Switch node: its value in ``switch_N``, then an if/elif chain over the cases.
+        N counts the Switch nodes of one function (a subprogram, a thread, the Robot
+        Program) from 1 (seen: three Switch nodes in three functions of CA-Giken MAIN are
+        all ``switch_1``; two in one function counting on is [U])."""
         self.switches += 1
         variable = f"switch_{self.switches}"
         expression = node.fields["expression"]
@@ -775,9 +890,50 @@ class _Compiler:
                           _num(value / self.analog_full_scale(index)))]
         if kind == "ExpressionOutput":
             return self.set_expression(node)
+        if kind == "SingleDigitalPulseActionState":
+            return self.set_pulse(node)
         if kind == "NoAction":
             return [self.marker(node, "Set")]
         return self.n_unknown(node)
+
+    def n_SetPayload(self, node: Node) -> list[Item]:
+        """A Set Payload node that selects one of the installation's payloads by name
+        (``workpieceName``): marker "Set Payload: NAME", then the statement the preamble
+        writes for a payload (seen: ``set_target_payload(mass, cog, inertia)``). Another
+        variant, or a payload the installation does not have, stays an unknown node."""
+        name = node.attrs.get("workpieceName")
+        payloads = getattr(self.installation, "payloads", ()) or ()
+        payload = next((p for p in payloads if p.name == name), None)
+        if not name or payload is None or self.installation is None:
+            return self.n_unknown(node)
+        return [self.marker(node, f"Set Payload: {name}"),
+                *payload_statements(self.installation, payload, self.version)]
+
+    def set_pulse(self, node: Node) -> list[Item]:
+        """A Set node's single digital pulse: a thread sets the output high, sleeps the
+        pulse's length (s) and sets it low; the program starts it and goes on, as PolyScope
+        writes it (seen: ``hiPulseInSeconds``, standard outputs and boolean output
+        registers). PolyScope numbers these threads ``SinglePulseN`` from a counter it
+        keeps across the programs it compiles (one project shows 2, 3 in one program and
+        397-402 in another), which no file records: urdsl counts them in the program from
+        1. A low pulse is not seen and stays an unknown node."""
+        pulse = node.fields.get("pulse") or {}
+        length = _floats_or_none(pulse.get("hiPulseInSeconds"))
+        if not length:
+            return self.n_unknown(node)
+        pin = str(node.fields.get("pin"))
+        bank, index = self.resolve_pin(pin, node)
+        function = _SET_FUNCTIONS.get(bank)
+        if function is None:
+            raise self.error(node, f"cannot set the I/O {pin!r}")
+        self.pulses += 1
+        name = f"SinglePulse{self.pulses}"
+        body = (_stmt(function, Number(index), Bool(True)),
+                _stmt("sleep", _num(length[0])),
+                _stmt(function, Number(index), Bool(False)))
+        return [self.marker(node, f"Set {self.pin_label(pin)}=HI:Pulse {length[0]}"),
+                ThreadDef(name, body),
+                Assign(Name(f"singlePulse{self.pulses}"), Run(name))]
 
     def analog_full_scale(self, index: int) -> float:
         """What an analog output's value (as the Set node stores it: V, or mA) is at the
@@ -878,11 +1034,13 @@ class _Compiler:
 
     def subprogram(self, node: Node) -> list[Item]:
         name = node.name or "subprogram"
+        self.switches = 0  # a function's Switch nodes count from 1 (see n_Switch)
         body = [self.marker(node, name, "noBreak"), *self.block(node.children)]
         return [FunctionDef(name, (), tuple(body))]
 
     def thread(self, node: Node) -> list[Item]:
         name = node.name or "Thread"
+        self.switches = 0
         body = self.block(node.children)
         if node.attrs.get("runOnlyOnce") != "true":
             body = [While(Paren(Bool(True)), tuple(body))]
@@ -993,6 +1151,15 @@ class _Compiler:
         selected = node.attrs.get("selectedDirection")
         expression = node.fields.get("expression")
         feature = node.fields.get("feature")
+        variable_feature = node.fields.get("feature_name")
+        if "feature" not in node.fields and move is not None:
+            # a Direction without its own <feature> moves in its Move's feature (seen: under
+            # a MoveL in a plane feature PolyScope labels it and writes that feature's pose)
+            feature = move.fields.get("feature")
+        if feature and feature not in _BASE_FEATURES and feature not in _TOOL_FEATURES:
+            # a named feature: its pose written in place, as for a variable one (PolyScope
+            # never writes a feature's name here in the real scripts)
+            variable_feature, feature = feature, None
         frame = "Tool" if feature in _TOOL_FEATURES else (
             "Base" if feature in (None, *_BASE_FEATURES) else str(feature))
         if selected:
@@ -1005,7 +1172,6 @@ class _Compiler:
             label = f"Direction: {frame}"
         else:
             return self.n_unknown(node)
-        variable_feature = node.fields.get("feature_name")
         if variable_feature:
             # a variable feature: its pose in the installation, written in place (seen); its
             # name when the installation does not have it [U]
@@ -1192,7 +1358,7 @@ class _Compiler:
         if all(child.kind == "Placeholder" or child.suppressed for child in node.children):
             return []  # PolyScope writes nothing for a Force node with an empty body
         # in force mode the program may not stop at a node: every marker inside is noBreak
-        body = [_no_break(item) for item in self.block(node.children)]
+        body = [_no_break(item) if self.flags else item for item in self.block(node.children)]
         return [self.marker(node, "Force"), _stmt("sleep", _num(0.02)), _stmt("zero_ftsensor"),
                 _stmt("force_mode", frame, List(tuple(Number(int(v)) for v in selection)),
                       List(tuple(_num(v) for v in wrench)), Number(kind),
@@ -1227,6 +1393,11 @@ class _Compiler:
             pose_expr, q_expr = self.fixed_values(node)
             pose_expr = self.in_variable_feature(node, move, pose_expr)
             if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
+                target = q_expr
+            elif "positionType" not in move.attrs and motion in ("MoveJ", "MoveL") and \
+                    move.attrs.get("useActiveTCP") == "false" and not move.fields.get("tcp"):
+                # PolyScope 3 (no positionType): a move that uses no TCP goes to the
+                # waypoint's joint angles, a MoveL too (seen: 3.5 ``movel([q], ...)``)
                 target = q_expr
             elif motion == "MoveJ":
                 target = _call("get_inverse_kin", pose_expr, qnear=q_expr)

@@ -217,7 +217,8 @@ class Installation:
     of the first point's tool z axis."""
     io_names: tuple[tuple[str, str], ...] = ()
     """The I/O names the user gave: (name, pin) pairs, pin as PolyScope refers to it
-    (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``)."""
+    (``digital_out[1]``, ``tool_in[0]``, ``configurable_in[3]``, ``analog_in[0]``, the
+    general purpose registers ``GP_bool_in[0]``, ``GP_int_out[2]``, ``GP_float_in[1]``)."""
     safety: Safety | None = None
     """The safety configuration's normal-mode limits and planes (3.x and 5.x), when the
     file has them."""
@@ -311,6 +312,8 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
     payloads: list[Payload] = []
     active_payload = None
     settings = root.find("TCPSettings")
+    if settings is None:  # PolyScope 3.4-3.5: the class name as the tag
+        settings = root.find("com.ur.view.tcp.domain.TCPSettingsImpl")
     if settings is not None:
         active_tcp = settings.get("activePose")
         for element in settings.iter("tcp"):
@@ -370,6 +373,12 @@ _IO_BANKS = {
     "ToolDigitalInputNames": "tool_in", "ToolDigitalOutputNames": "tool_out",
     "AnalogInputNames": "analog_in", "AnalogOutputNames": "analog_out",
     "ToolAnalogInputNames": "tool_analog_in",
+    "GeneralPurposeBooleanRegisterInputNames": "GP_bool_in",
+    "GeneralPurposeBooleanRegisterOutputNames": "GP_bool_out",
+    "GeneralPurposeIntRegisterInputNames": "GP_int_in",
+    "GeneralPurposeIntRegisterOutputNames": "GP_int_out",
+    "GeneralPurposeFloatRegisterInputNames": "GP_float_in",
+    "GeneralPurposeFloatRegisterOutputNames": "GP_float_out",
 }
 """``<IOs>`` name lists (comma-separated, empty for an unnamed pin) and the pins they name."""
 
@@ -502,6 +511,9 @@ def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
         element = root.find(tag)
         if element is not None:
             settings[tag] = dict(element.attrib)
+    if "ToolCommSettings" not in settings and root.get("toolOutputVoltage") is not None:
+        # PolyScope 3.4-3.5: the tool voltage (V) as an attribute of the root
+        settings["ToolCommSettings"] = {"toolOutputVoltage": root.get("toolOutputVoltage", "")}
     ios = root.find("IOs")
     if ios is not None:
         for element in ios:
@@ -510,6 +522,10 @@ def _settings(root: ElementTree.Element) -> dict[str, dict[str, str]]:
     for element in root.iter("Payload"):
         if element.get("inertiaParameters"):
             settings[f"Payload/{element.get('name', '')}"] = dict(element.attrib)
+    for element in root.iterfind("Contributions/URCaps/Contributed"):
+        if element.get("id") == "EthernetIP":  # the built-in EtherNet/IP adapter's data
+            settings["EthernetIP"] = {data.get("key", ""): data.get("value", "")
+                                      for data in element.iterfind("data")}
     return settings
 
 

@@ -34,11 +34,10 @@ from ..script.nodes import (
     ThreadDef,
     While,
 )
-from .installation import Installation
+from .installation import Installation, Payload
 from .urp import Expression, Program
 
 __all__ = ["BLOCKS", "initial_values", "preamble", "preamble_blocks", "step_counter"]
-
 
 def _call(name: str, *args: Expr, **keywords: Expr) -> Call:
     return Call(Name(name), tuple(args), tuple(Keyword(k, v) for k, v in keywords.items()))
@@ -83,7 +82,8 @@ _BAUD = {"BAUD_9600": 9600, "BAUD_19200": 19200, "BAUD_38400": 38400, "BAUD_5760
 _PARITY = {"NONE": 0, "ODD": 1, "EVEN": 2}
 _STOP_BITS = {"ONE": 1, "TWO": 2}
 _OUTPUT_MODE = {"SINKING": 1, "SOURCING": 2, "PUSH_PULL": 3}
-_VOLTAGE = {"ZERO": 0, "TWELVE": 12, "TWENTY_FOUR": 24}
+_VOLTAGE = {"ZERO": 0, "TWELVE": 12, "TWENTY_FOUR": 24, "0": 0, "12": 12, "24": 24}
+"""The tool output voltage as installations write it (PolyScope 3.4-3.5: the volts)."""
 
 
 def _baud(text: str) -> int:
@@ -132,6 +132,8 @@ _RUNSTATE = {"LOW_WHEN_PROGRAM_STOPPED": 1, "HIGH_WHEN_PROGRAM_STOPPED": 2,
              "HIGH_WHEN_PROGRAM_RUNNING_LOW_WHEN_STOPPED": 3}
 """Output actions when the program stops → the state number of ``set_runstate_*`` (1 seen;
 2 and 3 as the URScript manual numbers them [U])."""
+_GP_RUNSTATE = {"PROGRAM_RUNNING": 3}
+"""A general purpose boolean output register's action → its run state number (seen: 3)."""
 _RUNSTATE_BANKS = (("DigitalOutputActions", "standard"),
                    ("ConfigurableOutputActions", "configurable"),
                    ("ToolDigitalOutputActions", "tool"))
@@ -151,16 +153,17 @@ them in this order."""
 def preamble_blocks(program: Program, installation: Installation | None,
                     variables: list[tuple[str, str]]) -> list[tuple[str, list[Item]]]:
     """The preamble as (kind, statements) blocks in the order urdsl writes them. Kinds:
-    ``verification`` (PolyScope 5.13 on: a hidden global, always first), the movable
+    ``verification`` (PolyScope 5.12 on: a hidden global, always first), the movable
     blocks of :data:`BLOCKS`, then ``variables`` (the installation variables) and
-    ``features`` (feature poses, by name), ``urcaps`` (a marked block per URCap
+    ``features`` (feature poses, by name), ``watchdog`` (the EtherNet/IP adapter's watchdog
+    when it is enabled), ``urcaps`` (a marked block per URCap
     installation node: its code only the URCap can generate, so the block is empty), then
     ``initial`` (the program's initial variable values, see :func:`initial_values`).
     Modbus signals' input/output actions are not written."""
     blocks: list[tuple[str, list[Item]]] = []
     saved = _version(program.saved_in or program.created_in)
     major = program.major_version or saved[0] or 5
-    if saved >= (5, 13):
+    if saved >= (5, 12):  # seen from 5.12.4 on; 5.11.10 does not write it
         blocks.append(("verification", [Declare("global", "_hidden_verificationVariable",
                                                 Number(0))]))
     movable: dict[str, list[Item]] = {"steps": step_counter(program)}
@@ -177,10 +180,19 @@ def preamble_blocks(program: Program, installation: Installation | None,
             values.append(Comment(f" urdsl: installation variable {name} is not URScript"))
     if values:
         blocks.append(("variables", values))
+    # a name beyond ASCII ("点_1") is written as the compiler writes every name
+    # (``u28857_1``, seen), and sorted as written
     features = [Declare("global", name, Pose(tuple(_num(v) for v in pose)))
                 for name, pose in sorted(installation.features if installation else ())]
     if features:
         blocks.append(("features", features))
+    ethernet_ip = (installation.settings or {}).get("EthernetIP", {}) if installation else {}
+    if ethernet_ip.get("enabled") == "true" and ethernet_ip.get("watchdogAction"):
+        # the EtherNet/IP adapter enabled: a watchdog on the speed slider input (seen with
+        # the action IGNORE; PAUSE and STOP written the same way [U])
+        blocks.append(("watchdog", [_stmt("rtde_set_watchdog", String("speed_slider_mask"),
+                                          _num(10.0),
+                                          String(ethernet_ip["watchdogAction"].lower()))]))
     urcaps: list[Item] = []
     for name, vendor, title in installation.urcaps if installation else ():
         urcaps.extend((Comment(" begin: URCap Installation Node"),
@@ -278,17 +290,7 @@ def _installation_blocks(installation: Installation, major: int) -> dict[str, li
     blocks["modbus"] = _modbus(installation)
     payload = installation.payload
     if payload is not None:
-        raw = settings.get(f"Payload/{payload.name}")
-        if raw is not None and raw.get("inertiaParameters"):
-            inertia = tuple(float(v) for v in raw["inertiaParameters"].split(","))
-            blocks["payload"] = [_stmt("set_target_payload", _num(payload.mass),
-                                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))),
-                                       List(tuple(_num(v) for v in inertia)))]
-        elif payload.cog is None and major < 5:
-            blocks["payload"] = [_stmt("set_payload", _num(payload.mass))]
-        else:
-            blocks["payload"] = [_stmt("set_payload", _num(payload.mass),
-                                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))))]
+        blocks["payload"] = payload_statements(installation, payload, major)
     tcp = installation.tcp
     if tcp is not None:
         blocks["tcp"] = [_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset)))]
@@ -331,6 +333,13 @@ def _io(settings: dict[str, dict[str, str]]) -> list[Item]:
     for bank, index, state in states:
         items.append(_stmt(f"set_runstate_{bank}_digital_output_to_value", Number(index),
                            Number(state)))
+    # a general purpose boolean output register's action: only its state is written (seen:
+    # PROGRAM_RUNNING at register 0 as ``set_runstate_gp_boolean_output_to_value(0, 3)``)
+    actions = settings.get("IOs/GeneralPurposeBooleanRegisterOutputActions", {}).get("value", "")
+    for index, action in enumerate(a.strip() for a in actions.split(",")):
+        if action in _GP_RUNSTATE:
+            items.append(_stmt("set_runstate_gp_boolean_output_to_value", Number(index),
+                               Number(_GP_RUNSTATE[action])))
     return items
 
 
@@ -338,6 +347,7 @@ def _modbus(installation: Installation) -> list[Item]:
     """Each Modbus signal: added, its update frequency (Hz) set, and for an output what it
     does when the program stops."""
     items: list[Item] = []
+    choices: list[Item] = []
     for signal in installation.modbus:
         if signal.kind not in _MODBUS_KINDS:
             items.append(Comment(f" urdsl: Modbus signal {signal.name} of type "
@@ -353,9 +363,11 @@ def _modbus(installation: Installation) -> list[Item]:
                                Number(int(frequency)) if frequency == int(frequency)
                                else _num(frequency)))
         if signal.kind.endswith("OUTPUT") and signal.choice is not None:
-            items.append(_stmt("modbus_set_runstate_dependent_choice", name,
-                               Number(signal.choice)))
-    return items
+            choices.append(_stmt("modbus_set_runstate_dependent_choice", name,
+                                 Number(signal.choice)))
+    # the outputs' choices come after all the signals (seen: mswaidan/finishing-line
+    # modbustest, nine output signals among twenty-six)
+    return items + choices
 
 
 def step_counter(program: Program) -> list[Item]:
@@ -375,3 +387,21 @@ def step_counter(program: Program) -> list[Item]:
             Assign(Name(count), BinOp("+", Name(count), _num(1.0))),
             _stmt("sync"))),)),
         ExprStmt(Run(thread))]
+
+
+def payload_statements(installation: Installation, payload: Payload, major: int) -> list[Item]:
+    """What PolyScope writes to select one of the installation's payloads (mass kg, centre
+    of gravity m, inertia kg m²): ``set_target_payload`` when the installation gives its
+    inertia, else ``set_payload`` (PolyScope 3 without a centre of gravity: the mass
+    alone). Used by the preamble (the default payload) and a Set Payload node."""
+    raw = installation.settings.get(f"Payload/{payload.name}") if installation.settings \
+        else None
+    if raw is not None and raw.get("inertiaParameters"):
+        inertia = tuple(float(v) for v in raw["inertiaParameters"].split(","))
+        return [_stmt("set_target_payload", _num(payload.mass),
+                      List(tuple(_num(v) for v in payload.cog or (0, 0, 0))),
+                      List(tuple(_num(v) for v in inertia)))]
+    if payload.cog is None and major < 5:
+        return [_stmt("set_payload", _num(payload.mass))]
+    return [_stmt("set_payload", _num(payload.mass),
+                  List(tuple(_num(v) for v in payload.cog or (0, 0, 0))))]

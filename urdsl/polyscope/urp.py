@@ -417,6 +417,10 @@ class _Reader:
                 return ("io", name or inner.get("referencedName", ""))
             if piece.tag == "ExpressionWaypoint":
                 return ("waypoint", name)
+            if piece.tag == "ExpressionGeomFeature" and name == "Joint_0_name":
+                # the base feature in an expression is its pose (seen: "UF:=Base" is
+                # written ``global UF=p[0.0,0.0,0.0,0.0,0.0,0.0]``)
+                return ("token", "p[0.0,0.0,0.0,0.0,0.0,0.0]")
             return ("var", name)
         return ("token", piece.get("name", ""))
 
@@ -537,6 +541,11 @@ def _wait(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
 def _set(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["type"] = element.get("type", "NoAction")
     pin = element.find("pin")
+    pulse = element.find("SingleDigitalPulseActionState")
+    if pulse is not None:
+        # a single pulse: the pin and the pulse's length (s) are in this child
+        pin = pulse.find("pin")
+        node.fields["pulse"] = {key: value for key, value in pulse.attrib.items()}
     if pin is not None:
         node.fields["pin"] = reader.resolve(pin).get("referencedName")
     for key in ("digitalValue", "analogValue"):
