@@ -211,6 +211,19 @@ def test_base_feature_in_an_expression_is_its_pose():
     assert "global UF = p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]" in lines
 
 
+def test_tool_feature_in_an_expression_is_where_the_tool_is():
+    # taunoe/UR-scripts XMLRPC_loop: "camera.get_next_pose(Tool)"; "Joint_6_name" is
+    # PolyScope's name of the Tool feature, never a variable of the program
+    lines = compiled("""
+        <Assignment valueSource="Expression">
+          <variable name="next"/>
+          <expression><ExpressionToken token="camera.get_next_pose("/>
+            <ExpressionGeomFeature><feature referencedName="Joint_6_name"/></ExpressionGeomFeature>
+            <ExpressionToken token=")"/></expression>
+        </Assignment>""")
+    assert "global next = camera.get_next_pose(get_actual_tcp_pose())" in lines
+
+
 def test_names_beyond_ascii_in_an_expression():
     # CA-Giken TEST_SPEED: "pose_sub(CurrPos_p, ウェイポイント_1_p)" in an assignment
     lines = compiled("""

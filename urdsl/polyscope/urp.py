@@ -421,6 +421,10 @@ class _Reader:
                 # the base feature in an expression is its pose (seen: "UF:=Base" is
                 # written ``global UF=p[0.0,0.0,0.0,0.0,0.0,0.0]``)
                 return ("token", "p[0.0,0.0,0.0,0.0,0.0,0.0]")
+            if piece.tag == "ExpressionGeomFeature" and name == "Joint_6_name":
+                # PolyScope's built-in Tool feature: where the tool is [U: no script
+                # PolyScope wrote for it seen; its pose in Base is the TCP's]
+                return ("token", "get_actual_tcp_pose()")
             return ("var", name)
         return ("token", piece.get("name", ""))
 
