@@ -1,16 +1,19 @@
 """How steadily does ``urdsl sim`` publish RTDE at 500 Hz?
 
 Starts ``urdsl sim`` in its own process, runs a program that keeps the arm moving, and
-connects three RTDE clients that record timestamp and actual_q at 500 Hz for the given time.
-Prints, per client: packages received, the arrival interval (p50, p99, max, in ms), the
-jitter (|interval - 2 ms|, p99), dropped samples (gaps in the controller's timestamps), and
-the simulator process's CPU use. Target: p99 jitter < 1 ms, no drops.
+connects three RTDE clients that record timestamp and actual_q at 500 Hz for the given time
+(``--realtime N`` adds N clients of the realtime interface, port 30003, which sends a packet
+every controller step). Prints, per client: packages received, the arrival interval (p50,
+p99, max, in ms), the jitter (|interval - 2 ms|, p99), dropped samples (gaps in the
+controller's timestamps), and the simulator process's CPU use. Target: p99 jitter < 1 ms,
+no drops.
 
 There is no peer to run side by side: URSim (the official simulator) is a Docker image that
 does not run here. The numbers are absolute.
 
     .venv/bin/python bench/sim_bench.py                 # 60 s, 3 clients
     .venv/bin/python bench/sim_bench.py --seconds 10 --clients 5
+    .venv/bin/python bench/sim_bench.py --seconds 20 --realtime 3   # + 3 realtime readers
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from urdsl.protocol.realtime import RealtimeDecoder
 from urdsl.protocol.rtde import DataPackage, RtdeClient
 
 OFFSET = int(os.environ.get("SIM_BENCH_OFFSET", "3100"))
@@ -83,7 +87,26 @@ def record(port: int, seconds: float, out) -> None:
                 arrivals.append(now)
                 stamps.append(event.values["timestamp"])
     sock.close()
-    out.put({"arrivals": np.array(arrivals), "stamps": np.array(stamps)})
+    out.put({"kind": "rtde", "arrivals": np.array(arrivals), "stamps": np.array(stamps)})
+
+
+def record_realtime(port: int, seconds: float, out) -> None:
+    """One realtime-interface reader (its own process): arrival times and controller times
+    of every packet, decoded by :class:`urdsl.protocol.realtime.RealtimeDecoder`."""
+    sock = socket.create_connection(("127.0.0.1", port), timeout=5)
+    decoder = RealtimeDecoder()
+    arrivals, stamps = [], []
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end:
+        data = sock.recv(65536)
+        if not data:
+            break
+        now = time.perf_counter()
+        for state in decoder.feed(data):
+            arrivals.append(now)
+            stamps.append(state.time)
+    sock.close()
+    out.put({"kind": "realtime", "arrivals": np.array(arrivals), "stamps": np.array(stamps)})
 
 
 def main() -> int:
@@ -91,6 +114,8 @@ def main() -> int:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--clients", type=int, default=3)
+    parser.add_argument("--realtime", type=int, default=0,
+                        help="realtime-interface (30003) readers beside the RTDE clients")
     args = parser.parse_args()
 
     process = subprocess.Popen(_command("--port-offset", str(OFFSET), "--quiet"),
@@ -113,6 +138,9 @@ def main() -> int:
         clients = [multiprocessing.Process(target=record,
                                            args=(30004 + OFFSET, args.seconds, queue))
                    for _ in range(args.clients)]
+        clients += [multiprocessing.Process(target=record_realtime,
+                                            args=(30003 + OFFSET, args.seconds, queue))
+                    for _ in range(args.realtime)]
         cpu0, wall0 = _cpu_seconds(process.pid), time.perf_counter()
         for client in clients:
             client.start()
@@ -127,10 +155,12 @@ def main() -> int:
         except subprocess.TimeoutExpired:
             process.kill()
 
-    print(f"urdsl sim RTDE at 500 Hz, {args.clients} clients, {args.seconds:g} s "
+    print(f"urdsl sim RTDE at 500 Hz, {args.clients} clients, {args.realtime} realtime "
+          f"readers, {args.seconds:g} s "
           f"(no peer controller to compare against: URSim does not run here)")
-    print(f"{'client':>6} {'packages':>9} {'p50 ms':>7} {'p99 ms':>7} {'max ms':>7} "
-          f"{'jitter p99 ms':>13} {'dropped':>8}")
+    print(f"{'client':>6} {'kind':>8} {'packages':>9} {'p50 ms':>7} {'p99 ms':>7} "
+          f"{'max ms':>7} {'jitter p99 ms':>13} {'dropped':>8}")
+    results.sort(key=lambda result: result["kind"] != "rtde")
     worst = 0.0
     drops = 0
     for index, result in enumerate(results):
@@ -139,7 +169,8 @@ def main() -> int:
         dropped = int(np.sum(np.round(steps / 0.002) - 1))
         jitter = np.percentile(np.abs(intervals - 2.0), 99)
         worst, drops = max(worst, jitter), drops + dropped
-        print(f"{index:>6} {len(result['stamps']):>9} {np.percentile(intervals, 50):7.3f} "
+        print(f"{index:>6} {result['kind']:>8} {len(result['stamps']):>9} "
+              f"{np.percentile(intervals, 50):7.3f} "
               f"{np.percentile(intervals, 99):7.3f} {intervals.max():7.3f} {jitter:13.3f} "
               f"{dropped:>8}")
     print(f"simulator CPU: {cpu * 100:.0f}% of one core; worst p99 jitter {worst:.3f} ms "

@@ -35,12 +35,12 @@ from .dashboard import WELCOME, DashboardSession
 from .rtde import InputOwners, RtdeProtocolError, RtdeSession
 from .state import ControllerMessage, Snapshot
 from .wire import (
-    encode_realtime,
     encode_robot_state,
     encode_runtime_exception,
     encode_safety_message,
     encode_text_message,
     encode_version_message,
+    realtime_encoder,
 )
 
 __all__ = ["SimServers", "STANDARD_PORTS"]
@@ -160,6 +160,7 @@ class SimServers:
         self._closing = threading.Event()
         self._thread: threading.Thread | None = None
         self._last_state_time = 0.0
+        self._encode_realtime = realtime_encoder(controller.version)
         self.owns_controller = False
 
     # ---- life cycle ----------------------------------------------------------------------
@@ -271,7 +272,7 @@ class SimServers:
             kind = client.kind
             if kind in ("realtime", "realtime_ro"):
                 if realtime is None:
-                    realtime = encode_realtime(snap, self.sim.version)
+                    realtime = self._encode_realtime(snap)
                 client.send(realtime)
             elif kind == "rtde":
                 session: RtdeSession = client.session
