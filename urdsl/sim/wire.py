@@ -11,6 +11,7 @@ complete packets.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from functools import cache
 from typing import Any
@@ -34,12 +35,12 @@ from ..protocol.primary import (
     VersionMessage,
 )
 from ..protocol.realtime import RealtimeLayout, layout_for_version
-from .state import ControllerVersion, SafetyMode, Snapshot
+from .state import ControllerMessage, ControllerVersion, SafetyMode, Snapshot
 
 __all__ = [
     "realtime_size", "realtime_encoder", "encode_realtime", "encode_robot_state",
     "encode_version_message", "encode_text_message", "encode_runtime_exception",
-    "encode_safety_message",
+    "encode_safety_message", "encode_controller_message",
     "ROBOT_STATE", "ROBOT_MESSAGE",
 ]
 
@@ -240,3 +241,19 @@ def encode_safety_message(code: int, argument: int, mode: SafetyMode, time: floa
     return SafetyModeMessage(timestamp=_ms(time), source=SOURCE_CONTROLLER, code=code,
                              argument=argument, safety_mode_type=int(mode),
                              report_data_type=0, report_data=0).encode()
+
+
+def encode_controller_message(message: ControllerMessage) -> bytes:
+    """The robot message(s) of one :class:`ControllerMessage` for the primary interface: a
+    runtime exception with line and column; a protective stop as a SAFETY_MODE message
+    (code and argument from its ``C<code>A<argument>`` text) followed by its text; any other
+    kind as a TEXT message."""
+    if message.kind == "runtime_exception":
+        return encode_runtime_exception(message.line, message.column, message.text,
+                                        message.time)
+    if message.kind == "safety":
+        match = re.match(r"C(\d+)A(\d+)", message.text)
+        code, argument = (int(match.group(1)), int(match.group(2))) if match else (0, 0)
+        return (encode_safety_message(code, argument, SafetyMode.PROTECTIVE_STOP, message.time)
+                + encode_text_message(message.text, message.time))
+    return encode_text_message(message.text, message.time)
