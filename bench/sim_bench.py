@@ -67,46 +67,43 @@ def _exchange(sock: socket.socket, client: RtdeClient, request: bytes) -> list:
     return events
 
 
+def _collect(sock: socket.socket, seconds: float, times, kind: str, out) -> None:
+    """Receive for ``seconds``: the arrival time (s, perf_counter) and controller time of
+    every sample ``times(data)`` finds in the received bytes, put on the queue ``out``."""
+    arrivals, stamps = [], []
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end:
+        data = sock.recv(65536)
+        if not data:
+            break
+        now = time.perf_counter()
+        for stamp in times(data):
+            arrivals.append(now)
+            stamps.append(stamp)
+    sock.close()
+    out.put({"kind": kind, "arrivals": np.array(arrivals), "stamps": np.array(stamps)})
+
+
 def record(port: int, seconds: float, out) -> None:
     """One recording client (its own process), on :class:`urdsl.protocol.rtde.RtdeClient`:
-    arrival times (s, perf_counter) and controller timestamps, put on the queue ``out``."""
+    timestamps of the data packages."""
     sock = socket.create_connection(("127.0.0.1", port), timeout=5)
     client = RtdeClient()
     _exchange(sock, client, client.request_protocol_version(2))
     _exchange(sock, client, client.setup_outputs(["timestamp", "actual_q"], 500.0))
     _exchange(sock, client, client.start())
-    arrivals, stamps = [], []
-    end = time.perf_counter() + seconds
-    while time.perf_counter() < end:
-        data = sock.recv(65536)
-        if not data:
-            break
-        now = time.perf_counter()
-        for event in client.receive_data(data):
-            if isinstance(event, DataPackage):
-                arrivals.append(now)
-                stamps.append(event.values["timestamp"])
-    sock.close()
-    out.put({"kind": "rtde", "arrivals": np.array(arrivals), "stamps": np.array(stamps)})
+    _collect(sock, seconds, lambda data: [event.values["timestamp"] for event
+                                          in client.receive_data(data)
+                                          if isinstance(event, DataPackage)], "rtde", out)
 
 
 def record_realtime(port: int, seconds: float, out) -> None:
-    """One realtime-interface reader (its own process): arrival times and controller times
-    of every packet, decoded by :class:`urdsl.protocol.realtime.RealtimeDecoder`."""
+    """One realtime-interface reader (its own process): the controller time of every packet,
+    decoded by :class:`urdsl.protocol.realtime.RealtimeDecoder`."""
     sock = socket.create_connection(("127.0.0.1", port), timeout=5)
     decoder = RealtimeDecoder()
-    arrivals, stamps = [], []
-    end = time.perf_counter() + seconds
-    while time.perf_counter() < end:
-        data = sock.recv(65536)
-        if not data:
-            break
-        now = time.perf_counter()
-        for state in decoder.feed(data):
-            arrivals.append(now)
-            stamps.append(state.time)
-    sock.close()
-    out.put({"kind": "realtime", "arrivals": np.array(arrivals), "stamps": np.array(stamps)})
+    _collect(sock, seconds, lambda data: [state.time for state in decoder.feed(data)],
+             "realtime", out)
 
 
 def main() -> int:
