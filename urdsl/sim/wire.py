@@ -34,18 +34,15 @@ from ..protocol.primary import (
     ToolData,
     VersionMessage,
 )
-from ..protocol.realtime import RealtimeLayout, layout_for_version
+from ..protocol.realtime import layout_for_version
 from .state import ControllerMessage, ControllerVersion, SafetyMode, Snapshot
 
 __all__ = [
-    "realtime_size", "realtime_encoder", "encode_realtime", "encode_robot_state",
+    "realtime_encoder", "encode_realtime", "encode_robot_state",
     "encode_version_message", "encode_text_message", "encode_runtime_exception",
     "encode_safety_message", "encode_controller_message",
-    "ROBOT_STATE", "ROBOT_MESSAGE",
 ]
 
-ROBOT_STATE = 16
-ROBOT_MESSAGE = 20
 _ZEROS = (0.0,) * 6
 SOURCE_CONTROLLER = -2  # [U] the int8 source the controller puts on its own messages
 
@@ -83,17 +80,7 @@ def realtime_encoder(version: ControllerVersion) -> Callable[[Snapshot], bytes]:
     """``version``'s realtime encoder (snapshot → packet), made once: the protocol's
     encoder of the layout (:meth:`urdsl.protocol.realtime.RealtimeLayout.packer`, one
     precompiled struct) with the values :data:`_REALTIME` names."""
-    return _realtime_layout(version).packer(_REALTIME)
-
-
-def _realtime_layout(version: ControllerVersion) -> RealtimeLayout:
-    return layout_for_version(f"{version.major}.{version.minor}")
-
-
-def realtime_size(version: ControllerVersion) -> int:
-    """Total packet size (bytes, including the int32 size field) for a software version
-    (docs/controller-facts.md §10)."""
-    return _realtime_layout(version).size
+    return layout_for_version(f"{version.major}.{version.minor}").packer(_REALTIME)
 
 
 def encode_realtime(snap: Snapshot, version: ControllerVersion) -> bytes:
