@@ -170,7 +170,7 @@ def main() -> int:
               f"{np.percentile(intervals, 50):7.3f} "
               f"{np.percentile(intervals, 99):7.3f} {intervals.max():7.3f} {jitter:13.3f} "
               f"{dropped:>8}")
-    print(f"simulator CPU: {cpu * 100:.0f}% of one core; worst p99 jitter {worst:.3f} ms "
+    print(f"simulator CPU: {cpu * 100:.1f}% of one core; worst p99 jitter {worst:.3f} ms "
           f"(target < 1 ms): {'met' if worst < 1 else 'NOT met'}; dropped {drops} "
           f"(target 0): {'met' if drops == 0 else 'NOT met'}")
     return 0
