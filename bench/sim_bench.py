@@ -1,16 +1,19 @@
 """How steadily does ``urdsl sim`` publish RTDE at 500 Hz?
 
 Starts ``urdsl sim`` in its own process, runs a program that keeps the arm moving, and
-connects three RTDE clients that record timestamp and actual_q at 500 Hz for the given time.
-Prints, per client: packages received, the arrival interval (p50, p99, max, in ms), the
-jitter (|interval - 2 ms|, p99), dropped samples (gaps in the controller's timestamps), and
-the simulator process's CPU use. Target: p99 jitter < 1 ms, no drops.
+connects three RTDE clients that record timestamp and actual_q at 500 Hz for the given time
+(``--realtime N`` adds N clients of the realtime interface, port 30003, which sends a packet
+every controller step). Prints, per client: packages received, the arrival interval (p50,
+p99, max, in ms), the jitter (|interval - 2 ms|, p99), dropped samples (gaps in the
+controller's timestamps), and the simulator process's CPU use. Target: p99 jitter < 1 ms,
+no drops.
 
 There is no peer to run side by side: URSim (the official simulator) is a Docker image that
 does not run here. The numbers are absolute.
 
     .venv/bin/python bench/sim_bench.py                 # 60 s, 3 clients
     .venv/bin/python bench/sim_bench.py --seconds 10 --clients 5
+    .venv/bin/python bench/sim_bench.py --seconds 20 --realtime 3   # + 3 realtime readers
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from urdsl.protocol.realtime import RealtimeDecoder
 from urdsl.protocol.rtde import DataPackage, RtdeClient
 
 OFFSET = int(os.environ.get("SIM_BENCH_OFFSET", "3100"))
@@ -63,14 +67,9 @@ def _exchange(sock: socket.socket, client: RtdeClient, request: bytes) -> list:
     return events
 
 
-def record(port: int, seconds: float, out) -> None:
-    """One recording client (its own process), on :class:`urdsl.protocol.rtde.RtdeClient`:
-    arrival times (s, perf_counter) and controller timestamps, put on the queue ``out``."""
-    sock = socket.create_connection(("127.0.0.1", port), timeout=5)
-    client = RtdeClient()
-    _exchange(sock, client, client.request_protocol_version(2))
-    _exchange(sock, client, client.setup_outputs(["timestamp", "actual_q"], 500.0))
-    _exchange(sock, client, client.start())
+def _collect(sock: socket.socket, seconds: float, times, kind: str, out) -> None:
+    """Receive for ``seconds``: the arrival time (s, perf_counter) and controller time of
+    every sample ``times(data)`` finds in the received bytes, put on the queue ``out``."""
     arrivals, stamps = [], []
     end = time.perf_counter() + seconds
     while time.perf_counter() < end:
@@ -78,12 +77,33 @@ def record(port: int, seconds: float, out) -> None:
         if not data:
             break
         now = time.perf_counter()
-        for event in client.receive_data(data):
-            if isinstance(event, DataPackage):
-                arrivals.append(now)
-                stamps.append(event.values["timestamp"])
+        for stamp in times(data):
+            arrivals.append(now)
+            stamps.append(stamp)
     sock.close()
-    out.put({"arrivals": np.array(arrivals), "stamps": np.array(stamps)})
+    out.put({"kind": kind, "arrivals": np.array(arrivals), "stamps": np.array(stamps)})
+
+
+def record(port: int, seconds: float, out) -> None:
+    """One recording client (its own process), on :class:`urdsl.protocol.rtde.RtdeClient`:
+    timestamps of the data packages."""
+    sock = socket.create_connection(("127.0.0.1", port), timeout=5)
+    client = RtdeClient()
+    _exchange(sock, client, client.request_protocol_version(2))
+    _exchange(sock, client, client.setup_outputs(["timestamp", "actual_q"], 500.0))
+    _exchange(sock, client, client.start())
+    _collect(sock, seconds, lambda data: [event.values["timestamp"] for event
+                                          in client.receive_data(data)
+                                          if isinstance(event, DataPackage)], "rtde", out)
+
+
+def record_realtime(port: int, seconds: float, out) -> None:
+    """One realtime-interface reader (its own process): the controller time of every packet,
+    decoded by :class:`urdsl.protocol.realtime.RealtimeDecoder`."""
+    sock = socket.create_connection(("127.0.0.1", port), timeout=5)
+    decoder = RealtimeDecoder()
+    _collect(sock, seconds, lambda data: [state.time for state in decoder.feed(data)],
+             "realtime", out)
 
 
 def main() -> int:
@@ -91,6 +111,8 @@ def main() -> int:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--clients", type=int, default=3)
+    parser.add_argument("--realtime", type=int, default=0,
+                        help="realtime-interface (30003) readers beside the RTDE clients")
     args = parser.parse_args()
 
     process = subprocess.Popen(_command("--port-offset", str(OFFSET), "--quiet"),
@@ -113,6 +135,9 @@ def main() -> int:
         clients = [multiprocessing.Process(target=record,
                                            args=(30004 + OFFSET, args.seconds, queue))
                    for _ in range(args.clients)]
+        clients += [multiprocessing.Process(target=record_realtime,
+                                            args=(30003 + OFFSET, args.seconds, queue))
+                    for _ in range(args.realtime)]
         cpu0, wall0 = _cpu_seconds(process.pid), time.perf_counter()
         for client in clients:
             client.start()
@@ -127,10 +152,12 @@ def main() -> int:
         except subprocess.TimeoutExpired:
             process.kill()
 
-    print(f"urdsl sim RTDE at 500 Hz, {args.clients} clients, {args.seconds:g} s "
+    print(f"urdsl sim RTDE at 500 Hz, {args.clients} clients, {args.realtime} realtime "
+          f"readers, {args.seconds:g} s "
           f"(no peer controller to compare against: URSim does not run here)")
-    print(f"{'client':>6} {'packages':>9} {'p50 ms':>7} {'p99 ms':>7} {'max ms':>7} "
-          f"{'jitter p99 ms':>13} {'dropped':>8}")
+    print(f"{'client':>6} {'kind':>8} {'packages':>9} {'p50 ms':>7} {'p99 ms':>7} "
+          f"{'max ms':>7} {'jitter p99 ms':>13} {'dropped':>8}")
+    results.sort(key=lambda result: result["kind"] != "rtde")
     worst = 0.0
     drops = 0
     for index, result in enumerate(results):
@@ -139,10 +166,11 @@ def main() -> int:
         dropped = int(np.sum(np.round(steps / 0.002) - 1))
         jitter = np.percentile(np.abs(intervals - 2.0), 99)
         worst, drops = max(worst, jitter), drops + dropped
-        print(f"{index:>6} {len(result['stamps']):>9} {np.percentile(intervals, 50):7.3f} "
+        print(f"{index:>6} {result['kind']:>8} {len(result['stamps']):>9} "
+              f"{np.percentile(intervals, 50):7.3f} "
               f"{np.percentile(intervals, 99):7.3f} {intervals.max():7.3f} {jitter:13.3f} "
               f"{dropped:>8}")
-    print(f"simulator CPU: {cpu * 100:.0f}% of one core; worst p99 jitter {worst:.3f} ms "
+    print(f"simulator CPU: {cpu * 100:.1f}% of one core; worst p99 jitter {worst:.3f} ms "
           f"(target < 1 ms): {'met' if worst < 1 else 'NOT met'}; dropped {drops} "
           f"(target 0): {'met' if drops == 0 else 'NOT met'}")
     return 0

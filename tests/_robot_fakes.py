@@ -16,7 +16,7 @@ import time
 from collections.abc import Callable
 
 from urdsl.protocol import primary as p
-from urdsl.sim.framing import ScriptFramer
+from urdsl.protocol.script_framing import ScriptChunk
 
 LOOPBACK = "127.0.0.1"
 IO_TIMEOUT = 10.0  # s: no fake server socket blocks longer than this
@@ -136,14 +136,15 @@ def version_message() -> bytes:
 
 
 class FakeController:
-    """A controller model shared by fake primary and script servers.
+    """A controller model shared by fake primary and script servers, on the protocol's
+    server side of the primary interface (:class:`urdsl.protocol.primary.PrimaryServer`).
 
     ``behaviour(program_text)`` returns the events that running the program causes, each one
     of ``("run", ticks)`` (program running for that many state ticks), ``("text", s)``,
     ``("exception", line, column, text)``, ``("safety", mode)``. ``programs`` collects the
-    programs received, cut from the stream by the virtual controller's
-    :class:`~urdsl.sim.framing.ScriptFramer`. States go out every ``period`` s (the real
-    controller: 0.1 s).
+    programs received, cut from the stream as the controller cuts them
+    (:class:`~urdsl.protocol.script_framing.ScriptFramer`). States go out every ``period``
+    s (the real controller: 0.1 s). Each connection is served for ``lifetime`` s at most.
     """
 
     def __init__(self, behaviour, period: float = 0.02, lifetime: float = 10.0) -> None:
@@ -153,52 +154,60 @@ class FakeController:
         self.programs: list[str] = []
         self.inbox: queue.Queue[str] = queue.Queue()
 
-    def _take_programs(self, framer: ScriptFramer, data: bytes) -> None:
-        """Programs completed by ``data``, cut as the virtual controller cuts them (a
-        ``def``/``sec`` block up to its ``end``; bare lines run as they come)."""
-        for chunk in framer.feed(data):
+    def _take_programs(self, chunks: list[ScriptChunk]) -> None:
+        """Programs cut from the stream (a ``def``/``sec`` block up to its ``end``; bare
+        lines run as they come)."""
+        for chunk in chunks:
             self.programs.append(chunk.text)
             self.inbox.put(chunk.text)
 
+    def _events(self, events: list, server: p.PrimaryServer) -> tuple[bytes, int | None, int]:
+        """The robot messages of the events due now, up to the next ``("run", ticks)``: (their
+        bytes, a new safety mode or None, the ticks the program runs from now; 0 when no
+        run of at least one tick came)."""
+        out = b""
+        safety_mode = None
+        while events:
+            event = events.pop(0)
+            if event[0] == "run" and event[1] > 0:
+                return out, safety_mode, event[1]
+            if event[0] == "text":
+                out += server.robot_message(p.TextMessage(text=event[1]))
+            elif event[0] == "exception":
+                out += server.robot_message(p.RuntimeExceptionMessage(
+                    line=event[1], column=event[2], text=event[3]))
+            elif event[0] == "safety":
+                safety_mode = event[1]
+                out += server.robot_message(p.SafetyModeMessage(
+                    code=209, argument=0, safety_mode_type=event[1]))
+        return out, safety_mode, 0
+
     def primary(self, sock, index) -> None:
         """Serve the primary interface (also takes scripts, as 30001 does)."""
-        sock.sendall(version_message())
-        framer = ScriptFramer()
+        server = p.PrimaryServer(version_message(), period=self.period)
+        sock.sendall(server.greeting())
         events: list = []
         running_ticks = 0
         safety_mode = 1
-        end = time.monotonic() + self.lifetime
-        next_tick = time.monotonic()
         tick = 0
-        while time.monotonic() < end:
-            wait = max(next_tick - time.monotonic(), 0.0)
-            ready, _, _ = select.select([sock], [], [], wait)
+        end = time.monotonic() + self.lifetime
+        while (now := time.monotonic()) < end:
+            ready, _, _ = select.select([sock], [], [], min(server.until_state(now), end - now))
             if ready:
                 data = sock.recv(65536)
                 if not data:
                     return
-                self._take_programs(framer, data)
-            if time.monotonic() < next_tick:
+                self._take_programs(server.receive_data(data))
+            if not server.state_due(time.monotonic()):
                 continue
-            next_tick += self.period
             tick += 1
             while not self.inbox.empty():
                 events = list(self.behaviour(self.inbox.get()))
                 running_ticks = 0
             out = b""
-            while events and running_ticks == 0:
-                event = events.pop(0)
-                if event[0] == "run":
-                    running_ticks = event[1]
-                elif event[0] == "text":
-                    out += p.TextMessage(text=event[1]).encode()
-                elif event[0] == "exception":
-                    out += p.RuntimeExceptionMessage(line=event[1], column=event[2],
-                                                     text=event[3]).encode()
-                elif event[0] == "safety":
-                    safety_mode = event[1]
-                    out += p.SafetyModeMessage(code=209, argument=0,
-                                               safety_mode_type=event[1]).encode()
+            if running_ticks == 0:
+                out, new_mode, running_ticks = self._events(events, server)
+                safety_mode = new_mode if new_mode is not None else safety_mode
             running = running_ticks > 0
             if running_ticks:
                 running_ticks -= 1
@@ -206,9 +215,9 @@ class FakeController:
             sock.sendall(out)
 
     def script_port(self, sock, index) -> None:
-        """Serve a secondary-like port: state now and then, takes scripts, no messages."""
-        sock.sendall(version_message() + robot_state(False))
-        framer = ScriptFramer()
+        """Serve a secondary-like port: one state at first, takes scripts, no messages."""
+        server = p.PrimaryServer(version_message(), interface="secondary", period=self.period)
+        sock.sendall(server.greeting(robot_state(False)))
         end = time.monotonic() + self.lifetime
         while time.monotonic() < end:
             ready, _, _ = select.select([sock], [], [], 0.05)
@@ -216,7 +225,7 @@ class FakeController:
                 data = sock.recv(65536)
                 if not data:
                     return
-                self._take_programs(framer, data)
+                self._take_programs(server.receive_data(data))
 
 
 # ---- a fake RTDE server ------------------------------------------------------------------

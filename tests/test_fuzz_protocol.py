@@ -435,7 +435,7 @@ def test_fuzz_sim_rtde_session(idle_sim):
 
 
 def test_fuzz_sim_script_framer():
-    from urdsl.sim.framing import ScriptFramer
+    from urdsl.protocol.script_framing import ScriptFramer
 
     seeds = [b'def p():\n  textmsg("x")\nend\n', b"sec s():\n  x = 1\nend\n",
              b"textmsg(1)\nmovej([0,0,0,0,0,0])\n", b"def q():\r\n  y = 2\r\nend # done\r\n"]
@@ -447,7 +447,7 @@ def test_fuzz_sim_script_framer():
             try:
                 for chunk in framer.feed(piece):
                     assert chunk.kind in ("def", "sec", "bare")
-            except ValueError:
+            except ProtocolError:
                 break  # documented: a program or line over the limit
 
     assert run("sim-framer", step) >= 50

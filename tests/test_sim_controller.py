@@ -11,8 +11,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from urdsl.protocol.errors import ProtocolError
+from urdsl.protocol.script_framing import ScriptFramer
 from urdsl.sim.controller import DEFAULT_START, SimError, VirtualController, link_points
-from urdsl.sim.framing import ScriptFramer
 from urdsl.sim.state import ControllerVersion, ProgramState, RobotMode, SafetyMode
 
 TARGET = [0.6, -1.4, 1.3, -1.5, -1.6, 0.2]
@@ -259,7 +260,7 @@ def test_framer_never_crashes_on_random_bytes(data):
     try:
         for chunk in framer.feed(data):
             assert chunk.kind in ("def", "sec", "bare")
-    except ValueError:
+    except ProtocolError:
         pass
 
 

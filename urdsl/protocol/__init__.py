@@ -9,7 +9,9 @@ module                      port     what
 ==========================  =======  ================================================
 :mod:`.dashboard`           29999    dashboard server line protocol (both sides)
 :mod:`.realtime`            30003    realtime ("Matlab") interface, every version
-:mod:`.primary`             30001/2  primary/secondary: robot state and robot messages
+:mod:`.primary`             30001/2  primary/secondary: robot state and robot messages,
+                                     the controller's side of a connection
+:mod:`.script_framing`      30001-3  script text cut into programs as the controller does
 :mod:`.rtde`                30004    RTDE protocol v1/v2, client and server machines
 :mod:`.rtde_fields`                  the RTDE field/type table, as data
 ==========================  =======  ================================================
@@ -19,7 +21,13 @@ from __future__ import annotations
 
 from .dashboard import DashboardClient, DashboardReply, DashboardServer
 from .errors import ProtocolError
-from .primary import PrimaryDecoder, RobotState, RuntimeExceptionMessage, VersionMessage
+from .primary import (
+    PrimaryDecoder,
+    PrimaryServer,
+    RobotState,
+    RuntimeExceptionMessage,
+    VersionMessage,
+)
 from .realtime import RealtimeDecoder, RealtimeState, decode_realtime, encode_realtime
 from .rtde import DataPackage, Recipe, RtdeClient, RtdeServer
 
@@ -27,6 +35,6 @@ __all__ = [
     "ProtocolError",
     "DashboardClient", "DashboardReply", "DashboardServer",
     "RealtimeDecoder", "RealtimeState", "decode_realtime", "encode_realtime",
-    "PrimaryDecoder", "RobotState", "RuntimeExceptionMessage", "VersionMessage",
+    "PrimaryDecoder", "PrimaryServer", "RobotState", "RuntimeExceptionMessage", "VersionMessage",
     "RtdeClient", "RtdeServer", "Recipe", "DataPackage",
 ]

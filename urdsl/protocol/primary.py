@@ -30,6 +30,7 @@ decoded message gives back the same bytes.
 
 from __future__ import annotations
 
+import math
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -37,6 +38,7 @@ from typing import ClassVar, TypeVar
 
 from ._binary import Group, Row, Table, read_text, text_bytes
 from .errors import ProtocolError
+from .script_framing import MAX_SCRIPT_BYTES, ScriptChunk, ScriptFramer
 
 __all__ = [
     "PRIMARY_PORT", "SECONDARY_PORT", "ROBOT_STATE", "ROBOT_MESSAGE", "MAX_MESSAGE",
@@ -46,8 +48,8 @@ __all__ = [
     "RobotState", "RobotMessage", "TextMessage", "ProgramLabelMessage", "PopupMessage",
     "VersionMessage", "SafetyModeMessage", "ErrorCodeMessage", "KeyMessage",
     "RequestValueMessage", "RuntimeExceptionMessage", "UnknownRobotMessage", "UnknownMessage",
-    "PrimaryMessage", "decode_primary", "encode_primary", "PrimaryDecoder",
-    "SUB_PACKAGES", "ROBOT_MESSAGES",
+    "PrimaryMessage", "decode_primary", "encode_primary", "PrimaryDecoder", "PrimaryServer",
+    "SUB_PACKAGES", "ROBOT_MESSAGES", "STATE_PERIOD",
 ]
 
 PRIMARY_PORT = 30001
@@ -59,6 +61,10 @@ ROBOT_MESSAGE = 20
 _HEADER = struct.Struct(">iB")  # message: int32 size, uint8 type
 _SUB_HEADER = struct.Struct(">IB")  # sub-package: uint32 size, uint8 type
 _MESSAGE_HEAD = struct.Struct(">QbB")  # robot message: timestamp, source, robot message type
+
+STATE_PERIOD = 0.1
+"""Period of the robot state on the primary and secondary interfaces (s): 10 Hz on CB3 and
+e-Series (docs/controller-facts.md §7)."""
 
 MAX_MESSAGE = 1 << 20
 """Largest message accepted, in bytes.
@@ -1052,3 +1058,85 @@ class PrimaryDecoder:
         self.receive_data(data)
         return list(self)
 
+
+
+# --- the controller's side ------------------------------------------------------------------
+
+
+class PrimaryServer:
+    """The controller's side of one primary or secondary connection (ports 30001 / 30002,
+    read-only 30011 / 30012): no socket, no clock. The host (the virtual controller, a
+    test's fake controller) writes the bytes the methods return and passes its own time.
+
+    * :meth:`greeting`: the connection's first bytes, the VERSION robot message, then the
+      robot state it starts with (the controller's first one carries kinematics and
+      configuration).
+    * :meth:`receive_data`: the client's script text cut into programs as the controller cuts
+      it (:class:`~urdsl.protocol.script_framing.ScriptFramer`); a read-only port takes none.
+      Raises :class:`ProtocolError` for a program or line over ``script_limit`` bytes.
+    * :meth:`state_due`: whether the periodic robot state is due at the host's time ``now``
+      (s), every ``period`` s (10 Hz), on a grid of the host's clock, so that a host serving
+      many connections encodes each state once.
+    * :meth:`robot_message`: a robot message's bytes on the primary interface; the
+      secondary carries none (``b""``).
+
+    Messages are objects (:class:`RobotState`, :class:`RobotMessage`) or bytes already
+    encoded (a host serving many clients encodes once).
+    """
+
+    def __init__(self, version: VersionMessage | bytes, *, interface: str = "primary",
+                 read_only: bool = False, period: float = STATE_PERIOD,
+                 script_limit: int = MAX_SCRIPT_BYTES) -> None:
+        if interface not in ("primary", "secondary"):
+            raise ValueError(f"interface is 'primary' or 'secondary', not {interface!r}")
+        if not period > 0:
+            raise ValueError(f"the state period must be > 0 s, not {period!r}")
+        self.interface = interface
+        self.read_only = read_only
+        self.period = period
+        self._version = _message_bytes(version)
+        self.framer = None if read_only else ScriptFramer(script_limit, interface)
+        """The script text's framer (``None`` on a read-only port); ``framer.pending``: a
+        program has begun and not ended (cut off, never run, if the connection ends now)."""
+        self._next_slot: int | None = None  # the grid point (in periods) of the next state
+
+    def greeting(self, state: RobotState | bytes | None = None,
+                 now: float | None = None) -> bytes:
+        """The VERSION message, then ``state`` when given. With ``now`` (s) the periodic
+        state counts from there (the next is due at the next grid point after ``now``);
+        without, the first :meth:`state_due` call is due."""
+        if now is not None:
+            self._next_slot = self._slot(now) + 1
+        return self._version + (b"" if state is None else _message_bytes(state))
+
+    def receive_data(self, data: bytes) -> list[ScriptChunk]:
+        """The programs ``data`` completes, in order (none on a read-only port)."""
+        return [] if self.framer is None else self.framer.feed(data)
+
+    def state_due(self, now: float) -> bool:
+        """True when the robot state is due at ``now`` (s); the next one is then due at the
+        following grid point (states a host missed by falling behind are not owed)."""
+        slot = self._slot(now)
+        if self._next_slot is not None and slot < self._next_slot:
+            return False
+        self._next_slot = slot + 1
+        return True
+
+    def until_state(self, now: float) -> float:
+        """Seconds from ``now`` until the robot state is due (0 when it is)."""
+        if self._next_slot is None or self._slot(now) >= self._next_slot:
+            return 0.0
+        return max(self._next_slot * self.period - now, 0.0)
+
+    def robot_message(self, message: RobotMessage | bytes) -> bytes:
+        """``message``'s bytes on the primary interface; ``b""`` on the secondary."""
+        return _message_bytes(message) if self.interface == "primary" else b""
+
+    def _slot(self, now: float) -> int:
+        """The grid point at or before ``now`` (a billionth of a period forgiven: 5.1 s is in the
+        51st period of 0.1 s, though 5.1 / 0.1 < 51 in floating point)."""
+        return math.floor(now / self.period + 1e-9)
+
+
+def _message_bytes(message: PrimaryMessage | bytes) -> bytes:
+    return bytes(message) if isinstance(message, bytes | bytearray) else message.encode()

@@ -35,10 +35,11 @@ from __future__ import annotations
 
 import operator
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import partial
 from types import FunctionType, MappingProxyType
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from ..versions import ControllerVersion
 from .errors import ProtocolError
@@ -235,6 +236,10 @@ class RealtimeLayout:
                            if item.kind == "int")
         self.names = tuple(f.name for f in table)
         self._compile()
+        # the encoder of a RealtimeState: every field by name, its tail appended
+        self._write = self._packer(
+            {name: f"s.{name}" for name in self.names}, {}, "s.tail",
+            lambda state: _pack_checked(self, partial(getattr, state), state.tail))
 
     def _compile(self) -> None:
         """Build this layout's decoders: one ``unpack`` of the whole packet (size field and
@@ -320,24 +325,9 @@ class RealtimeLayout:
             "    f = unpack(data)\n"
             "    if f[0] != size:\n"
             "        return None\n" + body)
-        # the encoder: every field of the table by name, vectors spread, in one pack call;
-        # None (some value is missing, of the wrong type or length) leaves the diagnosis to
-        # encode_realtime's field-by-field path
-        vectors = [item.name for item in self.table if item.count > 1]
-        lengths = tuple(item.count for item in self.table if item.count > 1)
-        spread = ", ".join(f"*s.{item.name}" if item.count > 1 else f"s.{item.name}"
-                           for item in self.table)
-        source += (
-            "\ndef write(s):\n"
-            f"    if ({', '.join(f'len(s.{name})' for name in vectors)},) != {lengths}:\n"
-            "        return None\n"
-            "    tail = s.tail\n"
-            f"    return pack({self.size} + len(tail), {spread}) + tail\n")
-        namespace["pack"] = struct.Struct(f">i{self.doubles}d").pack
         exec(source, namespace)  # noqa: S102 - generated from the layout table above
         self._read = namespace["read"]
         self._whole = namespace["whole"]
-        self._write = namespace["write"]
         self._source = source
 
     def _whole_labelled(self, label: str) -> Callable[[bytes], RealtimeState | None]:
@@ -345,6 +335,69 @@ class RealtimeLayout:
         whole = self._whole
         return FunctionType(whole.__code__, whole.__globals__, whole.__name__,
                             (label, *whole.__defaults__[1:]))
+
+    def packer(self, carried: Mapping[str, Callable[[Any], object]]) -> Callable[[Any], bytes]:
+        """This layout's encoder for the caller's own objects (the simulator's snapshots).
+
+        ``carried[name](s)`` is the value field ``name`` carries for an object ``s``: a number,
+        or a sequence of the field's count (a tuple, a numpy array); every field not named is
+        sent as 0, and names this layout does not send are left out. The function returned
+        packs a whole packet (size field included) with this layout's one precompiled struct
+        call, generated from the table; a value that does not fit raises
+        :class:`ProtocolError` naming the field. A name that no layout has raises
+        ``KeyError`` here.
+        """
+        unknown = sorted(set(carried) - _ALL_NAMES)
+        if unknown:
+            raise KeyError(f"no realtime layout has the field(s) {', '.join(unknown)}")
+        namespace: dict[str, object] = {}
+        expressions = {}
+        for index, (name, value) in enumerate(carried.items()):
+            if name in self._offsets:
+                namespace[f"c{index}"] = value
+                expressions[name] = f"c{index}(s)"
+        return self._packer(expressions, namespace, None, _carried_fallback(self, carried))
+
+    def _packer(self, expressions: Mapping[str, str], namespace: dict[str, object],
+                tail: str | None, fallback: Callable[[Any], bytes]) -> Callable[[Any], bytes]:
+        """Generate ``write(s)``: one ``struct`` call packing each field's
+        ``expressions[name]`` in table order, vectors spread and their lengths checked (a
+        short vector beside a long one would shift the fields behind it with the total still
+        right); a field without an expression is pad bytes in the format (0.0 is eight zero
+        bytes), so it costs no argument. ``tail`` is an expression for bytes appended and
+        counted in the size field. ``fallback(s)`` packs field by field, or raises the error
+        naming the field that does not fit."""
+        lines = ["def write(s):", "    try:"]
+        codes = [">i"]
+        args: list[str] = []
+        vectors: list[tuple[str, int]] = []
+        for index, item in enumerate(self.table):
+            expression = expressions.get(item.name)
+            if expression is None:
+                codes.append(f"{8 * item.count}x")
+                continue
+            codes.append(f"{item.count}d")
+            if item.count == 1:
+                args.append(expression)
+            else:
+                lines.append(f"        v{index} = {expression}")
+                vectors.append((f"v{index}", item.count))
+                args.append(f"*v{index}")
+        if vectors:
+            lines.append(f"        if ({', '.join(f'len({v})' for v, _ in vectors)},) != "
+                         f"{tuple(count for _, count in vectors)}:")
+            lines.append("            return fallback(s)")
+        size, trailer = str(self.size), ""
+        if tail is not None:
+            lines.append(f"        tail = {tail}")
+            size, trailer = f"{self.size} + len(tail)", " + tail"
+        lines += [f"        return pack({', '.join([size, *args])}){trailer}",
+                  "    except (TypeError, ValueError, OverflowError, struct_error):",
+                  "        return fallback(s)"]
+        namespace.update(pack=struct.Struct("".join(codes)).pack, fallback=fallback,
+                         struct_error=struct.error)
+        exec("\n".join(lines) + "\n", namespace)  # noqa: S102 - generated from the table
+        return namespace["write"]  # type: ignore[return-value]
 
     def slot(self, name: str) -> slice:
         """Where field ``name`` sits in the packet's array of doubles (after the size field);
@@ -395,6 +448,8 @@ for _layout in LAYOUTS.values():  # every table row must be a field of RealtimeS
     assert set(_layout.names) <= set(RealtimeState._fields), \
         set(_layout.names) - set(RealtimeState._fields)
 del _layout
+
+_ALL_NAMES = frozenset(name for layout in LAYOUTS.values() for name in layout.names)
 
 
 def layout_for_size(size: int) -> RealtimeLayout:
@@ -518,32 +573,52 @@ def encode_realtime(state: RealtimeState, version: str | None = None) -> bytes:
     set (use :func:`realtime_state` to start from zeros); ``state.tail`` is appended and
     counted in the size field.
     """
-    layout = layout_for_version(version or state.version)
-    try:
-        data = layout._write(state)
-    except (TypeError, OverflowError, struct.error):
-        data = None
-    if data is not None and len(data) <= MAX_SIZE:
-        return data
+    data = layout_for_version(version or state.version)._write(state)
+    if len(data) > MAX_SIZE:
+        raise ProtocolError(f"packet of {len(data)} bytes exceeds {MAX_SIZE}",
+                            interface="realtime")
+    return data
+
+
+def _pack_checked(layout: RealtimeLayout, value_of: Callable[[str], Any], tail: bytes) -> bytes:
+    """The packet of ``layout`` with ``value_of(name)`` for each field, converted and checked
+    field by field: the slow path behind the generated encoders, for values they could not
+    pack (numbers of other types) and for the error naming the field that does not fit."""
     values: list[float] = []
     for item in layout.table:
-        value = getattr(state, item.name)
+        value = value_of(item.name)
+        offset = layout.offset(item.name)
         if value is None:
             raise ProtocolError(f"cannot encode a {layout.name} packet: field {item.name} "
-                                "is not set", interface="realtime",
-                                offset=layout.offset(item.name))
-        if item.count == 1:
-            values.append(float(value))
-        else:
-            if len(value) != item.count:
-                raise ProtocolError(f"field {item.name} needs {item.count} values, "
-                                    f"got {len(value)}", interface="realtime",
-                                    offset=layout.offset(item.name))
-            values.extend(float(v) for v in value)
-    size = layout.size + len(state.tail)
-    if size > MAX_SIZE:
-        raise ProtocolError(f"packet of {size} bytes exceeds {MAX_SIZE}", interface="realtime")
-    return _HEADER.pack(size) + layout.struct.pack(*values) + state.tail
+                                "is not set", interface="realtime", offset=offset)
+        try:
+            if item.count == 1:
+                values.append(float(value))
+                continue
+            count = len(value)
+            if count == item.count:
+                values.extend(float(v) for v in value)
+                continue
+        except (TypeError, ValueError, OverflowError):
+            raise ProtocolError(f"field {item.name} needs {_numbers(item.count)}, got "
+                                f"{value!r:.80}", interface="realtime", offset=offset) from None
+        raise ProtocolError(f"field {item.name} needs {item.count} values, got {count}",
+                            interface="realtime", offset=offset)
+    return _HEADER.pack(layout.size + len(tail)) + layout.struct.pack(*values) + tail
+
+
+def _numbers(count: int) -> str:
+    return "a number" if count == 1 else f"{count} numbers"
+
+
+def _carried_fallback(layout: RealtimeLayout,
+                      carried: Mapping[str, Callable[[Any], object]]) -> Callable[[Any], bytes]:
+    def zero(item: RealtimeField) -> object:
+        return 0.0 if item.count == 1 else (0.0,) * item.count
+
+    zeros = {item.name: zero(item) for item in layout.table}
+    return lambda s: _pack_checked(
+        layout, lambda name: carried[name](s) if name in carried else zeros[name], b"")
 
 
 class RealtimeDecoder:

@@ -56,8 +56,8 @@ from typing import Any
 
 import numpy as np
 
+from ..protocol.script_framing import ScriptFramer
 from ..script.diagnostics import ScriptError, ScriptSyntaxError
-from .framing import ScriptFramer
 from .state import (
     ControllerMessage,
     ControllerVersion,

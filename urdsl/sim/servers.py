@@ -31,16 +31,17 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
+from ..protocol.errors import ProtocolError
+from ..protocol.primary import PrimaryServer
+from ..protocol.script_framing import ScriptFramer
 from .dashboard import WELCOME, DashboardSession
-from .rtde import InputOwners, RtdeProtocolError, RtdeSession
+from .rtde import InputOwners, RtdeSession
 from .state import ControllerMessage, Snapshot
 from .wire import (
-    encode_realtime,
+    encode_controller_message,
     encode_robot_state,
-    encode_runtime_exception,
-    encode_safety_message,
-    encode_text_message,
     encode_version_message,
+    realtime_encoder,
 )
 
 __all__ = ["SimServers", "STANDARD_PORTS"]
@@ -62,8 +63,9 @@ MAX_CLIENTS = 64
 DROPS_KEPT = 1000
 """Reasons of the latest dropped connections kept in :attr:`SimServers.dropped`."""
 
-STATE_PERIOD = 0.1
-"""Primary/secondary robot state period (s of wall time): 10 Hz on CB3 and e-Series."""
+_PRIMARY = frozenset(("primary", "secondary", "primary_ro", "secondary_ro"))
+"""The interfaces served by :class:`urdsl.protocol.primary.PrimaryServer` (robot state at
+10 Hz of wall time, robot messages on the primary ones)."""
 
 
 @dataclass
@@ -86,8 +88,7 @@ class _Client:
         self.closed = False
         self.dropped_for = ""
         self.session: Any = None
-        self.framer = None
-        self.last_state = 0.0
+        self.framer: ScriptFramer | None = None  # cuts the script text of 30001-30003
         self.writing = False
         self.registered = False  # direct writes only once the connection's first
         # messages are out and the network thread knows it
@@ -159,7 +160,7 @@ class SimServers:
         self._woken = False
         self._closing = threading.Event()
         self._thread: threading.Thread | None = None
-        self._last_state_time = 0.0
+        self._encode_realtime = realtime_encoder(controller.version)
         self.owns_controller = False
 
     # ---- life cycle ----------------------------------------------------------------------
@@ -261,9 +262,6 @@ class SimServers:
         """Clock thread: queue realtime packets, due RTDE packages, and the 10 Hz state."""
         now = time.monotonic()
         realtime = None
-        state_due = now - self._last_state_time >= STATE_PERIOD
-        if state_due:
-            self._last_state_time = now
         state = None
         for client in list(self._clients):
             if client.closed:
@@ -271,7 +269,7 @@ class SimServers:
             kind = client.kind
             if kind in ("realtime", "realtime_ro"):
                 if realtime is None:
-                    realtime = encode_realtime(snap, self.sim.version)
+                    realtime = self._encode_realtime(snap)
                 client.send(realtime)
             elif kind == "rtde":
                 session: RtdeSession = client.session
@@ -287,17 +285,19 @@ class SimServers:
                     continue
                 if data is not None:
                     client.send(data)
-            elif kind != "dashboard" and state_due:
-                if state is None:
+            elif kind in _PRIMARY and client.session.state_due(now):
+                if state is None:  # encoded once: the sessions share one 10 Hz grid
                     state = encode_robot_state(snap, self.sim.version)
                 client.send(state)
 
     def _on_message(self, message: ControllerMessage) -> None:
         """Any thread: robot messages go to the primary interface (30001, 30011)."""
-        data = _encode_message(message)
+        data = encode_controller_message(message)
         for client in list(self._clients):
-            if client.kind in ("primary", "primary_ro"):
-                client.send(data)
+            if client.kind in _PRIMARY:
+                out = client.session.robot_message(data)
+                if out:
+                    client.send(out)
 
     # ---- the network thread --------------------------------------------------------------
 
@@ -387,15 +387,18 @@ class SimServers:
             client.send((WELCOME + "\n").encode())
         elif kind == "rtde":
             client.session = RtdeSession(sim.version, sim.env, self.owners, sim.frequency)
-        else:
-            if kind in ("primary", "secondary", "realtime"):
-                client.framer = sim.framer()
-            if kind in ("primary", "secondary", "primary_ro", "secondary_ro"):
-                snap = sim.snapshot()
-                client.send(encode_version_message(sim.version, snap.time))
-                client.send(encode_robot_state(
-                    snap, sim.version, sim.spec, (sim.kinematics.qd_max, sim.q_min, sim.q_max)
-                    if hasattr(sim.kinematics, "qd_max") else None, configuration=True))
+        elif kind in _PRIMARY:
+            snap = sim.snapshot()
+            client.session = PrimaryServer(encode_version_message(sim.version, snap.time),
+                                           interface=kind.removesuffix("_ro"),
+                                           read_only=kind.endswith("_ro"))
+            client.send(client.session.greeting(encode_robot_state(
+                snap, sim.version, sim.spec, (sim.kinematics.qd_max, sim.q_min, sim.q_max)
+                if hasattr(sim.kinematics, "qd_max") else None, configuration=True),
+                now=time.monotonic()))
+            client.framer = client.session.framer
+        elif kind == "realtime":
+            client.framer = ScriptFramer(interface="realtime")
         # only now may the clock and the message publisher add to its stream: the version
         # message must come first
         self._clients.add(client)
@@ -428,12 +431,11 @@ class SimServers:
                     reply = client.session.receive(data)
                 if reply:
                     client.send(reply)
-            elif client.framer is not None:
+            elif client.framer is not None:  # script text; read-only ports ignore it
                 origin = f"<{kind} {self.ports.get(kind, 0)}>"
                 for chunk in client.framer.feed(data):
                     self.sim.submit_chunk(chunk.kind, chunk.text, origin)
-            # read-only ports ignore what they receive
-        except RtdeProtocolError as error:
+        except ProtocolError as error:  # a broken RTDE framing, a program over the limit
             self._drop(client, f"protocol error: {error}")
         except ValueError as error:
             self._drop(client, f"bad input: {error}")
@@ -502,20 +504,3 @@ class SimServers:
                 client.sock.close()
             except OSError:
                 pass
-
-
-def _encode_message(message: ControllerMessage) -> bytes:
-    import re
-
-    if message.kind == "runtime_exception":
-        return encode_runtime_exception(message.line, message.column, message.text,
-                                             message.time)
-    if message.kind == "safety":
-        match = re.match(r"C(\d+)A(\d+)", message.text)
-        code, argument = (int(match.group(1)), int(match.group(2))) if match else (0, 0)
-        from .state import SafetyMode
-
-        return (encode_safety_message(code, argument, SafetyMode.PROTECTIVE_STOP,
-                                           message.time)
-                + encode_text_message(message.text, message.time))
-    return encode_text_message(message.text, message.time)
