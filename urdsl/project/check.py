@@ -158,9 +158,9 @@ def _settled(script, name: str, statement: n.Stmt | None) -> bool:
     """Whether a global of a file that neither includes this one nor is included by it has a
     value known here: given once in that file, by a constant expression (``global speed =
     0.25``, at its first level or in a function; a name in it is such a global too). A global
-    the other file sets again, or
-    computes from the arm or a device (``init_pos = get_actual_tcp_pose()`` after the
-    operator placed the arm), holds whatever that file's run left in it: unknown offline."""
+    the other file sets again, or computes from the arm or a device (``init_pos =
+    get_actual_tcp_pose()`` after the operator placed the arm), holds whatever that file's
+    run left in it: unknown offline."""
     return _settled_in(script, name, statement, frozenset())
 
 

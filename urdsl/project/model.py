@@ -253,9 +253,9 @@ class Project:
                     found += [p for p in _listing(above) if _key(p) not in keys]
         else:
             root = path.parent if str(path.parent) else Path(".")
-            found = _tree(root, MAX_TREE_FILES + 1)
-            if len(found) > MAX_TREE_FILES:  # a home or temporary folder, not a project
-                found = _listing(root)
+            # the folder's tree, or the folder alone when the tree is too large for a
+            # project (a home or temporary folder)
+            found = _bounded_tree(root, MAX_TREE_FILES) or _listing(root)
             if path.is_file() and _key(path) not in {_key(p) for p in found}:
                 found.append(path)
             above = _host_folder(path, found)
@@ -271,8 +271,8 @@ class Project:
                     found += [p for p in _listing(beside) if _key(p) not in keys]
             if above is not None:  # the program that includes the file is further up
                 root = above
-                tree = _tree(above, MAX_TREE_FILES + 1)
-                if len(tree) <= MAX_TREE_FILES:
+                tree = _bounded_tree(above, MAX_TREE_FILES)
+                if tree is not None:
                     found = tree
                 else:
                     keys = {_key(p) for p in found}
@@ -371,10 +371,14 @@ MAX_TREE_VISITS = 50_000
 """Entries a bounded tree search looks at before it stops (a home folder is no project)."""
 
 
-def _tree(folder: Path, limit: int | None = None) -> list[Path]:
-    """The project files in ``folder``'s tree (hidden folders left out), at most ``limit``;
-    with a ``limit``, the search also stops after :data:`MAX_TREE_VISITS` entries and then
-    returns ``limit`` + 1 files' worth of "too many" (more than ``limit`` paths)."""
+def _tree(folder: Path) -> list[Path]:
+    """The project files in ``folder``'s tree (hidden folders left out)."""
+    return _bounded_tree(folder, None) or []
+
+
+def _bounded_tree(folder: Path, limit: int | None) -> list[Path] | None:
+    """:func:`_tree`, or None when it holds more than ``limit`` project files or the search
+    meets more than :data:`MAX_TREE_VISITS` entries first (a home or temporary folder)."""
     if not folder.is_dir():
         return []
     found: list[Path] = []
@@ -383,12 +387,12 @@ def _tree(folder: Path, limit: int | None = None) -> list[Path]:
         for p in folder.rglob("*"):
             visited += 1
             if limit is not None and visited > MAX_TREE_VISITS:
-                return found + [folder] * (limit + 1 - len(found))  # too large: no project
+                return None
             if _wanted(p) and not any(part.startswith(".")
                                       for part in p.parts[len(folder.parts):]):
                 found.append(p)
-                if limit is not None and len(found) >= limit:
-                    break
+                if limit is not None and len(found) > limit:
+                    return None
     return sorted(found)
 
 
