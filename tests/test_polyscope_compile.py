@@ -289,4 +289,24 @@ def test_safe_home_moves_to_the_installations_position():
     text = compile_program(program, installation).text
     assert "movej([0.1, -1.5, 1.5, -1.5, -1.5, 0.0], a=1.4, v=1.05)" in text
     with pytest.raises(CompileError, match="safe home position is unknown"):
-        compile_program(program)
+        compile_program(program, parse_installation(b"<Installation/>", "i"))
+
+
+def test_safe_home_without_the_installation_is_a_warning_of_lint(tmp_path, capsys):
+    # the program is valid with its installation; the repository lacks the installation
+    from urdsl.polyscope.compile import MissingInstallation
+    from urdsl.polyscope.urp import parse_urp
+
+    text = (b'<URProgram name="p" lastSavedIn="5.11.1" installation="default"><children>'
+            b'<MainProgram runOnlyOnce="true"><children><Move motionType="MoveJ" speed="1.0" '
+            b'acceleration="1.4"><children><SafeHome positionOptionType='
+            b'"SPEED_AND_ACCELERATION" speed="1.05" acceleration="1.4"/></children></Move>'
+            b'</children></MainProgram></children></URProgram>')
+    with pytest.raises(MissingInstallation, match="installation the program names"):
+        compile_program(parse_urp(text, "p.urp"))
+    (tmp_path / "p.urp").write_bytes(text)
+    status = main(["lint", str(tmp_path / "p.urp")])
+    out = capsys.readouterr().out
+    assert status == 0
+    assert "warning" in out.lower() or "URS001 not linted" in out
+    assert "not linted: node Robot Program > MoveJ > SafeHome" in out

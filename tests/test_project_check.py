@@ -239,3 +239,18 @@ def test_a_few_common_lines_spread_over_a_program_do_not_make_it_a_host(tmp_path
     project = Project.discover(tmp_path / "endless.script")
     assert [h.filename for h in project.context(
         tmp_path / "endless.script", text, "endless.script").hosts] != []
+
+
+def test_a_fragment_that_reads_a_host_variable_before_it_sets_it_takes_the_hosts(
+        tmp_path, capsys):
+    # the fragment tests the host's flag first and clears it later: its first read is the
+    # host's value, not an undefined name
+    (tmp_path / "host.script").write_text(
+        'def host():\n  $ 1 "Robot Program"\n  run_program = True\n'
+        '  $ 2 "Script: step.script"\n  if run_program:\n    textmsg("step")\n  end\n'
+        "  run_program = False\nend\n")
+    (tmp_path / "step.script").write_text(
+        'if run_program:\n  textmsg("step")\nend\nrun_program = False\n')
+    status, report = check(capsys, str(tmp_path / "step.script"))
+    assert status == 0, report["findings"]
+    assert "run_program" in report["context"]

@@ -351,3 +351,13 @@ def test_hint_for_threads_with_parameters():
 def test_format_single_nodes():
     assert format(expr("a+b*(c)")) == "a + b * (c)"
     assert format(only("if a:\n x=1\nend")) == "if a:\n  x = 1\nend"
+
+
+def test_a_lone_cr_inside_a_comment_of_an_lf_file_is_part_of_the_comment():
+    # the OnRobot URCap's preamble comment, as PolyScope writes it into every program
+    text = "x = 1\n#======    OnRobot FT Search Part\r    ======#\ny = x\n"
+    tree = parse(text, filename="onrobot.script")
+    assert format(tree) == text
+    # in a file of CR-only lines, a CR still ends the comment
+    classic = "x = 1\r# note\ry = x\r"
+    assert [type(item).__name__ for item in parse(classic).body][-1] == "Assign"

@@ -116,3 +116,33 @@ def test_user_joint_limits(files, capsys):
     assert {f["code"] for f in report["findings"]} == {"URS303"}  # one per move
     assert [f["line"] for f in report["findings"]] == [1, 3, 4]
     assert "wrist 3" in report["findings"][0]["message"]
+
+
+def test_a_program_that_starts_where_the_arm_was_left(tmp_path, capsys):
+    # no start pose given or inferred (no taught waypoints): the arm stands wherever it was
+    # left, so a circle drawn around where it stands is not checked against the default
+    # start; given a start, it is
+    path = tmp_path / "around.script"
+    path.write_text("centre = get_target_tcp_pose()\n"
+                    "movel(pose_add(centre, p[0, 0, -1.5, 0, 0, 0]), a=1.2, v=0.25)\n")
+    status = main(["check", str(path), "--json", "--no-project"])
+    report = json.loads(capsys.readouterr().out)
+    assert status == 0, report["findings"]
+    (note,) = [f for f in report["findings"] if f["code"] == "URS210"]
+    assert "the program starts" in note["message"]
+    status = main(["check", str(path), "--json", "--no-project",
+                   "--start-joints", "0,-1.9,1.9,-1.57,-1.57,0"])
+    report = json.loads(capsys.readouterr().out)
+    assert status == 1
+    assert [f["code"] for f in report["findings"] if f["severity"] == "error"] == ["URS301"]
+
+
+def test_a_torque_loop_on_unknown_values_still_takes_a_frame_per_turn(tmp_path, capsys):
+    path = tmp_path / "torque.script"
+    path.write_text("while True:\n"
+                    "  torques = [read_input_float_register(0), 0, 0, 0, 0, 0]\n"
+                    "  direct_torque(torques)\nend\n")
+    status = main(["check", str(path), "--json", "--no-project", "--max-time", "2"])
+    report = json.loads(capsys.readouterr().out)
+    assert status == 0, report["findings"]
+    assert "URS207" not in [f["code"] for f in report["findings"]]

@@ -630,7 +630,7 @@ def test_the_path_of_a_move_from_where_an_unknown_move_left_the_arm_is_not_check
         """)
     assert "URS304" not in report.codes(), report.render_text()
     (note,) = [f for f in report.findings if f.code == "URS210" and f.span.line == 4]
-    assert "move at line 3 to an unknown target" in note.message
+    assert "after the move at line 3 to an unknown target" in note.message
     assert "path is not checked" in note.message
 
 

@@ -232,7 +232,7 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         soften_urcap_names,
         urcap_diagnostics,
     )
-    from ..polyscope.compile import CompileError
+    from ..polyscope.compile import CompileError, MissingInstallation
     from ..polyscope.urp import UrpError
     from ..script.diagnostics import Diagnostic
     from .config import ConfigError, settings_for
@@ -247,6 +247,11 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         raise UsageError(str(error)) from None
     try:
         generated = generate(name)
+    except MissingInstallation as error:  # not a mistake of the program: a warning
+        text = str(error)
+        message = text.split(": node ", 1)[1] if ": node " in text else text
+        return [Diagnostic(name, 1, 1, "warning", "URS001",
+                           f"not linted: node {message}")]
     except (UrpError, CompileError) as error:
         text = str(error)
         message = text.split(": error: ", 1)[1] if ": error: " in text else text

@@ -177,15 +177,9 @@ class MotionPlanner:
         # spans of the movel/movep calls that a condition may stop before their target
         # (PolyScope's Direction node: :func:`urdsl.motion.direction.stoppable_moves`)
         self.stoppable: frozenset = frozenset()
-        # the span of the last move, if it was such a move cut where the arm could follow it:
-        # where the arm really stops depends on its condition (contact, an input)
-        self.stopped_at: Span | None = None
-        # the span of the last freedrive_mode()/teach_mode() since the last move: the
-        # operator has moved the arm by hand, where to is unknown offline
-        self.hand_moved_at: Span | None = None
-        # the span of the last move to an unknown target (not planned; the check's unknown
-        # device values): where the arm went is unknown
-        self.unknown_move_at: Span | None = None
+        # where the arm is, when something outside the program decided it (see
+        # :meth:`unknown_position`): what left it there, and that statement's span
+        self.unknown_at: tuple[str, Span] | None = None
         self._tcp: np.ndarray | None = None
         self._pending: Segment | None = None  # the last move, if it may still blend
         self._q_end = self.q_start.copy()  # joints at the end of the last resolved move
@@ -369,20 +363,15 @@ class MotionPlanner:
         profile = line_profile(pose_from, pose, v, a, t, v_rot, a_rot)
         end = self._add_cartesian(kind, profile, pose_from, pose, r, span, params, now)
         if params.get("until"):
-            self.stopped_at = span  # where the arm ends depends on the condition
+            # where the arm ends depends on the condition
+            self.unknown_at = (f"the move at line {span.line}, which a condition stops", span)
         return end
 
-    def unknown_start(self) -> str | None:
-        """What left the arm where it is, when that place is unknown offline (a move that a
-        condition stopped, the operator's hand in freedrive, a move to an unknown target);
-        None when the arm is where the planned moves put it."""
-        if self.stopped_at is not None:
-            return f"the move at line {self.stopped_at.line}, which a condition stops,"
-        if self.hand_moved_at is not None:
-            return f"freedrive at line {self.hand_moved_at.line}"
-        if self.unknown_move_at is not None:
-            return f"the move at line {self.unknown_move_at.line} to an unknown target"
-        return None
+    def unknown_position(self, why: str, span: Span) -> None:
+        """From now on the arm stands where something outside the program put it, unknown
+        offline, until a move to a known target: ``why`` says what (``"freedrive at line
+        12, where the operator moves the arm by hand"``), ``span`` is that statement."""
+        self.unknown_at = (why, span)
 
     def _far(self, pose: np.ndarray) -> bool:
         """Whether a target (4x4) lies further from the base than :data:`FAR_TARGET` times
@@ -585,11 +574,9 @@ class MotionPlanner:
     # ---- planning --------------------------------------------------------------------------
 
     def _add(self, segment: Segment, now: float) -> float:
-        start = self.unknown_start()
-        if start is not None:  # its path from there is not known; its target is
-            segment.params["from_unknown"] = start
-        # a move to a known target: the arm's position is known again
-        self.stopped_at = self.hand_moved_at = self.unknown_move_at = None
+        if self.unknown_at is not None:  # its path from there is not known; its target is
+            segment.params["from_unknown"] = self.unknown_at[0]
+        self.unknown_at = None  # a move to a known target: the arm's position is known again
         previous = self._pending
         radius = segment.radius
         previous_radius = previous.radius if previous is not None else 0.0

@@ -94,6 +94,11 @@ class CompileError(Exception):
     """A program node that cannot be compiled; the message names the file and node path."""
 
 
+class MissingInstallation(CompileError):
+    """A node needs data of the program's installation (its safe home position), and the
+    installation the program names is not beside it: the program may well be right."""
+
+
 @dataclass
 class Compiled:
     """The result: ``module`` (the URScript tree), ``numbers`` (marker number → node) and
@@ -1322,6 +1327,10 @@ class _Compiler:
         """A move to the installation's safe home joint positions (rad)."""
         settings = (self.installation.settings or {}) if self.installation else {}
         position = settings.get("SafeHomeSettings", {}).get("position")
+        if not position and self.installation is None:
+            raise MissingInstallation(
+                f"{self.program.path}: node {node.path}: needs the installation's safe home "
+                "position, and the installation the program names is not beside it")
         if not position:
             raise self.error(node, "the installation's safe home position is unknown "
                                    "(no installation with SafeHomeSettings beside the program)")

@@ -52,11 +52,16 @@ def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
     calls: set[str] = set()
     threads: set[str] = set()
     for scope in analysis.scopes:
+        first_write = _first_writes(scope) if scope.kind == "top" else {}
         for name in scope.reads:
             # a name the controller may define itself (``pi``, [U]) is still looked up in the
             # project: a project that assigns it gives it the value the file reads
             if not analysis.defined(name.id, scope) or (
                     name.id in BUILTIN_VARIABLES and not _bound_in_file(analysis, name.id, scope)):
+                reads.add(name.id)
+            elif name.span.start < first_write.get(name.id, -1):
+                # read at the first level before the file's first write of it (``if
+                # run_program:`` ... ``run_program = False``): the value comes from the host
                 reads.add(name.id)
         for call in scope.calls:
             name = call.func.id  # type: ignore[union-attr]
@@ -68,6 +73,18 @@ def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
             if run.thread not in analysis.threads:
                 threads.add(run.thread)
     return reads, calls, threads
+
+
+def _first_writes(scope) -> dict[str, int]:
+    """Where (character offset) the first level of a file first writes each variable it
+    assigns without declaring it (``x = 1``; a ``global``/``local`` declaration binds the name
+    from the start)."""
+    found: dict[str, int] = {}
+    for name, nodes in scope.assigned.items():
+        if name in scope.declared_global or name in scope.declared_local:
+            continue
+        found[name] = min(node.span.start for node in nodes)
+    return found
 
 
 def _bound_in_file(analysis, name: str, scope) -> bool:

@@ -224,28 +224,17 @@ def _stop(rt, node, a, aRot="a"):  # noqa: N803
 
 def _stopped_by_condition(rt, arm) -> Unknown | None:
     """Where the arm is when something outside the program decided it, unknown offline
-    until a move to a known target:
-
-    - after a move that a condition stops (PolyScope's Direction node: until tool contact,
-      an input), where the arm is depends on that condition;
-    - after ``freedrive_mode()`` or ``teach_mode()`` the operator moves the arm by hand
-      (PolyScope programs put the tool "close to the corner" this way, behind a popup that
-      says so), and it stays where they left it after ``end_freedrive_mode()``."""
-    if not rt.unknown:
+    until a move to a known target (:meth:`urdsl.motion.planner.MotionPlanner.unknown_position`):
+    after a move that a condition stops (PolyScope's Direction node: until tool contact, an
+    input); after ``freedrive_mode()`` or ``teach_mode()``, when the operator moves the arm by
+    hand (PolyScope programs put the tool "close to the corner" this way, behind a popup that
+    says so); after a move to an unknown target; at the start of a program that starts
+    wherever the arm was left."""
+    unknown_at = getattr(arm, "unknown_at", None)
+    if unknown_at is None or not rt.unknown:
         return None
-    span = getattr(arm, "stopped_at", None)
-    if span is not None:
-        return Unknown(f"the arm's position after the move at line {span.line}, which a "
-                       "condition stops", span)
-    span = getattr(arm, "hand_moved_at", None)
-    if span is not None:
-        return Unknown(f"the arm's position after freedrive at line {span.line}, where "
-                       "the operator moves the arm by hand", span)
-    span = getattr(arm, "unknown_move_at", None)
-    if span is not None:
-        return Unknown(f"the arm's position after the move at line {span.line} to an "
-                       "unknown target", span)
-    return None
+    why, span = unknown_at
+    return Unknown(f"the arm's position after {why}", span)
 
 
 @implements("freedrive_mode", "teach_mode", "freedrive_mode_no_incorrect_payload_check")
@@ -253,7 +242,8 @@ def _freedrive(rt, node, **_arguments):
     """The arm is free to be moved by hand: from now on where it is, is unknown offline
     until a move to a known target (:func:`_stopped_by_condition`)."""
     if rt.robot is not None:
-        rt.robot.hand_moved_at = node.span
+        rt.robot.unknown_position(f"freedrive at line {node.span.line}, where the operator "
+                                  "moves the arm by hand", node.span)
 
 
 @implements("end_freedrive_mode", "end_teach_mode")

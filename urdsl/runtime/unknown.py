@@ -176,8 +176,12 @@ _STORES = frozenset({
 """Builtins that store an unknown value where the program reads it back unknown."""
 
 
+_FRAME_COMMANDS = ("servo", "speed", "direct_torque")
+"""Control commands that last one controller frame (a control loop's step)."""
+
+
 def _is_motion(name: str) -> bool:
-    return name.startswith(("move", "servo", "speed")) or name in ("stopj", "stopl")
+    return name.startswith(("move", *_FRAME_COMMANDS)) or name in ("stopj", "stopl")
 
 
 def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, node: Any,
@@ -198,14 +202,15 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
     if kind == "motion":
         # a servo or speed command lasts a controller frame; a move is taken as
         # UNCHECKED_MOVE_TIME
-        frame = name.startswith(("servo", "speed"))
+        frame = name.startswith(_FRAME_COMMANDS)
         took = f"{rt.config.step_time:g}" if frame else f"{UNCHECKED_MOVE_TIME:g}"
         rt.warn_once(f"this move depends on {found.source}, which is unknown offline; the "
                      f"move is not checked (taken as {took} s)", node)
         if rt.robot is not None:
             rt.robot.stop_blending(rt.time)
             # where the arm went is unknown until a move to a known target
-            rt.robot.unknown_move_at = node.span
+            rt.robot.unknown_position(f"the move at line {node.span.line} to an unknown "
+                                      "target", node.span)
         if frame:
             rt.sync()
         else:

@@ -75,11 +75,22 @@ class Lexer:
         if missing:  # pragma: no cover - grammar and lexer out of step
             raise ValueError(f"lexer: grammar lacks terminals {missing}")
         ops = "|".join(re.escape(op) for op in sorted(operators, key=len, reverse=True))
-        parts = [f"(?P<{name}>{patterns[name]})" for name in _REGEX_TERMINALS]
-        parts += [f"(?P<OP>{ops})", r"(?P<ERROR>[^ \t\f\r\n\v])"]
-        # Each match is the white space before a token (group 1) and the token: one match
-        # per token, and white space costs no loop turn of its own.
-        self._regex = re.compile(r"([ \t\f\r\n\v]*)(?:" + "|".join(parts) + ")", re.DOTALL)
+
+        def scanner(comment: str) -> re.Pattern[str]:
+            parts = [f"(?P<{name}>{comment if name == 'COMMENT' else patterns[name]})"
+                     for name in _REGEX_TERMINALS]
+            parts += [f"(?P<OP>{ops})", r"(?P<ERROR>[^ \t\f\r\n\v])"]
+            # Each match is the white space before a token (group 1) and the token: one
+            # match per token, and white space costs no loop turn of its own.
+            return re.compile(r"([ \t\f\r\n\v]*)(?:" + "|".join(parts) + ")", re.DOTALL)
+
+        self._regex = scanner(patterns["COMMENT"])
+        # In a file whose lines end with LF (or CRLF), a lone CR inside a comment is part of
+        # the comment: PolyScope writes the OnRobot URCap's preamble comment
+        # "#======    OnRobot FT Search Part<CR>    ======#" into every program that uses
+        # it, and the controller runs those programs [U]. A file of CR-only lines (classic
+        # Mac) still ends its comments at a CR.
+        self._regex_lf = scanner(r"#(?:[^\r\n]|\r(?!\n))*")
         self.keywords = keywords
         self.operators = operators
 
@@ -93,7 +104,8 @@ class Lexer:
         operators = self.operators
         last_end = -1  # end of the last token that is not a comment; -1 before the first
         # A UTF-8 byte-order mark (editors on Windows write one) is no token.
-        for match in self._regex.finditer(text, 1 if text.startswith("\ufeff") else 0):
+        regex = self._regex_lf if "\n" in text else self._regex
+        for match in regex.finditer(text, 1 if text.startswith("\ufeff") else 0):
             kind = match.lastgroup
             start = match.end(1)
             end = match.end()

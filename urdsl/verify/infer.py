@@ -516,7 +516,8 @@ def apply(options: CheckOptions, inference: Inference, tcp_given: bool) -> Check
     """``options`` with the inferred robot and start joints (and the installation's TCP as the
     TCP before the program sets one, unless ``--tcp`` was given)."""
     changes: dict[str, Any] = {"robot": inference.robot,
-                               "start_joints": inference.start_joints}
+                               "start_joints": inference.start_joints,
+                               "start_unknown": inference.start_source == "default"}
     if not tcp_given and inference.tcp is not None and inference.tcp_from.startswith("TCP "):
         changes["tcp"] = inference.tcp
     return replace(options, **changes)

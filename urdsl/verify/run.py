@@ -122,6 +122,11 @@ class CheckOptions:
     joint_speed_limit: tuple[float, ...] | None = None
     """Joint speed limits [rad/s] set for the cell (a PolyScope installation's), below the
     model's."""
+    start_unknown: bool = False
+    """Whether the program starts wherever the arm was left (no start pose given with
+    ``start_joints`` or inferred from the program): then ``start_joints`` is only where the
+    simulated arm stands, and what the program reads of the arm's position before its first
+    move to a known target is unknown, as is that move's path."""
     unknown_globals: dict[str, str] = field(default_factory=dict)
     """Globals the program reads that something outside it defines (a URCap node's code):
     name → where the value comes from; each holds an unknown value."""
@@ -181,6 +186,9 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     step = 0.008 if cb3 else 0.002
     planner = MotionPlanner(robot, options.start_joints, step_time=step, lazy_ik=True)
     planner.stoppable = stoppable_moves(module)  # Direction nodes: moves until a condition
+    if options.start_unknown:
+        planner.unknown_position("the program starts (where the arm was left: no start pose "
+                                 "given or inferred; --start-joints sets one)", module.span)
     if options.tcp is not None:
         planner.tcp = np.asarray(options.tcp, dtype=float)
     deadline = None if options.timeout is None else started + RUN_SHARE * options.timeout
@@ -305,8 +313,10 @@ def _assigned(module, name: str) -> bool:
     return False
 
 
-PATH_CODES = frozenset({"URS302", "URS303", "URS304", "URS305", "URS306", "URS307", "URS308"})
-"""Findings about the way a move goes (not its target), which depend on where it starts."""
+PATH_CODES = frozenset({"URS302", "URS304", "URS305", "URS306", "URS307", "URS308"})
+"""Findings about the way a move goes (not its target), which depend on where it starts.
+A joint position limit (URS303) is not among them: a movej interpolates the joints, so only
+its ends can pass a limit, and the target's joints are what the controller would command."""
 
 
 def _from_unknown_start(findings: list[Finding], planner) -> list[Finding]:
@@ -329,10 +339,10 @@ def _from_unknown_start(findings: list[Finding], planner) -> list[Finding]:
         if segment.span not in noted:
             noted.add(segment.span)
             kept.append(Finding.of(
-                "URS210", f"this move starts where {segment.params['from_unknown']} left "
-                "the arm, which is unknown offline: its path is not checked, its target is "
-                f"({finding.code} on the path drawn from where the arm was last known is not "
-                "reported)", segment.span, segment.start))
+                "URS210", "this move starts from the arm's position after "
+                f"{segment.params['from_unknown']}, which is unknown offline: its path is not "
+                f"checked, its target is ({finding.code} on the path drawn from where the arm "
+                "was last known is not reported)", segment.span, segment.start))
     return kept
 
 
