@@ -334,3 +334,38 @@ def test_polyscope_3_5_tcp_settings_and_tool_voltage():
     assert blocks["tcp"] == ["set_tcp(p[0.0, 0.0, 0.0, 0.0, 2.2217, -2.218])"]
     assert blocks["payload"] == ["set_payload(1.6)"]
     assert blocks["tool"] == ["set_tool_voltage(0)"]
+
+
+def _line_installation(first, second, axis) -> bytes:
+    points = (_point("firstPoint", first, axis) + _point("secondPoint", second, axis))
+    return f"""<Installation><Version major="5" minor="11" bugfix="0"/><Features>
+  <GeomLineNode><GeomLineNode name="Edge" isVariable="true">{points}</GeomLineNode>
+  </GeomLineNode>
+  <GeomLineNode><GeomLineNode name="Untaught" isVariable="true">
+    {_point("firstPoint", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))}
+    {_point("secondPoint", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))}</GeomLineNode>
+  </GeomLineNode></Features></Installation>""".encode()
+
+
+def test_a_line_feature_is_placed_as_polyscope_places_it():
+    """Origin at the first point, y along the line, z the taught tool's z made
+    perpendicular to the line: a line along +x taught with the tool pointing down (and a
+    little along the line) has y = +x, z = -z, x = y × z = +y."""
+    tilt = 0.2  # the tool tilted about y: its z has a component along the line
+    installation = parse_installation(
+        _line_installation((0.3, -0.1, 0.05), (0.7, -0.1, 0.05), (0.0, math.pi - tilt, 0.0)),
+        "cell.installation")
+    features = dict(installation.features)
+    pose = features["Edge"]
+    assert pose[:3] == pytest.approx((0.3, -0.1, 0.05))
+    # the rotation with columns x = (0, 1, 0), y = (1, 0, 0), z = (0, 0, -1): a half
+    # turn about (1, 1, 0)/√2
+    half = math.pi / math.sqrt(2)
+    assert [abs(v) for v in pose[3:]] == pytest.approx([half, half, 0.0], abs=1e-9)
+    assert pose[3] * pose[4] > 0
+    # a line never taught (both points zero) is the zero pose, as PolyScope writes it
+    assert features["Untaught"] == pytest.approx((0.0,) * 6)
+    blocks = _blocks(_urp("5.11.0"), _line_installation(
+        (0.3, -0.1, 0.05), (0.7, -0.1, 0.05), (0.0, math.pi, 0.0)))
+    assert [line.split(" =")[0] for line in blocks["features"]] == [
+        "global Edge", "global Untaught"]
