@@ -30,6 +30,8 @@ _IOS = """<IOs>
   <analogOutputDomain value="0, 1"/>
   <DigitalInputActions value="NONE, NONE, NONE, NONE, NONE, NONE, NONE, NONE"/>
   <ToolDigitalInputActions value="FREEDRIVE, NONE"/>
+  <GeneralPurposeBooleanRegisterInputActions value="START, STOP, PAUSE, NONE, NONE, NONE, NONE,
+    FREEDRIVE, NONE"/>
   <DigitalOutputActions value="LOW_WHEN_PROGRAM_STOPPED, NONE, NONE, LOW_WHEN_PROGRAM_STOPPED,
     NONE, NONE, NONE, NONE"/>
   <ConfigurableOutputActions value="NONE, NONE, LOW_WHEN_PROGRAM_STOPPED, NONE"/>
@@ -143,6 +145,8 @@ def test_polyscope_5_io_block(five):
         "set_tool_analog_input_domain(0, 1)", "set_tool_analog_input_domain(1, 1)",
         "set_analog_outputdomain(0, 0)", "set_analog_outputdomain(1, 1)",
         "set_input_actions_to_default()", 'set_tool_digital_input_action(0, "freedrive")',
+        # a general purpose register's freedrive; start, stop and pause write nothing
+        'set_gp_boolean_input_action(7, "freedrive")',
         "set_runstate_standard_digital_outputs([0, 3])",
         "set_runstate_configurable_digital_outputs([2])",
         "set_runstate_standard_digital_output_to_value(0, 1)",
