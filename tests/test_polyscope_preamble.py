@@ -373,3 +373,22 @@ def test_a_line_feature_is_placed_as_polyscope_places_it():
         (0.3, -0.1, 0.05), (0.7, -0.1, 0.05), (0.0, math.pi, 0.0)))
     assert [line.split(" =")[0] for line in blocks["features"]] == [
         "global Edge", "global Untaught"]
+
+
+def test_a_plane_a_hair_off_a_half_turn_is_written_as_polyscope_writes_it():
+    """Near a half turn PolyScope takes the angle from the acos of the trace and the axis
+    from the symmetric part of the rotation (reproduced to the last digit on a real plane:
+    eggsu/comp4320_ass2 assignment.installation, ``letter_start``). A plane whose second
+    point is 1 nm higher, taught pointing down: the rotation's columns are x = (0, 1, 0),
+    y = (1, 0, 1e-9), z = (1e-9, 0, -1); its trace is -1 (angle π) and the symmetric
+    part's axis (1, 1, 1e-9/2)/√2 gives z = π·1e-9/(2√2) (the column alone gives 0)."""
+    points = ((0.0, 0.0, 0.0), (1.0, 0.0, 1e-9), (0.0, 1.0, 0.0))
+    plane = "".join(_point(tag, p) for tag, p in zip(
+        ("firstPoint", "secondPoint", "thirdPoint"), points, strict=True))
+    data = f"""<Installation><Version major="5" minor="10" bugfix="0"/><Features>
+  <GeomPlaneNode><GeomPlaneNode name="Sheet" isVariable="true">{plane}</GeomPlaneNode>
+  </GeomPlaneNode></Features></Installation>""".encode()
+    pose = dict(parse_installation(data, "cell.installation").features)["Sheet"]
+    half = math.pi / math.sqrt(2)
+    assert pose[3:5] == pytest.approx((half, half), abs=1e-12)
+    assert pose[5] == pytest.approx(math.pi * 1e-9 / (2 * math.sqrt(2)), abs=1e-15)

@@ -412,9 +412,14 @@ def _rotvec(m: list[list[float]]) -> tuple[float, float, float]:
     if angle < 1e-12:
         return (0.0, 0.0, 0.0)
     if math.pi - angle < 1e-6:
-        diag = [(m[i][i] + 1.0) / 2.0 for i in range(3)]
-        column = max(range(3), key=lambda i: diag[i])
-        vector = [(m[i][column] + (1.0 if i == column else 0.0)) / 2.0 for i in range(3)]
+        # as PolyScope (to the last digit: eggsu/comp4320_ass2's plane letter_start): the
+        # angle from the acos of the trace, the axis from the symmetric part
+        cos = min(1.0, max(-1.0, (m[0][0] + m[1][1] + m[2][2] - 1.0) / 2.0))
+        angle = math.acos(cos)
+        sym = [[((m[i][j] + m[j][i]) / 2.0 - (cos if i == j else 0.0)) / (1.0 - cos)
+                for j in range(3)] for i in range(3)]
+        column = max(range(3), key=lambda i: sym[i][i])
+        vector = [sym[i][column] for i in range(3)]
         norm = math.sqrt(sum(v * v for v in vector))
         vector = [v / norm for v in vector]
         if sum(a * b for a, b in zip(vector, axis, strict=True)) < 0:
