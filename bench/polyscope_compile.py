@@ -5,7 +5,9 @@ Pairs are listed in ``bench/polyscope/pairs.tsv`` (repository, commit, .urp path
 licence, split). Files are read from local git directories (``--repos DIR`` holding
 ``owner+name`` git dirs, as ``fetch`` leaves them: ``DIR/owner+name/repo`` or a bare git dir
 ``DIR/owner+name``); nothing is downloaded. The installation the program names is read from
-the same folder when it is there.
+the same folder when it is there, with its ``.variables``, as of the last commit that changed
+the .script (when PolyScope wrote it; an installation committed only after the .script as of
+the pair's commit; ``--installation pair`` reads both at the pair's commit).
 
 Both scripts are parsed and printed canonically, statement by statement: comments and URCap
 blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare to
