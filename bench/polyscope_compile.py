@@ -5,7 +5,9 @@ Pairs are listed in ``bench/polyscope/pairs.tsv`` (repository, commit, .urp path
 licence, split). Files are read from local git directories (``--repos DIR`` holding
 ``owner+name`` git dirs, as ``fetch`` leaves them: ``DIR/owner+name/repo`` or a bare git dir
 ``DIR/owner+name``); nothing is downloaded. The installation the program names is read from
-the same folder when it is there.
+the same folder when it is there, with its ``.variables``, as of the last commit that changed
+the .script (when PolyScope wrote it; an installation committed only after the .script as of
+the pair's commit; ``--installation pair`` reads both at the pair's commit).
 
 Both scripts are parsed and printed canonically, statement by statement: comments and URCap
 blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare to
@@ -356,6 +358,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="a Script node's file: read it from the repository as of the "
                              "commit that last wrote the .script (file), or take the copy "
                              "the .urp keeps (cache)")
+    parser.add_argument("--installation", choices=("saved", "pair"), default="saved",
+                        help="read the installation (and .variables) as of the commit that "
+                             "last wrote the .script (saved), or as of the pair's commit")
     parser.add_argument("--only", default="", help="only pairs whose .urp path contains this")
     args = parser.parse_args(argv)
 
@@ -389,8 +394,16 @@ def main(argv: list[str] | None = None) -> int:
             st["errors"][str(error).split("error: ", 1)[-1][:150]] += 1
             st["no_installation"]["the .urp does not read"] += 1
             continue
+        # the installation as it was when PolyScope wrote the .script (a later commit may
+        # hold an installation saved after it: GapeCobot/Soudure Cobot_soudure_28112023);
+        # one committed only after the .script (vicisnotokay/Devs-1, 66 s later) as of the
+        # pair's commit
+        saved = last_commit(gitdir, commit, script_path)
+        name = program.installation_path or program.installation
         installation, variables, absent = load_installation(
-            gitdir, commit, urp_path, program.installation_path or program.installation)
+            gitdir, saved if args.installation == "saved" else commit, urp_path, name)
+        if absent and saved != commit:
+            installation, variables, absent = load_installation(gitdir, commit, urp_path, name)
         if absent:
             st["no_installation"][absent] += 1
         else:
@@ -416,7 +429,6 @@ def main(argv: list[str] | None = None) -> int:
             continue
         try:
             folder = PurePosixPath(urp_path).parent
-            saved = last_commit(gitdir, commit, script_path)
 
             def files(relative: str, folder=folder, gitdir=gitdir, saved=saved):
                 return git_show(gitdir, saved, _join(folder, relative))

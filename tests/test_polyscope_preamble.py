@@ -30,6 +30,8 @@ _IOS = """<IOs>
   <analogOutputDomain value="0, 1"/>
   <DigitalInputActions value="NONE, NONE, NONE, NONE, NONE, NONE, NONE, NONE"/>
   <ToolDigitalInputActions value="FREEDRIVE, NONE"/>
+  <GeneralPurposeBooleanRegisterInputActions value="START, STOP, PAUSE, NONE, NONE, NONE, NONE,
+    FREEDRIVE, NONE"/>
   <DigitalOutputActions value="LOW_WHEN_PROGRAM_STOPPED, NONE, NONE, LOW_WHEN_PROGRAM_STOPPED,
     NONE, NONE, NONE, NONE"/>
   <ConfigurableOutputActions value="NONE, NONE, LOW_WHEN_PROGRAM_STOPPED, NONE"/>
@@ -143,6 +145,8 @@ def test_polyscope_5_io_block(five):
         "set_tool_analog_input_domain(0, 1)", "set_tool_analog_input_domain(1, 1)",
         "set_analog_outputdomain(0, 0)", "set_analog_outputdomain(1, 1)",
         "set_input_actions_to_default()", 'set_tool_digital_input_action(0, "freedrive")',
+        # a general purpose register's freedrive; start, stop and pause write nothing
+        'set_gp_boolean_input_action(7, "freedrive")',
         "set_runstate_standard_digital_outputs([0, 3])",
         "set_runstate_configurable_digital_outputs([2])",
         "set_runstate_standard_digital_output_to_value(0, 1)",
@@ -334,3 +338,57 @@ def test_polyscope_3_5_tcp_settings_and_tool_voltage():
     assert blocks["tcp"] == ["set_tcp(p[0.0, 0.0, 0.0, 0.0, 2.2217, -2.218])"]
     assert blocks["payload"] == ["set_payload(1.6)"]
     assert blocks["tool"] == ["set_tool_voltage(0)"]
+
+
+def _line_installation(first, second, axis) -> bytes:
+    points = (_point("firstPoint", first, axis) + _point("secondPoint", second, axis))
+    return f"""<Installation><Version major="5" minor="11" bugfix="0"/><Features>
+  <GeomLineNode><GeomLineNode name="Edge" isVariable="true">{points}</GeomLineNode>
+  </GeomLineNode>
+  <GeomLineNode><GeomLineNode name="Untaught" isVariable="true">
+    {_point("firstPoint", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))}
+    {_point("secondPoint", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))}</GeomLineNode>
+  </GeomLineNode></Features></Installation>""".encode()
+
+
+def test_a_line_feature_is_placed_as_polyscope_places_it():
+    """Origin at the first point, y along the line, z the taught tool's z made
+    perpendicular to the line: a line along +x taught with the tool pointing down (and a
+    little along the line) has y = +x, z = -z, x = y × z = +y."""
+    tilt = 0.2  # the tool tilted about y: its z has a component along the line
+    installation = parse_installation(
+        _line_installation((0.3, -0.1, 0.05), (0.7, -0.1, 0.05), (0.0, math.pi - tilt, 0.0)),
+        "cell.installation")
+    features = dict(installation.features)
+    pose = features["Edge"]
+    assert pose[:3] == pytest.approx((0.3, -0.1, 0.05))
+    # the rotation with columns x = (0, 1, 0), y = (1, 0, 0), z = (0, 0, -1): a half
+    # turn about (1, 1, 0)/√2
+    half = math.pi / math.sqrt(2)
+    assert [abs(v) for v in pose[3:]] == pytest.approx([half, half, 0.0], abs=1e-9)
+    assert pose[3] * pose[4] > 0
+    # a line never taught (both points zero) is the zero pose, as PolyScope writes it
+    assert features["Untaught"] == pytest.approx((0.0,) * 6)
+    blocks = _blocks(_urp("5.11.0"), _line_installation(
+        (0.3, -0.1, 0.05), (0.7, -0.1, 0.05), (0.0, math.pi, 0.0)))
+    assert [line.split(" =")[0] for line in blocks["features"]] == [
+        "global Edge", "global Untaught"]
+
+
+def test_a_plane_a_hair_off_a_half_turn_is_written_as_polyscope_writes_it():
+    """Near a half turn PolyScope takes the angle from the acos of the trace and the axis
+    from the symmetric part of the rotation (reproduced to the last digit on a real plane:
+    eggsu/comp4320_ass2 assignment.installation, ``letter_start``). A plane whose second
+    point is 1 nm higher, taught pointing down: the rotation's columns are x = (0, 1, 0),
+    y = (1, 0, 1e-9), z = (1e-9, 0, -1); its trace is -1 (angle π) and the symmetric
+    part's axis (1, 1, 1e-9/2)/√2 gives z = π·1e-9/(2√2) (the column alone gives 0)."""
+    points = ((0.0, 0.0, 0.0), (1.0, 0.0, 1e-9), (0.0, 1.0, 0.0))
+    plane = "".join(_point(tag, p) for tag, p in zip(
+        ("firstPoint", "secondPoint", "thirdPoint"), points, strict=True))
+    data = f"""<Installation><Version major="5" minor="10" bugfix="0"/><Features>
+  <GeomPlaneNode><GeomPlaneNode name="Sheet" isVariable="true">{plane}</GeomPlaneNode>
+  </GeomPlaneNode></Features></Installation>""".encode()
+    pose = dict(parse_installation(data, "cell.installation").features)["Sheet"]
+    half = math.pi / math.sqrt(2)
+    assert pose[3:5] == pytest.approx((half, half), abs=1e-12)
+    assert pose[5] == pytest.approx(math.pi * 1e-9 / (2 * math.sqrt(2)), abs=1e-15)

@@ -166,13 +166,15 @@ def _matrix_to_rotvec(m: np.ndarray) -> np.ndarray:
     if angle < 1e-12:
         return np.zeros(3)
     if math.pi - angle < 1e-6:
-        # near π the antisymmetric part vanishes: take the axis from the symmetric part,
-        # its largest component positive (as PolyScope writes a half turn [U: one project])
-        b = (m + np.eye(3)) / 2.0
+        # near π the antisymmetric part vanishes: as PolyScope, the angle from the acos of
+        # the trace (π - 1.5e-8 for a trace one rounding step above -1) and the axis from
+        # the symmetric part, its largest component positive (a half turn [U: one project])
+        cos = min(1.0, max(-1.0, (float(np.trace(m)) - 1.0) / 2.0))
+        exact, angle = angle, math.acos(cos)
+        b = ((m + m.T) / 2.0 - cos * np.eye(3)) / (1.0 - cos)
         column = int(np.argmax(np.diag(b)))
-        axis = b[:, column] / math.sqrt(b[column, column])
-        axis = axis / np.linalg.norm(axis)
-        if math.pi - angle > 1e-9 and float(axis @ np.array(
+        axis = b[:, column] / np.linalg.norm(b[:, column])
+        if math.pi - exact > 1e-9 and float(axis @ np.array(
                 [m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])) < 0:
             axis = -axis  # not quite a half turn: the antisymmetric part gives the sign
         return axis * angle

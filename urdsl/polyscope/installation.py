@@ -412,9 +412,14 @@ def _rotvec(m: list[list[float]]) -> tuple[float, float, float]:
     if angle < 1e-12:
         return (0.0, 0.0, 0.0)
     if math.pi - angle < 1e-6:
-        diag = [(m[i][i] + 1.0) / 2.0 for i in range(3)]
-        column = max(range(3), key=lambda i: diag[i])
-        vector = [(m[i][column] + (1.0 if i == column else 0.0)) / 2.0 for i in range(3)]
+        # as PolyScope (to the last digit: eggsu/comp4320_ass2's plane letter_start): the
+        # angle from the acos of the trace, the axis from the symmetric part
+        cos = min(1.0, max(-1.0, (m[0][0] + m[1][1] + m[2][2] - 1.0) / 2.0))
+        angle = math.acos(cos)
+        sym = [[((m[i][j] + m[j][i]) / 2.0 - (cos if i == j else 0.0)) / (1.0 - cos)
+                for j in range(3)] for i in range(3)]
+        column = max(range(3), key=lambda i: sym[i][i])
+        vector = [sym[i][column] for i in range(3)]
         norm = math.sqrt(sum(v * v for v in vector))
         vector = [v / norm for v in vector]
         if sum(a * b for a, b in zip(vector, axis, strict=True)) < 0:
@@ -444,6 +449,30 @@ def _plane(points: list[tuple[float, ...]]) -> tuple[float, ...] | None:
     return tuple(p1) + _rotvec(matrix)
 
 
+def _line(points: list[tuple[float, ...]]) -> tuple[float, ...]:
+    """PolyScope's pose of a line feature taught by two points (each a pose): origin at the
+    first point, y along the line towards the second, z the first point's tool z axis made
+    perpendicular to y, x = y × z (seen: creativity-software/ur10-robot-draw-circle's
+    ``Line_1``). Two points at one place (a line never taught: both zero) give the first
+    point's pose [U: only the zero pose seen]."""
+    p1, p2 = points[0][:3], points[1][:3]
+    u = [b - a for a, b in zip(p1, p2, strict=True)]
+    nu = math.sqrt(sum(c * c for c in u))
+    tool_z = [row[2] for row in _rotation(points[0][3:])]
+    if nu < 1e-12:
+        return tuple(points[0])
+    y = [c / nu for c in u]
+    along = sum(a * b for a, b in zip(tool_z, y, strict=True))
+    z = [a - along * b for a, b in zip(tool_z, y, strict=True)]
+    nz = math.sqrt(sum(c * c for c in z))
+    if nz < 1e-12:  # the tool points along the line [U]: not seen
+        return tuple(points[0])
+    z = [c / nz for c in z]
+    x = [y[1] * z[2] - y[2] * z[1], y[2] * z[0] - y[0] * z[2], y[0] * z[1] - y[1] * z[0]]
+    matrix = [[x[i], y[i], z[i]] for i in range(3)]
+    return tuple(p1) + _rotvec(matrix)
+
+
 def _features(root: ElementTree.Element, path: str) -> tuple[tuple[str, tuple[float, ...]], ...]:
     features: list[tuple[str, tuple[float, ...]]] = []
     block = root.find("Features")
@@ -465,6 +494,14 @@ def _features(root: ElementTree.Element, path: str) -> tuple[tuple[str, tuple[fl
                     if value is not None:
                         points.append(value)
                 pose = _plane(points) if len(points) == 3 else None
+            elif element.tag == "GeomLineNode":
+                points = []
+                for tag in ("firstPoint", "secondPoint"):
+                    point = element.find(f"{tag}/GeomPoseNode")
+                    value = _point(point, name, path) if point is not None else None
+                    if value is not None:
+                        points.append(value)
+                pose = _line(points) if len(points) == 2 else None
             else:
                 continue
             if pose is not None:

@@ -321,6 +321,16 @@ def _io(settings: dict[str, dict[str, str]]) -> list[Item]:
             if action and action != "NONE":
                 items.append(_stmt("set_tool_digital_input_action", Number(index),
                                    String(action.lower().replace("_", " "))))
+        # a general purpose boolean input register's freedrive action (seen in
+        # CA-Giken/docker-noetic-capc's SUB_105 and SUB_161, 5.13: register 7); START, STOP
+        # and PAUSE are the controller's (their installation has them at 0-2, no script
+        # line); the value name FREEDRIVE as the tool inputs write it [U]
+        actions = settings.get("IOs/GeneralPurposeBooleanRegisterInputActions", {}).get(
+            "value", "").split(",")
+        for index, action in enumerate(a.strip() for a in actions):
+            if action == "FREEDRIVE":
+                items.append(_stmt("set_gp_boolean_input_action", Number(index),
+                                   String("freedrive")))
     states: list[tuple[str, int, int]] = []
     for key, bank in _RUNSTATE_BANKS:
         actions = settings.get(f"IOs/{key}", {}).get("value", "").split(",")
