@@ -64,6 +64,16 @@ class KinematicModel(Protocol):
         ...  # (N, 6), rows of NaN where a pose is out of reach
 
 
+def unreachable_reason(distance: float) -> str:
+    """Why a pose has no joint solution, for messages: ``distance`` (m) beyond the reach, or
+    0 when it is reachable only outside the joint limits."""
+    if distance <= 0:
+        return "reachable only outside the joint limits"
+    if distance < 5e-5:  # would print as 0.0 mm
+        return "just out of reach (by less than 0.1 mm)"
+    return f"out of reach by {distance * 1000:.1f} mm"
+
+
 class UnreachableTarget(KinematicsError):
     """A straight-line move's target is out of reach (found when its joints were solved).
 
@@ -74,8 +84,7 @@ class UnreachableTarget(KinematicsError):
 
     def __init__(self, segment: Segment, distance: float) -> None:
         where = segment.pose_end[:3, 3]
-        reason = (f"out of reach by {distance * 1000:.1f} mm" if distance > 0
-                  else "reachable only outside the joint limits")
+        reason = unreachable_reason(distance)
         super().__init__(f"the {segment.kind} target at [{where[0]:.4f}, {where[1]:.4f}, "
                          f"{where[2]:.4f}] m is {reason}")
         self.span = segment.span
@@ -403,8 +412,7 @@ class MotionPlanner:
         """The URS210 note for a stoppable move whose target (4x4) is out of reach."""
         where = ", ".join(f"{x:.4f}" for x in target[:3, 3])
         distance = getattr(why, "distance", 0.0) or 0.0
-        reason = (f"out of reach by {distance * 1000:.1f} mm" if distance > 0
-                  else "reachable only outside the joint limits")
+        reason = unreachable_reason(distance)
         return MotionWarning(
             "condition", f"the target of this move at [{where}] m is {reason}: the arm gets "
             "there only if the condition that stops the move (tool contact, an input) has not "
