@@ -357,8 +357,9 @@ class MotionPlanner:
         pose_from = self._end_matrix()
         params = {"a": a, "v": v, "t": t}
         if span in self.stoppable:
-            beyond = None if self._far(pose) else self._beyond_reach(pose)
-            if beyond is not None or self._far(pose):
+            far = self._far(pose)
+            beyond = None if far else self._beyond_reach(pose)
+            if far or beyond is not None:
                 target = pose
                 pose, stopped = self._until_out_of_reach(pose_from, pose)
                 if stopped:
@@ -414,10 +415,10 @@ class MotionPlanner:
         distance = getattr(why, "distance", 0.0) or 0.0
         reason = unreachable_reason(distance)
         return MotionWarning(
-            "condition", f"the target of this move at [{where}] m is {reason}: the arm gets "
-            "there only if the condition that stops the move (tool contact, an input) has not "
-            "held by then, which depends on the outside world; checked up to where the arm "
-            "could follow the line", span, now)
+            "condition", f"the target of this move at [{where}] m is {reason}: the arm stops "
+            "at the edge of its workspace only if the condition that stops the move (tool "
+            "contact, an input) has not held before, which depends on the outside world; "
+            "checked up to where the arm could follow the line", span, now)
 
     def _until_out_of_reach(self, pose_from: np.ndarray, pose: np.ndarray
                             ) -> tuple[np.ndarray, bool]:
