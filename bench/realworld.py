@@ -436,6 +436,16 @@ def report(runs: list[Run], projects: list[Project], json_out: Path | None) -> N
         json_out.write_text(json.dumps(document, indent=1), encoding="utf-8")
 
 
+def _selection(parser: argparse.ArgumentParser) -> None:
+    """The options that choose projects: --tune, --held or --all, and --project ID."""
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--tune", action="store_true", help="only the tuning projects")
+    group.add_argument("--held", action="store_true", help="only the held-back projects")
+    group.add_argument("--all", action="store_true", help="every project (default)")
+    parser.add_argument("--project", action="append", default=[], metavar="ID",
+                        help="only this project (repeatable)")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
@@ -447,12 +457,7 @@ def main(argv: list[str] | None = None) -> int:
     p_extract.add_argument("--held", action="store_true", help="only the held-back projects")
     p_run = commands.add_parser("run", help="lint and check the extracted projects")
     p_run.add_argument("--root", type=Path, required=True, help="the extract --out folder")
-    group = p_run.add_mutually_exclusive_group()
-    group.add_argument("--tune", action="store_true", help="only the tuning projects")
-    group.add_argument("--held", action="store_true", help="only the held-back projects")
-    group.add_argument("--all", action="store_true", help="every project (default)")
-    p_run.add_argument("--project", action="append", default=[], metavar="ID",
-                       help="only this project (repeatable)")
+    _selection(p_run)
     p_run.add_argument("--tool", choices=("lint", "check"), action="append",
                        help="only this tool (repeatable; default both)")
     p_run.add_argument("--timeout", type=float, default=120.0,
@@ -461,12 +466,7 @@ def main(argv: list[str] | None = None) -> int:
     p_score = commands.add_parser("score", help="match saved runs (run --json) against the "
                                   "labels again, without running anything")
     p_score.add_argument("saved", type=Path, nargs="+", help="JSON files written by run --json")
-    group = p_score.add_mutually_exclusive_group()
-    group.add_argument("--tune", action="store_true", help="only the tuning projects")
-    group.add_argument("--held", action="store_true", help="only the held-back projects")
-    group.add_argument("--all", action="store_true", help="every project (default)")
-    p_score.add_argument("--project", action="append", default=[], metavar="ID",
-                         help="only this project (repeatable)")
+    _selection(p_score)
     p_score.add_argument("--json", type=Path, help="also write everything as JSON here")
     args = parser.parse_args(argv)
 

@@ -200,28 +200,24 @@ def test_timers_in_polyscopes_order():
     assert globals_[:2] == ["global timer_brush = 0", "global timer_dry = 0"]
 
 
-def test_base_feature_in_an_expression_is_its_pose():
-    lines = compiled("""
-        <Assignment valueSource="Expression">
-          <variable featureName="UF"/>
-          <expression>
-            <ExpressionGeomFeature><feature referencedName="Joint_0_name"/></ExpressionGeomFeature>
-          </expression>
-        </Assignment>""")
-    assert "global UF = p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]" in lines
-
-
-def test_tool_feature_in_an_expression_is_where_the_tool_is():
+@pytest.mark.parametrize(("before", "feature", "after", "written"), [
+    # "UF:=Base" is written ``global UF=p[0.0,0.0,0.0,0.0,0.0,0.0]``
+    ("", "Joint_0_name", "", "p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]"),
     # taunoe/UR-scripts XMLRPC_loop: "camera.get_next_pose(Tool)"; "Joint_6_name" is
     # PolyScope's name of the Tool feature, never a variable of the program
-    lines = compiled("""
+    ("camera.get_next_pose(", "Joint_6_name", ")",
+     "camera.get_next_pose(get_actual_tcp_pose())"),
+])
+def test_built_in_features_in_an_expression(before, feature, after, written):
+    token = '<ExpressionToken token="{}"/>'
+    lines = compiled(f"""
         <Assignment valueSource="Expression">
-          <variable name="next"/>
-          <expression><ExpressionToken token="camera.get_next_pose("/>
-            <ExpressionGeomFeature><feature referencedName="Joint_6_name"/></ExpressionGeomFeature>
-            <ExpressionToken token=")"/></expression>
+          <variable name="value"/>
+          <expression>{token.format(before) if before else ""}
+            <ExpressionGeomFeature><feature referencedName="{feature}"/></ExpressionGeomFeature>
+            {token.format(after) if after else ""}</expression>
         </Assignment>""")
-    assert "global next = camera.get_next_pose(get_actual_tcp_pose())" in lines
+    assert f"global value = {written}" in lines
 
 
 def test_names_beyond_ascii_in_an_expression():
