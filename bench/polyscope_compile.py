@@ -46,7 +46,7 @@ installation.
 Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back;
 ``extra``: projects found later, used to find the variants the tune pairs lack; ``tune2``:
 projects found after those, two of every three in the order they were added, the third
-``held``),
+``held``; ``tune3``: the same for the projects found after the ``tune2`` ones),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most. ``--show N`` prints the first differing lines of N programs.
 """
@@ -351,7 +351,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repos", type=Path, default=Path("/work/.mirror"),
                         help="folder of owner+name git dirs")
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
-    parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "all"),
+    parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "tune3", "all"),
                         default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
     parser.add_argument("--script-files", choices=("file", "cache"), default="file",
