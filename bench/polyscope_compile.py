@@ -48,7 +48,11 @@ Prints, per split (``tune``: used while writing the compiler; ``held``: projects
 projects found after those, two of every three in the order they were added, the third
 ``held``; ``tune3``: the same for the projects found after the ``tune2`` ones),
 the share of programs exact, the mean share of matching lines and the node types whose lines
-differ most. ``--show N`` prints the first differing lines of N programs.
+differ most; then each project's share of programs exact (program part, whole, whole among
+the programs with their installation) and the mean of these over the projects, each project
+weighing the same (a few projects hold most pairs: nedlecky/UR, CA-Giken, mswaidan,
+Unitedplasticfabricating). A program that does not compile counts as not exact.
+``--show N`` prints the first differing lines of N programs.
 """
 
 from __future__ import annotations
@@ -345,6 +349,42 @@ def compare(ours: list[str], theirs: list[str]) -> float:
     return same / max(len(theirs), len(ours))
 
 
+def project_means(projects: dict[str, list[int]]) -> tuple[float, float, float | None, int]:
+    """The mean over projects of the share of programs exact: program part, whole, whole
+    among the programs with their installation (None when no project has one), and how many
+    projects have their installation. Each project weighs the same, whatever its number of
+    programs; a program that does not compile counts as not exact. ``projects`` maps a
+    repository to [programs, exact program part, exact whole, programs with their
+    installation, exact whole of those]."""
+    counted = [v for v in projects.values() if v[0]]
+    if not counted:
+        return 0.0, 0.0, None, 0
+    part = sum(v[1] / v[0] for v in counted) / len(counted)
+    whole = sum(v[2] / v[0] for v in counted) / len(counted)
+    with_ = [v for v in counted if v[3]]
+    whole_with = sum(v[4] / v[3] for v in with_) / len(with_) if with_ else None
+    return part, whole, whole_with, len(with_)
+
+
+def print_projects(projects: dict[str, list[int]]) -> None:
+    """The per-project view of a split: one line per project (share exact of its programs:
+    program part, whole; whole among those with their installation), then the means over
+    the projects. One project with many programs can carry a split's per-program figure."""
+    counted = {k: v for k, v in projects.items() if v[0]}
+    print(f"  per project ({len(counted)}; exact program part, whole, whole with installation,"
+          " of programs):")
+    for repo, v in sorted(counted.items(), key=lambda item: (-item[1][0], item[0])):
+        with_ = f"{v[4]}/{v[3]}" if v[3] else "-"
+        print(f"    {repo:<52} {v[1]:>3}/{v[0]:<3} {v[2]:>3}/{v[0]:<3} {with_:>7}"
+              f"  ({v[1] / v[0]:.0%} part, {v[2] / v[0]:.0%} whole)")
+    if counted:
+        part, whole, whole_with, n_with = project_means(counted)
+        print(f"  mean over the {len(counted)} projects: program part exact {part:.1%}, "
+              f"whole exact {whole:.1%}" + (
+                  f", whole exact with installation {whole_with:.1%} (over {n_with})"
+                  if whole_with is not None else ""))
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -380,7 +420,9 @@ def main(argv: list[str] | None = None) -> int:
                                       "pre_found": 0, "pre_extra": 0, "with": 0,
                                       "exact_with": 0, "no_installation": collections.Counter(),
                                       "pre_kinds": collections.Counter(), "projects": {}})
-        project = st["projects"].setdefault(repo, [0, 0, 0])  # programs, exact part, whole
+        # programs, exact program part, exact whole, with their installation, exact whole
+        # of those: every program counts, one that does not compile as not exact
+        project = st["projects"].setdefault(repo, [0, 0, 0, 0, 0])
         gitdir = git_dir(args.repos, repo)
         urp = git_show(gitdir, commit, urp_path)
         script = git_show(gitdir, commit, script_path)
@@ -388,6 +430,7 @@ def main(argv: list[str] | None = None) -> int:
             st["missing"] += 1
             continue
         st["n"] += 1
+        project[0] += 1
         try:
             program = parse_urp(urp, urp_path)
         except UrpError as error:
@@ -408,6 +451,7 @@ def main(argv: list[str] | None = None) -> int:
             st["no_installation"][absent] += 1
         else:
             st["with"] += 1
+            project[3] += 1
         reference = script.decode("utf-8", "replace")
         by_text = True
         try:
@@ -421,11 +465,13 @@ def main(argv: list[str] | None = None) -> int:
                 continue
         if not any(isinstance(item, Marker) for item in _walk_items(theirs_tree)):
             st["n"] -= 1
+            project[0] -= 1
             st["not_polyscope"] += 1
             if absent:
                 st["no_installation"][absent] -= 1
             else:
                 st["with"] -= 1
+                project[3] -= 1
             continue
         try:
             folder = PurePosixPath(urp_path).parent
@@ -469,11 +515,11 @@ def main(argv: list[str] | None = None) -> int:
         st["exact"] += exact
         st["exact_written"] += ours == theirs
         st["exact_prog"] += ours_prog == theirs_prog
-        project[0] += 1
         project[1] += ours_prog == theirs_prog
         project[2] += exact
         if not absent:
             st["exact_with"] += exact
+            project[4] += exact
         if ours_prog != theirs_prog:
             for kind in compiled.kinds_in_diff(ours_prog, theirs_prog):
                 st["kinds"][kind] += 1
@@ -518,14 +564,7 @@ def main(argv: list[str] | None = None) -> int:
                                                  st["errors"].most_common(5)))
         print("  node types in differing lines: " + ", ".join(
             f"{k} {v}" for k, v in st["kinds"].most_common(8)))
-        # one project with many programs can carry a split: its share per project, and the
-        # mean over projects
-        projects = {k: v for k, v in st["projects"].items() if v[0]}
-        print("  per project (exact program part / whole, of programs): " + "; ".join(
-            f"{k} {v[1]}/{v[2]} of {v[0]}" for k, v in sorted(projects.items())))
-        if projects:
-            mean = sum(v[1] / v[0] for v in projects.values()) / len(projects)
-            print(f"  mean over the {len(projects)} projects: program part exact {mean:.1%}")
+        print_projects(st["projects"])
     return 0
 
 
