@@ -332,6 +332,13 @@ def load_installation(gitdir: Path, commit: str, urp_path: str, name: str | None
     folder = PurePosixPath(urp_path).parent
     data = git_show(gitdir, commit, _join(folder, f"{name}.installation"))
     if data is None:
+        # renamed with the program: the files of one save carry the .urp's new name
+        # (loukjeab/WS2223_Master_Semester_Project_Workpiece_Transfer_Unit: UR5e_Program.urp,
+        # .script, .installation, .variables; the .urp names the installation it was saved
+        # with, OPC_UA_LJ_Henrik_Installation_01.02.2023)
+        name = PurePosixPath(urp_path).stem
+        data = git_show(gitdir, commit, _join(folder, f"{name}.installation"))
+    if data is None:
         return None, [], "the installation file is not in the repository"
     try:
         installation = parse_installation(data, f"{name}.installation")
