@@ -21,7 +21,9 @@ wrote is compared as written. Two views: the whole program, and the program part
 level statements from the first waypoint global, definition or marker on: what the program
 tree, not the installation, generates).
 
-The installation is the one the program names (``installationRelativePath``). A Script
+The installation is the one the program names (``installationRelativePath``); when that
+is not there, the one named like the ``.urp`` beside it (renamed with the program: the
+``.urp`` keeps the name it was saved with). A Script
 node's file is read from the repository as it was in the last commit that changed the
 .script (PolyScope compiles the file's contents when it saves, not the copy the .urp keeps;
 ``--script-files cache`` takes that copy instead). A script file edited after the save but
@@ -380,9 +382,10 @@ def print_projects(projects: dict[str, list[int]]) -> None:
     counted = {k: v for k, v in projects.items() if v[0]}
     print(f"  per project ({len(counted)}; exact program part, whole, whole with installation,"
           " of programs):")
+    width = max((len(repo) for repo in counted), default=0)
     for repo, v in sorted(counted.items(), key=lambda item: (-item[1][0], item[0])):
         with_ = f"{v[4]}/{v[3]}" if v[3] else "-"
-        print(f"    {repo:<52} {v[1]:>3}/{v[0]:<3} {v[2]:>3}/{v[0]:<3} {with_:>7}"
+        print(f"    {repo:<{width}} {v[1]:>3}/{v[0]:<3} {v[2]:>3}/{v[0]:<3} {with_:>7}"
               f"  ({v[1] / v[0]:.0%} part, {v[2] / v[0]:.0%} whole)")
     if counted:
         part, whole, whole_with, n_with = project_means(counted)
