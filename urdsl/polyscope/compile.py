@@ -304,6 +304,9 @@ _GET_FUNCTIONS = {
     "GP_int_in": "read_input_integer_register", "GP_int_out": "read_output_integer_register",
     "GP_float_in": "read_input_float_register", "GP_float_out": "read_output_float_register",
 }
+_DEFAULT_CASE = "2147483647"
+"""The ``caseValue`` of a Switch's Default Case (Java's ``Integer.MAX_VALUE``; seen in files
+of PolyScope 5.8 and 5.15)."""
 _BASE_FEATURES = frozenset(("Joint_0_name", "Base", "base"))
 """Names PolyScope gives the base frame in a move's feature reference."""
 _TOOL_FEATURES = frozenset(("Joint_6_name", "Tool", "tool"))
@@ -322,7 +325,8 @@ def _floats_or_none(text: str | None) -> tuple[float, ...] | None:
 def _blend_kept(move: Node, motion: Node) -> bool:
     """Whether a process move (MoveP) keeps the blend of ``motion``: not at its last motion
     unless the next node is another MoveP, into which it can blend (after the Robot
-    Program's last node comes its first one again when the program loops)."""
+    Program's last node comes its first one again when the program loops), or the move ends
+    a subprogram."""
     if move.fields.get("motion_type") != "MoveP":
         return True
     motions = [child for child in move.children
@@ -339,6 +343,11 @@ def _blend_kept(move: Node, motion: Node) -> bool:
     elif index >= 0 and parent.kind == "MainProgram" and \
             parent.attrs.get("runOnlyOnce") != "true":
         following = siblings[0]
+    elif index >= 0 and parent.kind == "SubProgram":
+        # the last node of a subprogram: what follows is the caller's, which PolyScope does
+        # not look at; it keeps the blend (seen: PolyScope 5.8, four MoveP in subprograms,
+        # three followed by a MoveL write r=0, the last node of one r=0.025)
+        return True
     else:
         return False
     return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
@@ -458,7 +467,6 @@ class _Compiler:
         self.number_of: dict[int, int] = {}
         self.waypoints: dict[str, Node] = {}
         self.counter = 0
-        self.switches = 0
         self.labels: dict[int, str] = {}
         self.pins = dict(getattr(installation, "io_names", ()) or ())
         self.version = program.major_version or 5
@@ -522,7 +530,6 @@ class _Compiler:
             body.extend(self.thread(thread))
         events = [node for node in program.others if node.kind == "Event" and not node.suppressed]
         body.extend(self.event_thread(events))
-        self.switches = 0
         main = self.node(program.main)
         if program.main.attrs.get("runOnlyOnce") == "true":
             body.extend(main)
@@ -574,9 +581,13 @@ class _Compiler:
         """The URScript text of a PolyScope expression, its I/O pins read as PolyScope
         reads them."""
         out = []
+        poses = dict(getattr(self.installation, "features", ()) or ())
         for kind, text in expression.parts:
             if kind == "io":
                 out.append(print_tree(self.pin_read(text, node)))
+            elif kind == "feature" and text in poses:
+                # a feature as a constant: its installation pose (m, rad), written in place
+                out.append(print_tree(Pose(tuple(_num(v) for v in poses[text]))))
             else:
                 out.append(Expression(((kind, text),)).script)
         return "".join(out)
@@ -706,11 +717,16 @@ class _Compiler:
 
     def n_Switch(self, node: Node) -> list[Item]:
         """A Switch node: its value in ``switch_N``, then an if/elif chain over the cases.
-        N counts the Switch nodes of one function (a subprogram, a thread, the Robot
-        Program) from 1 (seen: three Switch nodes in three functions of CA-Giken MAIN are
-        all ``switch_1``; two in one function counting on is [U])."""
-        self.switches += 1
-        variable = f"switch_{self.switches}"
+        N is 1 for a Switch in no other Switch (seen: three Switch nodes in three functions
+        of CA-Giken MAIN, and four one after another in one Robot Program of PolyScope 5.8,
+        are all ``switch_1``); a Switch inside a case of another one needs its own variable
+        to leave the outer value unchanged: N counts the enclosing Switch nodes [U]."""
+        depth = 1
+        parent = node.parent
+        while parent is not None:
+            depth += parent.kind == "Switch"
+            parent = parent.parent
+        variable = f"switch_{depth}"
         expression = node.fields["expression"]
         items: list[Item] = [self.marker(node, f"Switch {expression.label}"),
                              Assign(Name(variable),
@@ -720,6 +736,8 @@ class _Compiler:
         default: tuple[Item, ...] | None = None
         for case in cases:
             value = case.attrs.get("caseValue")
+            if value == _DEFAULT_CASE:
+                value = None  # the Default Case
             label = f"Case {value}" if value is not None else "Default Case"
             body = (self.marker(case, label), *self.block(case.children))
             if case.kind == "Case" and value is not None:
@@ -1041,13 +1059,11 @@ class _Compiler:
 
     def subprogram(self, node: Node) -> list[Item]:
         name = node.name or "subprogram"
-        self.switches = 0  # a function's Switch nodes count from 1 (see n_Switch)
         body = [self.marker(node, name, "noBreak"), *self.block(node.children)]
         return [FunctionDef(name, (), tuple(body))]
 
     def thread(self, node: Node) -> list[Item]:
         name = node.name or "Thread"
-        self.switches = 0
         body = self.block(node.children)
         if node.attrs.get("runOnlyOnce") != "true":
             body = [While(Paren(Bool(True)), tuple(body))]

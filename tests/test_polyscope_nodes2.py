@@ -1,0 +1,121 @@
+"""Node variants whose PolyScope output was learned from programs saved beside their
+``.script`` in public repositories outside the benchmark pairs (other commits and projects
+of the local mirrors): an Until that waits for an expression, a feature used as a constant
+in an expression, a Switch's Default Case saved with a value, Switch variables, a MoveP that
+ends a subprogram. Fixtures are written here; the expected forms are PolyScope's."""
+
+from __future__ import annotations
+
+from test_polyscope_variants import WAYPOINT, compiled
+
+
+def test_until_expression_stops_the_direction_when_it_holds():
+    # o2ac/o2ac-ur cable_extend_red_v2 (PolyScope 5.10): the condition is kept in
+    # <ExpressionBranch>; PolyScope writes kill, stopl(deceleration), marker, break
+    lines = compiled("""
+        <Move motionType="MoveL" speed="0.01" acceleration="0.25" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            <gui.program.direction.MoveDirectionNode selectedDirection="XMinus">
+              <children>
+                <Until type="EXPRESSION" allowActions="false" deceleration="0.25">
+                  <ExpressionBranch>
+                    <ExpressionToken token="pose_dist"/>
+                    <ExpressionChar character="("/>
+                    <ExpressionToken token="p0, get_actual_tcp_pose()"/>
+                    <ExpressionChar character=")"/>
+                    <ExpressionChar character=" "/>
+                    <ExpressionChar character="≥"/>
+                    <ExpressionChar character=" "/>
+                    <ExpressionToken token="pull_len"/>
+                  </ExpressionBranch>
+                </Until>
+              </children>
+            </gui.program.direction.MoveDirectionNode>
+          </children>
+        </Move>""")
+    assert after(lines, "move_thread_han_3 = run move_thread_3()", 7) == [
+        "while (True):",
+        "if (pose_dist(p0, get_actual_tcp_pose()) >= pull_len):",
+        "kill move_thread_han_3",
+        "stopl(0.25)",
+        '$ 4 "Until (expression)"',
+        "break",
+        "end",
+    ]
+    assert not any(line.startswith("join ") for line in lines)
+
+
+def after(lines: list[str], start: str, count: int) -> list[str]:
+    """The ``count`` lines after the last line ``start``."""
+    at = len(lines) - 1 - lines[::-1].index(start)
+    return lines[at + 1:at + 1 + count]
+
+
+def test_a_feature_as_a_constant_is_its_installation_pose():
+    # loukjeab/WS2223... (PolyScope 5.8): "Base_var:=Base_1_const" is written
+    # ``global Base_var=p[...]``, the installation's pose of the plane Base_1
+    lines = compiled("""
+        <Assignment valueSource="Expression">
+          <variable name="frame"/>
+          <expression>
+            <ExpressionGeomFeature><feature referencedName="Cube"/></ExpressionGeomFeature>
+          </expression>
+        </Assignment>""")
+    assert "global frame = p[-0.65, -0.29, 0.15, 1.19, 1.2, 1.23]" in lines
+    assert '$ 2 "frame≔Cube_const"' in lines
+
+
+def test_switch_default_case_saved_with_a_value_is_the_else_branch():
+    # loukjeab/WS2223... (5.8) and Pugens/ursim (5.15) save the Default Case as
+    # <Case caseValue="2147483647"> (Java's Integer.MAX_VALUE); PolyScope writes `else:`
+    lines = compiled("""
+        <Switch>
+          <expression><ExpressionToken token="mode"/></expression>
+          <children>
+            <Case caseValue="1"><children>
+              <Wait type="Sleep"><waitTime>0.1</waitTime></Wait></children></Case>
+            <Case caseValue="2147483647"><children>
+              <Wait type="Sleep"><waitTime>0.2</waitTime></Wait></children></Case>
+          </children>
+        </Switch>""")
+    assert not any("2147483647" in line for line in lines)
+    assert after(lines, "sleep(0.1)", 3) == ["else:", '$ 5 "Default Case"', '$ 6 "Wait: 0.2"']
+
+
+def test_switch_variables_one_after_another_and_nested():
+    # loukjeab/WS2223... (5.8): four Switch nodes one after another in the Robot Program are
+    # all ``switch_1``; one inside a case of another needs its own variable [U]
+    switch = """<Switch>
+          <expression><ExpressionToken token="{value}"/></expression>
+          <children><Case caseValue="1"><children>{inner}</children></Case></children>
+        </Switch>"""
+    inner = switch.format(value="c", inner='<Wait type="Sleep"><waitTime>0.1</waitTime></Wait>')
+    lines = compiled(switch.format(value="a", inner=inner) +
+                     switch.format(value="b", inner=""))
+    assert [line for line in lines if line.startswith("switch_")] == [
+        "switch_1 = a", "switch_2 = c", "switch_1 = b"]
+    assert "if (1 == switch_2):" in lines
+
+
+def test_a_movep_that_ends_a_subprogram_keeps_its_blend():
+    # loukjeab/WS2223... (5.8): three MoveP followed by a MoveL end with r=0, the MoveP that
+    # is the last node of a subprogram keeps r=0.025
+    movep = f"""<Move motionType="MoveP" speed="0.25" acceleration="1.2" blendRadius="0.025"
+              useActiveTCP="true" positionType="CartesianPose">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>{WAYPOINT.format(name="{name}")}</children>
+        </Move>"""
+    movel = f"""<Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>{WAYPOINT.format(name="Down")}</children>
+        </Move>"""
+    body = f"""<CallSubProgram>
+          <subprogram name="Place" keepHidden="false" keepSynchronizedWithDisk="false">
+            <children>{movep.format(name="Above")}{movel}{movep.format(name="Away")}</children>
+          </subprogram>
+        </CallSubProgram>"""
+    lines = compiled(body, others='<SubProgram reference="../MainProgram/children/'
+                                  'CallSubProgram/subprogram"/>')
+    assert "movep(Above_p, a=1.2, v=0.25, r=0.0)" in lines
+    assert "movep(Away_p, a=1.2, v=0.25, r=0.025)" in lines
