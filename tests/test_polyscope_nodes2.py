@@ -119,3 +119,27 @@ def test_a_movep_that_ends_a_subprogram_keeps_its_blend():
                                   'CallSubProgram/subprogram"/>')
     assert "movep(Above_p, a=1.2, v=0.25, r=0.0)" in lines
     assert "movep(Away_p, a=1.2, v=0.25, r=0.025)" in lines
+
+
+def test_polyscope3_conveyor_tracking_runs_its_children_while_tracking():
+    # Usaakm/UR10-Conveyor-Belt (PolyScope 3.15): a Contributed node of Universal Robots
+    # that PolyScope compiles itself, without a URCap block
+    lines = compiled("""
+        <Contributed strategyClass="ConveyorTracking" strategyProgramNodeType="Conveyor Tracking"
+            strategyURCapDeveloper="Universal Robots" strategyURCapName="Conveyor Tracking">
+          <dataModel/>
+          <children>
+            <Assignment valueSource="Expression">
+              <variable name="here"/>
+              <expression><ExpressionToken token="get_actual_tcp_pose()"/></expression>
+            </Assignment>
+          </children>
+        </Contributed>""", version="3.15.4.106291")
+    assert after(lines, '$ 1 "Robot Program"', 5) == [
+        '$ 2 "Tracking Conveyor 1"',
+        "start_conveyor_tracking0()",
+        '$ 3 "here≔get_actual_tcp_pose()" "noBreak"',
+        "global here = get_actual_tcp_pose()",
+        "stop_conveyor_tracking()",
+    ]
+    assert not any("URCap" in line for line in lines)

@@ -833,12 +833,31 @@ class _Compiler:
         return [self.marker(node, "Halt"), Halt()]
 
     def n_Contributed(self, node: Node) -> list[Item]:
+        if node.attrs.get("strategyClass") == "ConveyorTracking":
+            return self.conveyor_tracking(node)
         return [Comment(" begin: URCap Program Node"),
                 Comment(f"   Source: {node.attrs.get('strategyURCapName', '?')}, "
                         f"{node.attrs.get('strategyURCapDeveloper', '?')}"),
                 Comment(f"   Type: {node.title}"),
                 self.marker(node, node.title),
                 Comment(" end: URCap Program Node")]
+
+    def conveyor_tracking(self, node: Node) -> list[Item]:
+        """PolyScope 3's Conveyor Tracking node (``strategyClass="ConveyorTracking"``, saved
+        as a URCap node of Universal Robots, compiled by PolyScope itself: no URCap block):
+        marker "Tracking Conveyor N", the installation's ``start_conveyor_trackingK()``
+        (K = N - 1), the children (their markers ``noBreak``), ``stop_conveyor_tracking()``
+        (seen: 3.15, 14 scripts of one project, all conveyor 1; the key that selects conveyor
+        2 is [U])."""
+        data = {item.get("key"): item.get("value")
+                for item in (node.element.find("dataModel") if node.element is not None and
+                             node.element.find("dataModel") is not None else ())}
+        number = data.get("conveyor") or "1"
+        index = int(number) - 1 if number.isdigit() and int(number) > 0 else 0
+        return [self.marker(node, f"Tracking Conveyor {index + 1}"),
+                _stmt(f"start_conveyor_tracking{index}"),
+                *(_no_break(item) for item in self.block(node.children)),
+                _stmt("stop_conveyor_tracking")]
 
     def n_Wait(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
