@@ -143,3 +143,43 @@ def test_polyscope3_conveyor_tracking_runs_its_children_while_tracking():
         "stop_conveyor_tracking()",
     ]
     assert not any("URCap" in line for line in lines)
+
+
+RELATIVE = """
+        <Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true">
+          <children>
+            <Waypoint type="Relative" name="Slide" kinematicsFlags="4">
+              <motionParameters/>
+              {start}
+              {end}
+            </Waypoint>
+          </children>
+        </Move>"""
+POSITION = """<{tag}><JointAngles angles="{q}"/>
+              <TCPOffset pose="0.0, 0.0, 0.2, 0.0, 0.0, 0.0"/></{tag}>"""
+
+
+def test_relative_waypoint_moves_by_the_taught_difference():
+    # CA-Giken MAIN (5.13): globals Slide_from_p and Slide_to_p, the motion from where the
+    # arm is by their difference
+    lines = compiled(RELATIVE.format(
+        start=POSITION.format(tag="relativeFromPosition", q="0.0, -1.5, 1.5, -1.5, -1.5, 0.0"),
+        end=POSITION.format(tag="position", q="0.1, -1.5, 1.5, -1.5, -1.5, 0.0")))
+    assert any(line.startswith("global Slide_from_p = p[") for line in lines)
+    assert any(line.startswith("global Slide_to_p = p[") for line in lines)
+    assert "movel(pose_add(get_target_tcp_pose(), pose_sub(Slide_to_p, Slide_from_p)), " \
+           "a=1.2, v=0.25)" in lines
+
+
+def test_polyscope3_relative_waypoint_writes_its_poses_in_place():
+    # PolyScope 3 writes no waypoint globals; a relative waypoint's two poses stand in the
+    # motion as a fixed waypoint's pose does [U]
+    lines = compiled(RELATIVE.format(
+        start='<relativeFromPosition joints="0, -1.5, 1.5, -1.5, -1.5, 0" '
+              'pose="0.1, 0.2, 0.3, 0.0, 3.14, 0.0"/>',
+        end='<position joints="0, -1.4, 1.5, -1.5, -1.5, 0" '
+            'pose="0.1, 0.25, 0.3, 0.0, 3.14, 0.0"/>'),
+        version="3.15.4.106291")
+    assert not any("Slide_" in line for line in lines)
+    assert "movel(pose_add(get_target_tcp_pose(), pose_sub(p[0.1, 0.25, 0.3, 0.0, 3.14, 0.0], " \
+           "p[0.1, 0.2, 0.3, 0.0, 3.14, 0.0])), a=1.2, v=0.25)" in lines

@@ -1451,8 +1451,18 @@ class _Compiler:
                 target = pose_expr
         elif kind == "Relative":
             label = name
+            to: Expr = Name(f"{name}_to_p")
+            start: Expr = Name(f"{name}_from_p")
+            if self.version < 5:
+                # PolyScope 3 writes no waypoint globals: the two poses in place, as for a
+                # fixed waypoint [U: no PolyScope 3 script with a relative waypoint seen]
+                to_pose, from_pose = self.pose_of(node), self.pose_of(node, "from_")
+                if to_pose is None or from_pose is None:
+                    raise self.error(node, "a relative waypoint without its two positions")
+                to = Pose(tuple(_num(v) for v in to_pose))
+                start = Pose(tuple(_num(v) for v in from_pose))
             target = _call("pose_add", _call("get_target_tcp_pose"),
-                           _call("pose_sub", Name(f"{name}_to_p"), Name(f"{name}_from_p")))
+                           _call("pose_sub", to, start))
         else:
             return [self.marker(node, name, "breakAfter")]
         keywords = self.motion_keywords(move, node)
