@@ -1282,8 +1282,8 @@ class _Compiler:
         """The loop that waits, while a move thread runs, for the first of its Until
         conditions: tool contact (checked first, whatever the order), a condition (an
         expression: the move stops at the Until's ``deceleration``, m/s², else the move's
-        acceleration; the form is inferred, not yet seen in a PolyScope script [U]), and the
-        end of the move (distance, reached waypoint), in the node order."""
+        acceleration; seen: PolyScope 5.10), and the end of the move (distance, reached
+        waypoint), in the node order."""
         loop: list[Item] = []
         ordered = sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION")
         for until in ordered:
