@@ -183,3 +183,9 @@ def test_polyscope3_relative_waypoint_writes_its_poses_in_place():
     assert not any("Slide_" in line for line in lines)
     assert "movel(pose_add(get_target_tcp_pose(), pose_sub(p[0.1, 0.25, 0.3, 0.0, 3.14, 0.0], " \
            "p[0.1, 0.2, 0.3, 0.0, 3.14, 0.0])), a=1.2, v=0.25)" in lines
+
+
+def test_a_wait_not_yet_set_writes_its_marker_only():
+    # MuhammadUmarAnjum/PakBot (3.15): <Wait type="NoWait"/> is '$ 53 "Wait: 0"' alone
+    lines = compiled('<Wait type="NoWait"/>', version="3.15.3.106223")
+    assert after(lines, '$ 1 "Robot Program"', 2) == ['$ 2 "Wait: 0"', "end"]

@@ -861,6 +861,8 @@ class _Compiler:
 
     def n_Wait(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
+        if kind == "NoWait":  # a Wait not yet set: its marker only (seen: PolyScope 3.15)
+            return [self.marker(node, "Wait: 0")]
         if kind == "Sleep":
             seconds = node.fields.get("seconds", 0.0)
             return [self.marker(node, f"Wait: {seconds}"), _stmt("sleep", _num(seconds))]
