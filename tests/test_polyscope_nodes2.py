@@ -189,3 +189,13 @@ def test_a_wait_not_yet_set_writes_its_marker_only():
     # MuhammadUmarAnjum/PakBot (3.15): <Wait type="NoWait"/> is '$ 53 "Wait: 0"' alone
     lines = compiled('<Wait type="NoWait"/>', version="3.15.3.106223")
     assert after(lines, '$ 1 "Robot Program"', 2) == ['$ 2 "Wait: 0"', "end"]
+
+
+def test_operator_assignment_as_polyscope_labels_and_writes_it():
+    # Snupai/SZ (5.9): '$ 3 "Artikel≔'Artikelnummer eingeben'"', then
+    # global Artikel=request_string_from_primary_client("Artikelnummer eingeben")
+    lines = compiled("""<Assignment valueSource="Operator" message="Startlage eingeben"
+          valueType="Integer"><variable name="Lage"/></Assignment>""")
+    assert after(lines, '$ 1 "Robot Program"', 2) == [
+        '$ 2 "Lage≔\'Startlage eingeben\'"',
+        'global Lage = request_integer_from_primary_client("Startlage eingeben")']

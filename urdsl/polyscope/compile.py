@@ -1017,10 +1017,12 @@ class _Compiler:
         expression = node.fields["expression"]
         name = node.name or "var"
         if node.fields.get("source") == "Operator":
-            # the operator types the value in; the form is unconfirmed [U]
+            # the operator types the value in (seen: Snupai/SZ, 5.9, integer and string:
+            # '$ 3 "Artikel≔'Artikelnummer eingeben'"' then
+            # ``global Artikel=request_string_from_primary_client("Artikelnummer eingeben")``)
             kind = str(node.fields.get("value_type") or "Integer").lower()
             message = str(node.fields.get("message", ""))
-            return [self.marker(node, f"{name}≔Operator"),
+            return [self.marker(node, f"{name}≔'{message}'"),
                     Declare("global", name, _call(f"request_{kind}_from_primary_client",
                                                   String(message.replace('"', "'"))))]
         label = f"{name}≔{expression.label}"
