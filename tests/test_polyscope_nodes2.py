@@ -6,6 +6,7 @@ ends a subprogram. Fixtures are written here; the expected forms are PolyScope's
 
 from __future__ import annotations
 
+import pytest
 from test_polyscope_variants import WAYPOINT, compiled
 
 
@@ -199,3 +200,29 @@ def test_operator_assignment_as_polyscope_labels_and_writes_it():
     assert after(lines, '$ 1 "Robot Program"', 2) == [
         '$ 2 "Lage≔\'Startlage eingeben\'"',
         'global Lage = request_integer_from_primary_client("Startlage eingeben")']
+
+
+def test_check_runs_a_conveyor_program_whose_functions_urdsl_cannot_write(tmp_path, capsys):
+    # PolyScope 3's Conveyor Tracking calls start_conveyor_tracking0(), which the
+    # installation's preamble defines; urdsl does not write it: the check takes it as a
+    # device instead of stopping at a name it cannot find
+    import json
+
+    from test_polyscope_variants import program
+
+    from urdsl.cli import main
+    from urdsl.runtime.unknown import DEVICE_REPLY_TIME
+
+    path = tmp_path / "conveyor.urp"
+    path.write_text(program("""
+        <Contributed strategyClass="ConveyorTracking" strategyProgramNodeType="Conveyor Tracking"
+            strategyURCapDeveloper="Universal Robots" strategyURCapName="Conveyor Tracking">
+          <dataModel/>
+          <children><Wait type="Sleep"><waitTime>0.5</waitTime></Wait></children>
+        </Contributed>""", version="3.15.4.106291"))
+    assert main(["check", str(path), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not any(f["severity"] == "error" for f in report["findings"])
+    assert "start_conveyor_tracking0" in report["context"]
+    # the node and the stand-in each answer as a device, then the wait
+    assert report["cycle_time"] == pytest.approx(2 * DEVICE_REPLY_TIME + 0.5, abs=0.01)
