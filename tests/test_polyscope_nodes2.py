@@ -9,6 +9,8 @@ from __future__ import annotations
 import pytest
 from test_polyscope_variants import WAYPOINT, compiled
 
+from urdsl.polyscope.compile import CompileError
+
 
 def test_until_expression_stops_the_direction_when_it_holds():
     # o2ac/o2ac-ur cable_extend_red_v2 (PolyScope 5.10): the condition is kept in
@@ -226,3 +228,21 @@ def test_check_runs_a_conveyor_program_whose_functions_urdsl_cannot_write(tmp_pa
     assert "start_conveyor_tracking0" in report["context"]
     # the node and the stand-in each answer as a device, then the wait
     assert report["cycle_time"] == pytest.approx(2 * DEVICE_REPLY_TIME + 0.5, abs=0.01)
+
+
+def test_assignment_of_two_calls_typed_together_is_written_as_polyscope_writes_it():
+    # o2ac/o2ac-ur (5.9): "currentpose≔get_actual_tcp_pose()get_actual_joint_positions()" is
+    # written ``global currentpose= get_actual_tcp_pose () get_actual_joint_positions ()``
+    lines = compiled("""<Assignment valueSource="Expression"><variable name="here"/>
+          <expression><ExpressionToken token="get_actual_tcp_pose"/>
+          <ExpressionChar character="("/><ExpressionChar character=")"/>
+          <ExpressionToken token="get_actual_joint_positions"/>
+          <ExpressionChar character="("/><ExpressionChar character=")"/></expression>
+        </Assignment>""")
+    assert after(lines, '$ 1 "Robot Program"', 3) == [
+        '$ 2 "here≔get_actual_tcp_pose()get_actual_joint_positions()"',
+        "global here = get_actual_tcp_pose()", "get_actual_joint_positions()"]
+    # what is not URScript at all is still one message naming the node
+    with pytest.raises(CompileError, match="Robot Program > here"):
+        compiled("""<Assignment valueSource="Expression"><variable name="here"/>
+          <expression><ExpressionToken token="1 +"/></expression></Assignment>""")

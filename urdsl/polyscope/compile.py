@@ -1026,8 +1026,22 @@ class _Compiler:
                     Declare("global", name, _call(f"request_{kind}_from_primary_client",
                                                   String(message.replace('"', "'"))))]
         label = f"{name}≔{expression.label}"
-        return [self.marker(node, label),
-                Declare("global", name, self.expr(self.script_of(expression, node), node))]
+        text = self.script_of(expression, node)
+        try:
+            value = self.expr(text, node)
+        except CompileError:
+            # PolyScope writes ``global NAME= TEXT`` whatever TEXT is: two calls typed one
+            # after the other are a declaration and a statement (seen: o2ac/o2ac-ur 5.9,
+            # "currentpose≔get_actual_tcp_pose()get_actual_joint_positions()")
+            try:
+                items = parse(_ascii_code(f"global {name}={text}\n"), self.program.path).body
+            except ScriptError:
+                items = ()
+            if not items or not isinstance(items[0], Declare) or \
+                    not all(isinstance(item, ExprStmt) for item in items[1:]):
+                raise
+            return [self.marker(node, label), *items]
+        return [self.marker(node, label), Declare("global", name, value)]
 
     def n_Script(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
