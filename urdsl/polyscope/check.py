@@ -192,6 +192,53 @@ def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
     return {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
 
 
+def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Module, list[str]]:
+    """When code urdsl cannot generate is part of the program (URCap nodes, URCaps of the
+    installation, PolyScope 3's Conveyor Tracking with its preamble function): ``module`` with
+    a stand-in for each function the program calls but defines nowhere, taking a device's
+    reply time (:data:`urdsl.runtime.unknown.DEVICE_REPLY_TIME`) and as many parameters as
+    its calls pass (keywords as parameters with a default), so that the check runs the rest
+    of the program; and their names. Nothing changes without such code."""
+    from ..project.check import needed_names
+    from ..runtime.unknown import DEVICE_REPLY_TIME
+
+    if not urcap_sources(generated):
+        return module, []
+    _reads, calls, _threads = needed_names(module)
+    if not calls:
+        return module, []
+    positional: dict[str, int] = {name: 0 for name in calls}
+    keywords: dict[str, list[str]] = {name: [] for name in calls}
+    stack: list = [module]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, n.Call) and isinstance(node.func, n.Name) and \
+                node.func.id in positional:
+            positional[node.func.id] = max(positional[node.func.id], len(node.args))
+            for keyword in node.keywords:
+                if keyword.name not in keywords[node.func.id]:
+                    keywords[node.func.id].append(keyword.name)
+        if dataclasses.is_dataclass(node):
+            for f in dataclasses.fields(node):
+                value = getattr(node, f.name)
+                if isinstance(value, tuple):
+                    stack.extend(v for v in value if dataclasses.is_dataclass(v))
+                elif dataclasses.is_dataclass(value) and not isinstance(value, n.Span):
+                    stack.append(value)
+    stubs = tuple(
+        n.FunctionDef(name, tuple(n.Param(f"arg{i + 1}") for i in range(positional[name])) +
+                      tuple(n.Param(k, n.Number(0)) for k in keywords[name]),
+                      (n.ExprStmt(n.Call(n.Name("sleep"), (n.Number(DEVICE_REPLY_TIME),))),))
+        for name in sorted(calls))
+    body = module.body
+    if len(body) == 1 and isinstance(body[0], n.FunctionDef):
+        program = body[0]
+        body = (dataclasses.replace(program, body=stubs + tuple(program.body)),)
+    else:
+        body = stubs + tuple(body)
+    return dataclasses.replace(module, body=body), sorted(calls)
+
+
 def with_urcap_time(module: n.Module, numbers: set[int]) -> n.Module:
     """``module`` with each URCap node (marker number in ``numbers``) taking a device's
     reply time (:data:`urdsl.runtime.unknown.DEVICE_REPLY_TIME`, as ``sleep``, placed on the
@@ -328,6 +375,10 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     if file_options.unknown_globals:
         notes.append("unknown values from URCap nodes: "
                      + ", ".join(sorted(file_options.unknown_globals)))
+    module, stand_ins = with_urcap_functions(generated, module)
+    if stand_ins:
+        notes.append("functions defined by code urdsl cannot generate, taken as devices: "
+                     + ", ".join(stand_ins))
     urcaps = {number for number, _node in generated.urcap_nodes()}
     report = check_tree(with_urcap_time(module, urcaps), generated.filename, file_options)
     report.inferred = inference

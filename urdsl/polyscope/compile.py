@@ -304,6 +304,9 @@ _GET_FUNCTIONS = {
     "GP_int_in": "read_input_integer_register", "GP_int_out": "read_output_integer_register",
     "GP_float_in": "read_input_float_register", "GP_float_out": "read_output_float_register",
 }
+_DEFAULT_CASE = "2147483647"
+"""The ``caseValue`` of a Switch's Default Case (Java's ``Integer.MAX_VALUE``; seen in files
+of PolyScope 5.8 and 5.15)."""
 _BASE_FEATURES = frozenset(("Joint_0_name", "Base", "base"))
 """Names PolyScope gives the base frame in a move's feature reference."""
 _TOOL_FEATURES = frozenset(("Joint_6_name", "Tool", "tool"))
@@ -322,7 +325,8 @@ def _floats_or_none(text: str | None) -> tuple[float, ...] | None:
 def _blend_kept(move: Node, motion: Node) -> bool:
     """Whether a process move (MoveP) keeps the blend of ``motion``: not at its last motion
     unless the next node is another MoveP, into which it can blend (after the Robot
-    Program's last node comes its first one again when the program loops)."""
+    Program's last node comes its first one again when the program loops), or the move ends
+    a subprogram."""
     if move.fields.get("motion_type") != "MoveP":
         return True
     motions = [child for child in move.children
@@ -339,6 +343,11 @@ def _blend_kept(move: Node, motion: Node) -> bool:
     elif index >= 0 and parent.kind == "MainProgram" and \
             parent.attrs.get("runOnlyOnce") != "true":
         following = siblings[0]
+    elif index >= 0 and parent.kind == "SubProgram":
+        # the last node of a subprogram: what follows is the caller's, which PolyScope does
+        # not look at; it keeps the blend (seen: PolyScope 5.8, four MoveP in subprograms,
+        # three followed by a MoveL write r=0, the last node of one r=0.025)
+        return True
     else:
         return False
     return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
@@ -458,7 +467,6 @@ class _Compiler:
         self.number_of: dict[int, int] = {}
         self.waypoints: dict[str, Node] = {}
         self.counter = 0
-        self.switches = 0
         self.labels: dict[int, str] = {}
         self.pins = dict(getattr(installation, "io_names", ()) or ())
         self.version = program.major_version or 5
@@ -522,7 +530,6 @@ class _Compiler:
             body.extend(self.thread(thread))
         events = [node for node in program.others if node.kind == "Event" and not node.suppressed]
         body.extend(self.event_thread(events))
-        self.switches = 0
         main = self.node(program.main)
         if program.main.attrs.get("runOnlyOnce") == "true":
             body.extend(main)
@@ -574,9 +581,13 @@ class _Compiler:
         """The URScript text of a PolyScope expression, its I/O pins read as PolyScope
         reads them."""
         out = []
+        poses = dict(getattr(self.installation, "features", ()) or ())
         for kind, text in expression.parts:
             if kind == "io":
                 out.append(print_tree(self.pin_read(text, node)))
+            elif kind == "feature" and text in poses:
+                # a feature as a constant: its installation pose (m, rad), written in place
+                out.append(print_tree(Pose(tuple(_num(v) for v in poses[text]))))
             else:
                 out.append(Expression(((kind, text),)).script)
         return "".join(out)
@@ -706,11 +717,16 @@ class _Compiler:
 
     def n_Switch(self, node: Node) -> list[Item]:
         """A Switch node: its value in ``switch_N``, then an if/elif chain over the cases.
-        N counts the Switch nodes of one function (a subprogram, a thread, the Robot
-        Program) from 1 (seen: three Switch nodes in three functions of CA-Giken MAIN are
-        all ``switch_1``; two in one function counting on is [U])."""
-        self.switches += 1
-        variable = f"switch_{self.switches}"
+        N is 1 for a Switch in no other Switch (seen: three Switch nodes in three functions
+        of CA-Giken MAIN, and four one after another in one Robot Program of PolyScope 5.8,
+        are all ``switch_1``); a Switch inside a case of another one needs its own variable
+        to leave the outer value unchanged: N counts the enclosing Switch nodes [U]."""
+        depth = 1
+        parent = node.parent
+        while parent is not None:
+            depth += parent.kind == "Switch"
+            parent = parent.parent
+        variable = f"switch_{depth}"
         expression = node.fields["expression"]
         items: list[Item] = [self.marker(node, f"Switch {expression.label}"),
                              Assign(Name(variable),
@@ -720,6 +736,8 @@ class _Compiler:
         default: tuple[Item, ...] | None = None
         for case in cases:
             value = case.attrs.get("caseValue")
+            if value == _DEFAULT_CASE:
+                value = None  # the Default Case
             label = f"Case {value}" if value is not None else "Default Case"
             body = (self.marker(case, label), *self.block(case.children))
             if case.kind == "Case" and value is not None:
@@ -815,6 +833,8 @@ class _Compiler:
         return [self.marker(node, "Halt"), Halt()]
 
     def n_Contributed(self, node: Node) -> list[Item]:
+        if node.attrs.get("strategyClass") == "ConveyorTracking":
+            return self.conveyor_tracking(node)
         return [Comment(" begin: URCap Program Node"),
                 Comment(f"   Source: {node.attrs.get('strategyURCapName', '?')}, "
                         f"{node.attrs.get('strategyURCapDeveloper', '?')}"),
@@ -822,8 +842,27 @@ class _Compiler:
                 self.marker(node, node.title),
                 Comment(" end: URCap Program Node")]
 
+    def conveyor_tracking(self, node: Node) -> list[Item]:
+        """PolyScope 3's Conveyor Tracking node (``strategyClass="ConveyorTracking"``, saved
+        as a URCap node of Universal Robots, compiled by PolyScope itself: no URCap block):
+        marker "Tracking Conveyor N", the installation's ``start_conveyor_trackingK()``
+        (K = N - 1), the children (their markers ``noBreak``), ``stop_conveyor_tracking()``
+        (seen: 3.15, 14 scripts of one project, all conveyor 1; the key that selects conveyor
+        2 is [U])."""
+        data = {item.get("key"): item.get("value")
+                for item in (node.element.find("dataModel") if node.element is not None and
+                             node.element.find("dataModel") is not None else ())}
+        number = data.get("conveyor") or "1"
+        index = int(number) - 1 if number.isdigit() and int(number) > 0 else 0
+        return [self.marker(node, f"Tracking Conveyor {index + 1}"),
+                _stmt(f"start_conveyor_tracking{index}"),
+                *(_no_break(item) for item in self.block(node.children)),
+                _stmt("stop_conveyor_tracking")]
+
     def n_Wait(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
+        if kind == "NoWait":  # a Wait not yet set: its marker only (seen: PolyScope 3.15)
+            return [self.marker(node, "Wait: 0")]
         if kind == "Sleep":
             seconds = node.fields.get("seconds", 0.0)
             return [self.marker(node, f"Wait: {seconds}"), _stmt("sleep", _num(seconds))]
@@ -978,15 +1017,31 @@ class _Compiler:
         expression = node.fields["expression"]
         name = node.name or "var"
         if node.fields.get("source") == "Operator":
-            # the operator types the value in; the form is unconfirmed [U]
+            # the operator types the value in (seen: Snupai/SZ, 5.9, integer and string:
+            # '$ 3 "Artikel≔'Artikelnummer eingeben'"' then
+            # ``global Artikel=request_string_from_primary_client("Artikelnummer eingeben")``)
             kind = str(node.fields.get("value_type") or "Integer").lower()
             message = str(node.fields.get("message", ""))
-            return [self.marker(node, f"{name}≔Operator"),
+            return [self.marker(node, f"{name}≔'{message}'"),
                     Declare("global", name, _call(f"request_{kind}_from_primary_client",
                                                   String(message.replace('"', "'"))))]
         label = f"{name}≔{expression.label}"
-        return [self.marker(node, label),
-                Declare("global", name, self.expr(self.script_of(expression, node), node))]
+        text = self.script_of(expression, node)
+        try:
+            value = self.expr(text, node)
+        except CompileError:
+            # PolyScope writes ``global NAME= TEXT`` whatever TEXT is: two calls typed one
+            # after the other are a declaration and a statement (seen: o2ac/o2ac-ur 5.9,
+            # "currentpose≔get_actual_tcp_pose()get_actual_joint_positions()")
+            try:
+                items = parse(_ascii_code(f"global {name}={text}\n"), self.program.path).body
+            except ScriptError:
+                items = ()
+            if not items or not isinstance(items[0], Declare) or \
+                    not all(isinstance(item, ExprStmt) for item in items[1:]):
+                raise
+            return [self.marker(node, label), *items]
+        return [self.marker(node, label), Declare("global", name, value)]
 
     def n_Script(self, node: Node) -> list[Item]:
         kind = node.fields.get("type")
@@ -1041,13 +1096,11 @@ class _Compiler:
 
     def subprogram(self, node: Node) -> list[Item]:
         name = node.name or "subprogram"
-        self.switches = 0  # a function's Switch nodes count from 1 (see n_Switch)
         body = [self.marker(node, name, "noBreak"), *self.block(node.children)]
         return [FunctionDef(name, (), tuple(body))]
 
     def thread(self, node: Node) -> list[Item]:
         name = node.name or "Thread"
-        self.switches = 0
         body = self.block(node.children)
         if node.attrs.get("runOnlyOnce") != "true":
             body = [While(Paren(Bool(True)), tuple(body))]
@@ -1247,8 +1300,8 @@ class _Compiler:
         """The loop that waits, while a move thread runs, for the first of its Until
         conditions: tool contact (checked first, whatever the order), a condition (an
         expression: the move stops at the Until's ``deceleration``, m/s², else the move's
-        acceleration; the form is inferred, not yet seen in a PolyScope script [U]), and the
-        end of the move (distance, reached waypoint), in the node order."""
+        acceleration; seen: PolyScope 5.10), and the end of the move (distance, reached
+        waypoint), in the node order."""
         loop: list[Item] = []
         ordered = sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION")
         for until in ordered:
@@ -1416,8 +1469,18 @@ class _Compiler:
                 target = pose_expr
         elif kind == "Relative":
             label = name
+            to: Expr = Name(f"{name}_to_p")
+            start: Expr = Name(f"{name}_from_p")
+            if self.version < 5:
+                # PolyScope 3 writes no waypoint globals: the two poses in place, as for a
+                # fixed waypoint [U: no PolyScope 3 script with a relative waypoint seen]
+                to_pose, from_pose = self.pose_of(node), self.pose_of(node, "from_")
+                if to_pose is None or from_pose is None:
+                    raise self.error(node, "a relative waypoint without its two positions")
+                to = Pose(tuple(_num(v) for v in to_pose))
+                start = Pose(tuple(_num(v) for v in from_pose))
             target = _call("pose_add", _call("get_target_tcp_pose"),
-                           _call("pose_sub", Name(f"{name}_to_p"), Name(f"{name}_from_p")))
+                           _call("pose_sub", to, start))
         else:
             return [self.marker(node, name, "breakAfter")]
         keywords = self.motion_keywords(move, node)

@@ -53,14 +53,16 @@ _SYMBOLS = {"≔": "=", "≟": "==", "≠": "!=", "≤": "<=", "≥": ">=", "∧
 class Expression:
     """A PolyScope expression: ``parts`` are ``(kind, text)`` pairs in order, where kind is
     ``char`` (one character), ``token``, ``var`` (a program or installation variable name),
-    ``io`` (a pin name), ``waypoint`` (a waypoint name). ``label`` is the text PolyScope shows,
-    ``script`` the URScript text it generates."""
+    ``io`` (a pin name), ``waypoint`` (a waypoint name), ``feature`` (an installation
+    feature used as a constant: the compiler writes its pose; its name here). ``label`` is the
+    text PolyScope shows, ``script`` the URScript text it generates."""
 
     parts: tuple[tuple[str, str], ...] = ()
 
     @property
     def label(self) -> str:
-        return "".join(text for _kind, text in self.parts)
+        return "".join(f"{text}_const" if kind == "feature" else text
+                       for kind, text in self.parts)
 
     @property
     def script(self) -> str:
@@ -425,6 +427,11 @@ class _Reader:
                 # PolyScope's built-in Tool feature: where the tool is [U: no script
                 # PolyScope wrote for it seen; its pose in Base is the TCP's]
                 return ("token", "get_actual_tcp_pose()")
+            if piece.tag == "ExpressionGeomFeature" and name:
+                # another feature as a constant: its pose in the installation (seen:
+                # "Base_var:=Base_1_const" is written ``global Base_var=p[...]``, the
+                # installation's pose of Base_1; PolyScope 5.8, loukjeab/WS2223...)
+                return ("feature", name)
             return ("var", name)
         return ("token", piece.get("name", ""))
 
@@ -641,9 +648,19 @@ def _event(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     node.fields["expression"] = reader.expression(element.find("expression"))
 
 
+def _until(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
+    """An Until node: an EXPRESSION Until keeps its condition in ``<ExpressionBranch>``
+    (seen: PolyScope 5.10, o2ac/o2ac-ur), older files in ``<expression>`` [U]."""
+    branch = element.find("ExpressionBranch")
+    if branch is None:
+        branch = element.find("expression")
+    if branch is not None:
+        node.fields["expression"] = reader.expression(branch)
+
+
 _FIELDS = {
     "Move": _move, "Waypoint": _waypoint, "Loop": _loop, "If": _if, "Wait": _wait,
     "Set": _set, "Assignment": _assignment, "Script": _script, "Popup": _popup,
     "Comment": _comment, "Timer": _timer, "Direction": _direction, "Force": _force,
-    "SubProgram": _subprogram, "CallSubProgram": _call, "Event": _event,
+    "SubProgram": _subprogram, "CallSubProgram": _call, "Event": _event, "Until": _until,
 }
