@@ -515,26 +515,29 @@ def _features(root: ElementTree.Element, path: str) -> tuple[tuple[str, tuple[fl
             if element.tag == "GeomPoseNode":
                 pose = _point(element, name, path)
             elif element.tag == "GeomPlaneNode":
-                points = []
-                for tag in ("firstPoint", "secondPoint", "thirdPoint"):
-                    point = element.find(f"{tag}/GeomPoseNode")
-                    value = _point(point, name, path) if point is not None else None
-                    if value is not None:
-                        points.append(value)
+                points = _points(element, ("firstPoint", "secondPoint", "thirdPoint"), name,
+                                 path)
                 pose = _plane(points) if len(points) == 3 else None
             elif element.tag == "GeomLineNode":
-                points = []
-                for tag in ("firstPoint", "secondPoint"):
-                    point = element.find(f"{tag}/GeomPoseNode")
-                    value = _point(point, name, path) if point is not None else None
-                    if value is not None:
-                        points.append(value)
+                points = _points(element, ("firstPoint", "secondPoint"), name, path)
                 pose = _line(points) if len(points) == 2 else None
             else:
                 continue
             if pose is not None:
                 features.append((name, pose))
     return tuple(features)
+
+
+def _points(element: ElementTree.Element, tags: tuple[str, ...], name: str,
+            path: str) -> list:
+    """The poses of a plane's or line's taught points (``tags``) that are there and read."""
+    points = []
+    for tag in tags:
+        point = element.find(f"{tag}/GeomPoseNode")
+        value = _point(point, name, path) if point is not None else None
+        if value is not None:
+            points.append(value)
+    return points
 
 
 _BUILT_IN = frozenset((
@@ -558,12 +561,7 @@ def _conveyors(root: ElementTree.Element, path: str) -> tuple[Conveyor, ...]:
         name = line.get("name")
         if not name:
             continue
-        points = []
-        for tag in ("firstPoint", "secondPoint"):
-            point = line.find(f"{tag}/GeomPoseNode")
-            value = _point(point, name, path) if point is not None else None
-            if value is not None:
-                points.append(value)
+        points = _points(line, ("firstPoint", "secondPoint"), name, path)
         if len(points) == 2:
             lines.setdefault(name, (points[0], points[1]))
     conveyors = []
