@@ -452,11 +452,18 @@ def main(argv: list[str] | None = None) -> int:
         # one committed only after the .script (vicisnotokay/Devs-1, 66 s later) as of the
         # pair's commit
         saved = last_commit(gitdir, commit, script_path)
-        name = program.installation_path or program.installation
-        installation, variables, absent = load_installation(
-            gitdir, saved if args.installation == "saved" else commit, urp_path, name)
-        if absent and saved != commit:
-            installation, variables, absent = load_installation(gitdir, commit, urp_path, name)
+        # the names `urdsl compile` tries, in its order: the relative path (``../default``:
+        # the parent folder on the robot), then the name in the program's folder (a copy
+        # beside the programs: o2ac/o2ac-ur b_bot)
+        names = [n for n in (program.installation_path, program.installation) if n] or [None]
+        for name in dict.fromkeys(names):
+            installation, variables, absent = load_installation(
+                gitdir, saved if args.installation == "saved" else commit, urp_path, name)
+            if absent and saved != commit:
+                installation, variables, absent = load_installation(
+                    gitdir, commit, urp_path, name)
+            if not absent:
+                break
         if absent:
             st["no_installation"][absent] += 1
         else:
