@@ -189,3 +189,21 @@ def test_help_says_a_python_file_is_run(command, capsys):
         main([command, "--help"])
     out = " ".join(capsys.readouterr().out.split())
     assert "run as Python" in out
+
+
+def test_a_urp_that_is_urscript_text_is_linted_as_a_script_when_named(tmp_path, capsys):
+    # projects keep script templates as .urp (a PolyScope program is XML): named, such a
+    # file is read as URScript with a note; found in a folder it is named in a warning only
+    text = "def main():\n  textmsg(undefined_name)\nend\nmain()\n"
+    (tmp_path / "driver.urp").write_text(text)
+    status, out, _ = run(capsys, str(tmp_path / "driver.urp"), "--format", "json")
+    found = {(d["code"], d["severity"], d["line"]) for d in json.loads(out)}
+    assert status == 1
+    assert found == {("URS001", "info", 1), ("URS101", "error", 2)}
+    status, out, _ = run(capsys, str(tmp_path), "--format", "json")
+    (only,) = json.loads(out)
+    assert status == 0 and only["severity"] == "warning" and "not linted" in only["message"]
+    # a real program's .urp is still read as one: truncated XML is an error
+    (tmp_path / "driver.urp").write_text('<URProgram name="x"><children>')
+    status, out, _ = run(capsys, str(tmp_path / "driver.urp"), "--format", "json")
+    assert status == 1 and "truncated" in json.loads(out)[0]["message"]

@@ -149,3 +149,11 @@ def test_a_torque_loop_on_unknown_values_still_takes_a_frame_per_turn(tmp_path, 
     report = json.loads(capsys.readouterr().out)
     assert status == 0, report["findings"]
     assert "URS207" not in [f["code"] for f in report["findings"]]
+
+
+def test_a_urp_that_is_urscript_text_is_checked_as_a_script(tmp_path, capsys):
+    (tmp_path / "prog.urp").write_text("def main():\n  textmsg(undefined_name)\nend\nmain()\n")
+    assert main(["check", "--json", "--no-project", str(tmp_path / "prog.urp")]) == 1
+    report = json.loads(capsys.readouterr().out)
+    found = [(f["code"], f["severity"], f["line"]) for f in report["findings"]]
+    assert found == [("URS001", "info", 1), ("URS201", "error", 2)]

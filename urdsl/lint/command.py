@@ -168,8 +168,17 @@ class _Projects:
         return project.context(file), extra  # type: ignore[attr-defined]
 
 
+_TEXT_URP = ("this .urp is text, not a PolyScope program (PolyScope saves a program as XML, "
+             "gzip-compressed or plain): read as a URScript file")
+_TEXT_URP_SKIPPED = ("not linted: this .urp is text, not a PolyScope program (PolyScope saves a "
+                     "program as XML, gzip-compressed or plain); name it on the command line "
+                     "to lint it as a URScript file")
+
+
 def cmd_lint(args: argparse.Namespace) -> int:
     from .._cli import EXIT_OK, EXIT_PROBLEMS, UsageError, read_input
+    from ..polyscope.urp import is_text_file
+    from ..script.diagnostics import Diagnostic
     from . import report
     from .config import ConfigError, settings_for
     from .linter import lint_text, lint_tree
@@ -186,8 +195,14 @@ def cmd_lint(args: argparse.Namespace) -> int:
     ran: set[str] = set()
     for name, root in pairs:
         if name.lower().endswith(".urp"):
-            found.extend(_lint_urp(name, select, ignore, args))
-            continue
+            if not is_text_file(name):
+                found.extend(_lint_urp(name, select, ignore, args))
+                continue
+            if root is not None:  # found in a folder, not named: its names may live in
+                # other such files, which a project does not read; say so, lint nothing
+                found.append(Diagnostic(name, 1, 1, "warning", "URS001", _TEXT_URP_SKIPPED))
+                continue
+            found.append(Diagnostic(name, 1, 1, "info", "URS001", _TEXT_URP))
         source = read_input(name)
         label = args.stdin_filename if name == "-" and args.stdin_filename else source.name
         where = source.path if source.path is not None else args.stdin_filename

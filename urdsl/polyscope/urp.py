@@ -233,6 +233,27 @@ def parse_urp(data: bytes, path: str = "<urp>") -> Program:
     return reader.program()
 
 
+def is_text_file(path: str | Path) -> bool:
+    """Whether the ``.urp`` at ``path`` is plain text that is not XML (a script file given the
+    extension: seen in projects that keep URScript templates as ``.urp``): PolyScope saves
+    a program as gzip-compressed or plain XML. False when the file cannot be read."""
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(4096)
+    except OSError:
+        return False
+    if head.startswith(b"\x1f\x8b"):
+        return False
+    try:
+        text = head.decode("utf-8")
+    except UnicodeDecodeError as error:  # a multi-byte character cut at the end of head
+        if error.start < len(head) - 3:
+            return False
+        text = head[:error.start].decode("utf-8")
+    text = text.lstrip("\ufeff \t\r\n")
+    return bool(text) and not text.startswith("<") and "\x00" not in text
+
+
 def _looks_like_urscript(data: bytes) -> bool:
     """Whether text that is not XML reads as URScript (seen: script files saved as
     ``.urp``)."""

@@ -152,6 +152,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         options.cell = load_cell(robot, args.cell)
     from ..dsl.command import ProgramFileError
     from ..dsl.errors import DslError
+    from ..polyscope.urp import is_text_file
 
     reports = []
     failed = False
@@ -163,7 +164,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                 print(str(error), file=sys.stderr)
                 failed = True
                 continue
-        elif name.lower().endswith(".urp"):
+        elif name.lower().endswith(".urp") and not is_text_file(name):
             report = _bounded(name, options, lambda o, n=name: _check_urp(n, args, o))
             if report is None:
                 failed = True
@@ -171,6 +172,13 @@ def cmd_check(args: argparse.Namespace) -> int:
         else:
             source = read_input(name)
             report = _bounded(name, options, lambda o, s=source: _check_script(s, args, o))
+            if name.lower().endswith(".urp"):  # a script file given the extension
+                from ..lint.command import _TEXT_URP
+                from ..script.nodes import Source, Span
+                from .findings import Finding
+
+                span = Span(Source(source.text, source.name), 0, 0)
+                report.findings.insert(0, Finding("URS001", "info", _TEXT_URP, span))
         reports.append(report)
         if not args.json:
             _print(report, args.all_moves)
