@@ -31,6 +31,9 @@ TRIGGERS = [
     ("URS101", "thread blink():\n  on = True\nend\ndef show():\n  textmsg(on)\nend\n",
      [(5, 11)], {}),
     ("URS101", "def f():\n  run worker()\nend\n", [(2, 3)], {}),
+    # no closures: a thread inside a function does not see the function's parameter
+    ("URS101", "def f(speed):\n  thread t():\n    movel(p[0, 0, 0, 0, 0, 0], v=speed)\n"
+     "  end\n  run t()\nend\nf(0.1)\n", [(3, 34)], {}),
     ("URS102", 'textmesg("hello")\n', [(1, 1)], {}),
     ("URS102", "thread t():\n  sync()\nend\nt()\n", [(4, 1)], {}),
     ("URS103", "l = make_list(3, 0, 10)\ntextmsg(l)\n", [(1, 5)], {"version": "3.15"}),
@@ -89,6 +92,9 @@ CLEAN = [
     ("URS101", "thread blink():\n  global on = True\nend\ndef show():\n  textmsg(on)\nend\n", {}),
     ("URS101", "def prog():\n  def f():\n    textmsg(x)\n  end\n  x = 1\n  f()\nend\n", {}),
     ("URS101", "x = pi / 2\ntextmsg(x)\n", {}),
+    # a program's first-level variables are globals: its threads see them
+    ("URS101", "def prog():\n  speed = 0.1\n  thread t():\n    textmsg(speed)\n  end\n"
+     "  run t()\nend\n", {}),
     ("URS102", 'textmsg("hello")\ndef f():\n  return 1\nend\nx = f()\n', {}),
     ("URS103", "l = make_list(3, 0, 10)\ntextmsg(l)\n", {"version": "5.15"}),
     ("URS103", "l = make_list(3, 0, 10)\ntextmsg(l)\n", {}),

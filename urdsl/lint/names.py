@@ -151,7 +151,16 @@ def undefined_name(ctx: LintContext) -> Iterator[Diagnostic]:
                 continue
             hint = None
             owner = _owner(ctx, name.id)
-            if owner is not None:
+            enclosing = scope.parent
+            while enclosing is not None and enclosing.parent is not None \
+                    and not enclosing.binds(name.id):
+                enclosing = enclosing.parent
+            if enclosing is not None and enclosing.parent is not None:
+                hint = (f"`{name.id}` belongs to the enclosing {enclosing.kind} "
+                        f"{enclosing.name}(); a {scope.kind} defined inside it sees only its "
+                        "own names and the globals (URScript has no closures): pass it "
+                        "through a global variable")
+            elif owner is not None:
                 hint = (f"`{name.id}` is local to {owner.kind} {owner.name}(); declare it "
                         f"`global {name.id}` there, or assign it at the first level")
             elif lookup(name.id) is not None:

@@ -63,6 +63,20 @@ class Scope:
         return (name in self.assigned or name in self.params or name in self.declared_local
                 or name in self.declared_global)
 
+    def sees(self, name: str) -> bool:
+        """Whether code of this scope finds ``name`` among the program's variables: bound
+        here, or at the first level of the program (its globals). URScript has no closures:
+        a function or thread nested in another function sees only its own names and the
+        globals, not the enclosing function's parameters and locals (the manual's scoping
+        rules: nested definitions follow the rules of functions; the controller rejects a
+        thread reading such a name: "name '...' is not defined")."""
+        if self.binds(name):
+            return True
+        top = self
+        while top.parent is not None:
+            top = top.parent
+        return top is not self and top.binds(name)
+
     def local_names(self) -> set[str]:
         """Names bound in this scope itself (parameters, assignments, declarations)."""
         return (set(self.params) | set(self.assigned) | set(self.declared_local)
@@ -100,11 +114,8 @@ class Analysis:
 
     def defined(self, name: str, scope: Scope) -> bool:
         """Whether reading ``name`` in ``scope`` finds a variable, function or thread."""
-        current: Scope | None = scope
-        while current is not None:
-            if current.binds(name):
-                return True
-            current = current.parent
+        if scope.sees(name):
+            return True
         return (name in self.globals or name in self.functions or name in self.threads
                 or name in BUILTIN_VARIABLES)
 

@@ -90,11 +90,8 @@ def _first_writes(scope) -> dict[str, int]:
 def _bound_in_file(analysis, name: str, scope) -> bool:
     """Whether reading ``name`` in ``scope`` finds a variable, function or thread of the file
     itself (the controller's own variables not counted)."""
-    current = scope
-    while current is not None:
-        if current.binds(name):
-            return True
-        current = current.parent
+    if scope.sees(name):
+        return True
     return name in analysis.globals or name in analysis.functions or name in analysis.threads
 
 
