@@ -111,7 +111,8 @@ def test_lint_names_the_node(cell, capsys):
     assert any("node Robot Program > MoveL" in d["message"] for d in found)
 
 
-@pytest.mark.parametrize("data", [b"\x89garbage\xff\x00", gzip.compress(b"<URProgram><children>")[:-6],
+@pytest.mark.parametrize("data", [b"\x89garbage\xff\x00",
+                                  gzip.compress(b"<URProgram><children>")[:-6],
                                   b"<URProgram name='x'><children></children></URProgram>"])
 def test_a_broken_program_is_one_message(tmp_path, capsys, data):
     program = tmp_path / "broken.urp"
