@@ -21,7 +21,9 @@ wrote is compared as written. Two views: the whole program, and the program part
 level statements from the first waypoint global, definition or marker on: what the program
 tree, not the installation, generates).
 
-The installation is the one the program names (``installationRelativePath``). A Script
+The installation is the one the program names (``installationRelativePath``); when that
+is not there, the one named like the ``.urp`` beside it (renamed with the program: the
+``.urp`` keeps the name it was saved with). A Script
 node's file is read from the repository as it was in the last commit that changed the
 .script (PolyScope compiles the file's contents when it saves, not the copy the .urp keeps;
 ``--script-files cache`` takes that copy instead). A script file edited after the save but
@@ -46,9 +48,13 @@ installation.
 Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back;
 ``extra``: projects found later, used to find the variants the tune pairs lack; ``tune2``:
 projects found after those, two of every three in the order they were added, the third
-``held``),
+``held``; ``tune3``: the same for the projects found after the ``tune2`` ones),
 the share of programs exact, the mean share of matching lines and the node types whose lines
-differ most. ``--show N`` prints the first differing lines of N programs.
+differ most; then each project's share of programs exact (program part, whole, whole among
+the programs with their installation) and the mean of these over the projects, each project
+weighing the same (a few projects hold most pairs: nedlecky/UR, CA-Giken, mswaidan,
+Unitedplasticfabricating). A program that does not compile counts as not exact.
+``--show N`` prints the first differing lines of N programs.
 """
 
 from __future__ import annotations
@@ -328,6 +334,13 @@ def load_installation(gitdir: Path, commit: str, urp_path: str, name: str | None
     folder = PurePosixPath(urp_path).parent
     data = git_show(gitdir, commit, _join(folder, f"{name}.installation"))
     if data is None:
+        # renamed with the program: the files of one save carry the .urp's new name
+        # (loukjeab/WS2223_Master_Semester_Project_Workpiece_Transfer_Unit: UR5e_Program.urp,
+        # .script, .installation, .variables; the .urp names the installation it was saved
+        # with, OPC_UA_LJ_Henrik_Installation_01.02.2023)
+        name = PurePosixPath(urp_path).stem
+        data = git_show(gitdir, commit, _join(folder, f"{name}.installation"))
+    if data is None:
         return None, [], "the installation file is not in the repository"
     try:
         installation = parse_installation(data, f"{name}.installation")
@@ -345,13 +358,50 @@ def compare(ours: list[str], theirs: list[str]) -> float:
     return same / max(len(theirs), len(ours))
 
 
+def project_means(projects: dict[str, list[int]]) -> tuple[float, float, float | None, int]:
+    """The mean over projects of the share of programs exact: program part, whole, whole
+    among the programs with their installation (None when no project has one), and how many
+    projects have their installation. Each project weighs the same, whatever its number of
+    programs; a program that does not compile counts as not exact. ``projects`` maps a
+    repository to [programs, exact program part, exact whole, programs with their
+    installation, exact whole of those]."""
+    counted = [v for v in projects.values() if v[0]]
+    if not counted:
+        return 0.0, 0.0, None, 0
+    part = sum(v[1] / v[0] for v in counted) / len(counted)
+    whole = sum(v[2] / v[0] for v in counted) / len(counted)
+    with_ = [v for v in counted if v[3]]
+    whole_with = sum(v[4] / v[3] for v in with_) / len(with_) if with_ else None
+    return part, whole, whole_with, len(with_)
+
+
+def print_projects(projects: dict[str, list[int]]) -> None:
+    """The per-project view of a split: one line per project (share exact of its programs:
+    program part, whole; whole among those with their installation), then the means over
+    the projects. One project with many programs can carry a split's per-program figure."""
+    counted = {k: v for k, v in projects.items() if v[0]}
+    print(f"  per project ({len(counted)}; exact program part, whole, whole with installation,"
+          " of programs):")
+    width = max((len(repo) for repo in counted), default=0)
+    for repo, v in sorted(counted.items(), key=lambda item: (-item[1][0], item[0])):
+        with_ = f"{v[4]}/{v[3]}" if v[3] else "-"
+        print(f"    {repo:<{width}} {v[1]:>3}/{v[0]:<3} {v[2]:>3}/{v[0]:<3} {with_:>7}"
+              f"  ({v[1] / v[0]:.0%} part, {v[2] / v[0]:.0%} whole)")
+    if counted:
+        part, whole, whole_with, n_with = project_means(counted)
+        print(f"  mean over the {len(counted)} projects: program part exact {part:.1%}, "
+              f"whole exact {whole:.1%}" + (
+                  f", whole exact with installation {whole_with:.1%} (over {n_with})"
+                  if whole_with is not None else ""))
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repos", type=Path, default=Path("/work/.mirror"),
                         help="folder of owner+name git dirs")
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
-    parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "all"),
+    parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "tune3", "all"),
                         default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
     parser.add_argument("--script-files", choices=("file", "cache"), default="file",
@@ -380,7 +430,9 @@ def main(argv: list[str] | None = None) -> int:
                                       "pre_found": 0, "pre_extra": 0, "with": 0,
                                       "exact_with": 0, "no_installation": collections.Counter(),
                                       "pre_kinds": collections.Counter(), "projects": {}})
-        project = st["projects"].setdefault(repo, [0, 0, 0])  # programs, exact part, whole
+        # programs, exact program part, exact whole, with their installation, exact whole
+        # of those: every program counts, one that does not compile as not exact
+        project = st["projects"].setdefault(repo, [0, 0, 0, 0, 0])
         gitdir = git_dir(args.repos, repo)
         urp = git_show(gitdir, commit, urp_path)
         script = git_show(gitdir, commit, script_path)
@@ -388,6 +440,7 @@ def main(argv: list[str] | None = None) -> int:
             st["missing"] += 1
             continue
         st["n"] += 1
+        project[0] += 1
         try:
             program = parse_urp(urp, urp_path)
         except UrpError as error:
@@ -408,6 +461,7 @@ def main(argv: list[str] | None = None) -> int:
             st["no_installation"][absent] += 1
         else:
             st["with"] += 1
+            project[3] += 1
         reference = script.decode("utf-8", "replace")
         by_text = True
         try:
@@ -421,11 +475,13 @@ def main(argv: list[str] | None = None) -> int:
                 continue
         if not any(isinstance(item, Marker) for item in _walk_items(theirs_tree)):
             st["n"] -= 1
+            project[0] -= 1
             st["not_polyscope"] += 1
             if absent:
                 st["no_installation"][absent] -= 1
             else:
                 st["with"] -= 1
+                project[3] -= 1
             continue
         try:
             folder = PurePosixPath(urp_path).parent
@@ -469,11 +525,11 @@ def main(argv: list[str] | None = None) -> int:
         st["exact"] += exact
         st["exact_written"] += ours == theirs
         st["exact_prog"] += ours_prog == theirs_prog
-        project[0] += 1
         project[1] += ours_prog == theirs_prog
         project[2] += exact
         if not absent:
             st["exact_with"] += exact
+            project[4] += exact
         if ours_prog != theirs_prog:
             for kind in compiled.kinds_in_diff(ours_prog, theirs_prog):
                 st["kinds"][kind] += 1
@@ -518,14 +574,7 @@ def main(argv: list[str] | None = None) -> int:
                                                  st["errors"].most_common(5)))
         print("  node types in differing lines: " + ", ".join(
             f"{k} {v}" for k, v in st["kinds"].most_common(8)))
-        # one project with many programs can carry a split: its share per project, and the
-        # mean over projects
-        projects = {k: v for k, v in st["projects"].items() if v[0]}
-        print("  per project (exact program part / whole, of programs): " + "; ".join(
-            f"{k} {v[1]}/{v[2]} of {v[0]}" for k, v in sorted(projects.items())))
-        if projects:
-            mean = sum(v[1] / v[0] for v in projects.values()) / len(projects)
-            print(f"  mean over the {len(projects)} projects: program part exact {mean:.1%}")
+        print_projects(st["projects"])
     return 0
 
 

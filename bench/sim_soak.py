@@ -17,24 +17,18 @@ bench stops the simulator and fails.
 from __future__ import annotations
 
 import argparse
-import shutil
 import socket
 import struct
 import subprocess
 import sys
 import time
-from pathlib import Path
+
+from sim_bench import _command  # bench/ is on sys.path when this runs as a script
 
 from urdsl.protocol.primary import PrimaryDecoder, RuntimeExceptionMessage, TextMessage
 
 OFFSET = 3300
 HOST = "127.0.0.1"
-
-
-def _command(*args: str) -> list[str]:
-    script = Path(sys.executable).with_name("urdsl")
-    found = str(script) if script.exists() else shutil.which("urdsl")
-    return [found, "sim", *args] if found else [sys.executable, "-m", "urdsl.cli", "sim", *args]
 
 
 def rss_mib(pid: int) -> float:

@@ -99,7 +99,10 @@ def test_rotation_vectors_round_trip(axis, angle):
         axis = np.array([0.0, 0.0, 1.0])
     rv = axis / np.linalg.norm(axis) * angle
     back = _matrix_to_rotvec(_rotvec_to_matrix(rv))
-    assert np.allclose(_rotvec_to_matrix(back), _rotvec_to_matrix(rv), atol=1e-9)
+    # near a half turn the angle comes from the acos of the trace, as PolyScope computes it,
+    # which keeps about 8 digits (axis [0, 1, 0.5] at exactly pi: 2e-8 off)
+    tolerance = 1e-7 if math.pi - angle < 1e-6 else 1e-9
+    assert np.allclose(_rotvec_to_matrix(back), _rotvec_to_matrix(rv), atol=tolerance)
     assert np.linalg.norm(back) <= math.pi + 1e-12
 
 

@@ -392,3 +392,84 @@ def test_a_plane_a_hair_off_a_half_turn_is_written_as_polyscope_writes_it():
     half = math.pi / math.sqrt(2)
     assert pose[3:5] == pytest.approx((half, half), abs=1e-12)
     assert pose[5] == pytest.approx(math.pi * 1e-9 / (2 * math.sqrt(2)), abs=1e-15)
+
+
+def _conveyor_installation(switch: str = "true", encoder: str = "1", kind: str = "1",
+                           major: str = "3") -> bytes:
+    """Usaakm/UR10-Conveyor-Belt's conveyor (3.15): conveyor 0, linear, an incremental
+    encoder on digital inputs 0 and 1, 13333 ticks a metre, its direction a line feature
+    taught by two points; output 7 high when the program stops; EtherNet/IP on."""
+    line = (_point("firstPoint", (0.8, -0.45, -0.17), (-3.1, -0.2, 0.0))
+            + _point("secondPoint", (-0.85, -0.46, -0.16), (-3.1, -0.2, 0.0)))
+    return f"""<Installation><Version major="{major}" minor="15" bugfix="4"/>
+  <IOs><DigitalOutputActions value="NONE, NONE, NONE, NONE, NONE, NONE, NONE,
+    HIGH_WHEN_PROGRAM_STOPPED"/></IOs>
+  <Features>
+    <GeomLineNode><GeomLineNode name="belt" isVariable="false">{line}</GeomLineNode>
+    </GeomLineNode>
+    <GeomPoseNode><GeomPoseNode name="pick" isVariable="true">
+      <toolPosition value="0.4, -0.1, 0.25"/><toolAxisAngle value="0.0, 3.14, 0.0"/>
+    </GeomPoseNode></GeomPoseNode>
+  </Features>
+  <Contributions><URCaps>
+    <Contributed ownerId="com.ur.urcap.conveyortracking" id="ConveyorTracking"
+        name="Conveyor Tracking" vendor="Universal Robots">
+      <data key="major.version" value="3"/><data key="enabled_0" value="true"/>
+      <data key="apin_0" value="0"/><data key="bpin_0" value="1"/>
+      <data key="tpr_0" value="0"/><data key="rotateTool_0" value="false"/>
+      <data key="encoderType_0" value="{encoder}"/><data key="incrementalMode_0" value="1"/>
+      <data key="conveyorType_0" value="{kind}"/><data key="direction_0" value="belt"/>
+      <data key="tpm_0" value="13333"/><data key="switchDirection_0" value="{switch}"/>
+      <data key="enabled_1" value="false"/><data key="apin_1" value="2"/>
+    </Contributed>
+    <Contributed ownerId="com.ur.urcap.ethernetip" id="EthernetIP" name="Ethernet/IP">
+      <data key="enabled" value="true"/><data key="watchdogAction" value="IGNORE"/>
+    </Contributed>
+  </URCaps></Contributions>
+</Installation>""".encode()
+
+
+_FIRST = "p[0.8, -0.45, -0.17, -3.1, -0.2, 0.0]"
+_SECOND = "p[-0.85, -0.46, -0.16, -3.1, -0.2, 0.0]"
+
+
+@pytest.mark.parametrize("switch, direction", [
+    ("true", f"pose_sub({_FIRST}, {_SECOND})"),  # U.urp (Testings/UR10_Code_V2)
+    ("false", f"pose_sub({_SECOND}, {_FIRST})"),  # Lower_Z.urp (UR10_Code_V1)
+])
+def test_conveyor_tracking_writes_its_encoder_and_its_start_function(switch, direction):
+    """After the features: the encoder's pulse decoding, then the function the program's
+    conveyor tracking node calls; the direction is the line's second point minus its first,
+    or the first minus the second when switched; a disabled conveyor writes nothing."""
+    program = parse_urp(_urp("3.15.4.106291"), "pre.urp")
+    installation = parse_installation(_conveyor_installation(switch), "cell.installation")
+    blocks = dict(preamble_blocks(program, installation, []))
+    lines = [print_tree(item).strip() for item in blocks["conveyor"]]
+    assert lines == ["encoder_enable_pulse_decode(0, 1, 0, 1)",
+                     "def start_conveyor_tracking0():\n"
+                     f"  track_conveyor_linear({direction}, 13333, 0)\nend"]
+    kinds = list(blocks)
+    assert kinds.index("features") < kinds.index("conveyor") < kinds.index("watchdog")
+    text = compile_program(program, installation).text
+    assert text.index("global pick") < text.index("encoder_enable_pulse_decode(0, 1, 0, 1)") \
+        < text.index("def start_conveyor_tracking0():") < text.index("rtde_set_watchdog(")
+    assert "tracking1" not in text and "global belt" not in text  # the line is not variable
+
+
+def test_a_conveyor_urdsl_cannot_write_is_said():
+    """An encoder other than the incremental one and a conveyor that is not linear: no
+    script seen, a comment each, nothing guessed."""
+    blocks = _blocks(_urp("3.15.4.106291"), _conveyor_installation(encoder="2", kind="2"))
+    assert blocks["conveyor"] == ["# urdsl: conveyor 0's encoder (type 2) is not written",
+                                  "# urdsl: conveyor 0 (type 2) is not written"]
+
+
+def test_polyscope_3_sets_each_outputs_stop_state_only():
+    """PolyScope 3.15 writes only ``set_runstate_standard_digital_output_to_value(7, 2)``
+    (output 7 high when the program stops: state 2); PolyScope 5 first names the outputs
+    that have a state (mswaidan/finishing-line, 5.11)."""
+    three = _blocks(_urp("3.15.4.106291"), _conveyor_installation())
+    assert three["io"] == ["set_runstate_standard_digital_output_to_value(7, 2)"]
+    five = _blocks(_urp("5.11.5.1010327"), _conveyor_installation(major="5"))
+    assert five["io"] == ["set_runstate_standard_digital_outputs([7])",
+                          "set_runstate_standard_digital_output_to_value(7, 2)"]

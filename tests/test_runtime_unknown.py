@@ -176,6 +176,55 @@ def test_a_thread_looping_on_an_input_without_sync_is_still_stopped():
     assert result.error is not None and result.error.diagnostic.code == "URS207"
 
 
+POLLING = """\
+movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])
+while True:
+  force = get_tcp_force()
+  if force[2] <= -18:
+    movej([0.3, -1.5708, 1.5708, -1.5708, -1.5708, 0])
+  elif force[0] >= 18:
+    movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])
+  end
+  while norm(get_target_joint_speeds()) >= 0.0001:
+    sync()
+  end
+end
+"""
+
+
+def test_a_loop_that_acts_only_when_pushed_spins_when_nobody_pushes():
+    # it moves while the operator pushes the arm, and loops without physical time when
+    # nobody does: the check follows a working sensor for a few passes, then an idle one
+    from urdsl.runtime.unknown import IDLE_AFTER_PASSES
+    from urdsl.verify.run import check_text
+
+    report = check_text(POLLING, "push.script")
+    (spin,) = [f for f in report.findings if f.severity == "error"]
+    assert spin.code == "URS207" and spin.span.line == 2
+    (note,) = [f for f in report.findings if f.span.line == 4]
+    assert f"for the loop's first {IDLE_AFTER_PASSES} passes, then skips it" in note.message
+    assert len(report.moves) == 1 + IDLE_AFTER_PASSES  # the pushes of the first passes
+
+
+@pytest.mark.parametrize("change", [
+    ("  end\n  while norm", "  end\n  sync()\n  while norm"),  # it waits a frame each pass
+    ("  force = get_tcp_force()", "  force = get_tcp_force()\n  sleep(0.1)"),
+    ("  force = get_tcp_force()", "  force = get_tcp_force()\n  pause()"),  # a def may wait
+])
+def test_a_loop_that_takes_time_of_its_own_is_not_left_idle(change):
+    from urdsl.runtime.unknown import polls_devices
+    from urdsl.verify.run import CheckOptions, check_text
+
+    text = ("def pause():\n  sleep(0.1)\nend\n" if "pause" in change[1] else "") + \
+        POLLING.replace(*change)
+    loop = next(s for s in parse(text, "prog.script").body if type(s).__name__ == "While")
+    assert polls_devices(parse(POLLING, "prog.script").body[1].body)
+    assert not polls_devices(loop.body)
+    report = check_text(text, "push.script", options=CheckOptions(max_time=30.0))
+    assert [f.code for f in report.findings if f.severity == "error"] == []
+    assert any(f.code == "URS312" for f in report.findings)  # it ran until the bound
+
+
 def test_a_socket_read_with_a_timeout_the_device_sent_still_waits():
     # UR's External Control loop: the read's timeout comes from the previous reply
     result = run('socket_open("127.0.0.1", 50001, "reverse")\n'
@@ -303,11 +352,15 @@ def test_a_name_left_unassigned_by_a_branch_the_check_skipped_is_a_warning():
     text = ('answer = request_integer_from_primary_client("1, 2 or 5 to stop")\n'
             "if answer == 5:\n  answer = 0\nend\n"
             "if answer == 1:\n  kind = 10\nelif answer == 2:\n  kind = 20\nend\n"
-            "textmsg(kind)\n")
+            "textmsg(kind)\n"
+            "movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])\n")
     report = check_text(text, "ask.script")
-    (finding,) = [f for f in report.findings if f.code == "URS201"]
+    (finding,) = [f for f in report.findings if "'kind' is not defined" in f.message]
     assert finding.severity == "warning" and finding.span.line == 10
     assert "depends on the replies the check assumed (the first at line 2)" in finding.message
+    # the check goes on with the name's value unknown: the move after it is checked
+    assert not [f for f in report.findings if f.severity == "error"]
+    assert [m.span.line for m in report.moves] == [11]
     # a name the program never assigns stays an error
     report = check_text(text.replace("textmsg(kind)", "textmsg(knid)"), "ask.script")
     (finding,) = [f for f in report.findings if f.code == "URS201"]

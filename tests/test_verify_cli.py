@@ -34,14 +34,16 @@ def test_a_good_program_exits_0_and_lists_its_moves(files, capsys):
 
 
 def test_errors_exit_1_and_show_the_line(files, capsys):
-    assert main(["check", str(files / "bad.script"), "--no-self-collision"]) == 1
+    assert main(["check", str(files / "bad.script"), "--no-self-collision",
+                 "--robot", "ur5e"]) == 1
     out = capsys.readouterr().out
     assert "bad.script:2:1" in out and "URS301" in out
     assert "movel(p[1.5, 0.2, 0.3, 0, 3.1416, 0])" in out
 
 
 def test_json_report_is_one_document_even_on_failure(files, capsys):
-    assert main(["check", str(files / "bad.script"), "--json", "--no-self-collision"]) == 1
+    assert main(["check", str(files / "bad.script"), "--json", "--no-self-collision",
+                 "--robot", "ur5e"]) == 1
     report = json.loads(capsys.readouterr().out)
     assert report["ok"] is False and report["robot"] == "ur5e"
     (finding,) = report["findings"]
@@ -103,7 +105,8 @@ def test_a_cell_with_a_table_in_reach_finds_the_collision(files, tmp_path, capsy
     cell = tmp_path / "cell.toml"
     cell.write_text('[[box]]\nname = "fixture"\nsize = [0.3, 0.3, 0.3]\n'
                     'pose = [-0.3, -0.08, 0.35, 0, 0, 0]\n')
-    assert main(["check", str(files / "good.script"), "--cell", str(cell), "--json"]) == 1
+    assert main(["check", str(files / "good.script"), "--cell", str(cell), "--json",
+                 "--robot", "ur5e"]) == 1
     report = json.loads(capsys.readouterr().out)
     assert any(f["code"] == "URS308" and "fixture" in f["message"]
                for f in report["findings"])
@@ -111,7 +114,7 @@ def test_a_cell_with_a_table_in_reach_finds_the_collision(files, tmp_path, capsy
 
 def test_user_joint_limits(files, capsys):
     assert main(["check", str(files / "good.script"), "--json", "--no-self-collision",
-                 "--q-max", "6.28,6.28,6.28,6.28,6.28,-0.5"]) == 1
+                 "--robot", "ur5e", "--q-max", "6.28,6.28,6.28,6.28,6.28,-0.5"]) == 1
     report = json.loads(capsys.readouterr().out)
     assert {f["code"] for f in report["findings"]} == {"URS303"}  # one per move
     assert [f["line"] for f in report["findings"]] == [1, 3, 4]
@@ -130,7 +133,7 @@ def test_a_program_that_starts_where_the_arm_was_left(tmp_path, capsys):
     assert status == 0, report["findings"]
     (note,) = [f for f in report["findings"] if f["code"] == "URS210"]
     assert "the program starts" in note["message"]
-    status = main(["check", str(path), "--json", "--no-project",
+    status = main(["check", str(path), "--json", "--no-project", "--robot", "ur5e",
                    "--start-joints", "0,-1.9,1.9,-1.57,-1.57,0"])
     report = json.loads(capsys.readouterr().out)
     assert status == 1

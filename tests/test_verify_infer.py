@@ -409,12 +409,21 @@ def test_a_target_no_ur_model_reaches_stays_an_error(tmp_path, capsys):
     assert finding["severity"] == "error" and "assumed" not in finding["message"]
 
 
-def test_a_hand_written_script_keeps_the_default_model_certain(tmp_path, capsys):
-    text = ("movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])\n"
-            "movel(p[-1.1, -0.1, 0.3, 0, 3.14, 0], a=1.2, v=0.25)\n")
-    report = _check_json(tmp_path, capsys, text)
+def test_a_hand_written_script_is_checked_on_an_assumed_model(tmp_path, capsys):
+    # nothing says which arm a hand-written script runs on: a pose only the assumed UR5e
+    # cannot reach (1.1 m out; a UR10 reaches it) is a warning that says so, a pose no UR
+    # model reaches (2.5 m out) stays an error, and --robot makes the first certain
+    far = "movel(p[-1.1, -0.1, 0.3, 0, 3.14, 0], a=1.2, v=0.25)\n"
+    start = "movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])\n"
+    report = _check_json(tmp_path, capsys, start + far)
+    (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
+    assert finding["severity"] == "warning"
+    assert "on the assumed ur5e: the program does not say which arm" in finding["message"]
+    report = _check_json(tmp_path, capsys, start + far.replace("-1.1", "-2.5"))
     (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
     assert finding["severity"] == "error"
+    report = _check_json(tmp_path, capsys, start + far, "--robot", "ur5e")
+    assert [f["severity"] for f in report["findings"] if f["code"] == "URS301"] == ["error"]
 
 
 def test_a_fragment_of_a_polyscope_program_is_taught_too(tmp_path, capsys):

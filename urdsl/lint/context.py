@@ -9,28 +9,12 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from ..script import nodes as n
-from ..script.builtins import Builtin, Version, lookup
+from ..script.builtins import BLOCKING_CALLS, MOTION_CALLS, Builtin, Version, lookup
 from ..script.diagnostics import Diagnostic
 from .registry import RULES
 from .scope import Analysis, Scope, statements
 
 __all__ = ["LintContext", "MOTION_CALLS", "BLOCKING_CALLS"]
-
-MOTION_CALLS = frozenset((
-    "movej", "movel", "movep", "movec", "optimovej", "optimovel", "servoj", "servoc", "speedj",
-    "speedl", "stopj", "stopl", "direct_torque", "mc_run_motion", "screw_driving",
-))
-"""Builtins that move the arm and take physical time (one frame at least)."""
-
-BLOCKING_CALLS = MOTION_CALLS | frozenset((
-    "sleep", "sync", "socket_read_ascii_float", "socket_read_binary_integer",
-    "socket_read_byte_list", "socket_read_line", "socket_read_string", "socket_get_var",
-    "socket_open", "interpreter_mode", "popup", "request_boolean_from_primary_client",
-    "request_float_from_primary_client", "request_integer_from_primary_client",
-    "request_string_from_primary_client", "tool_contact", "zero_ftsensor", "powerdown",
-))
-"""Builtins that take physical time, so that a loop calling them yields to other threads
-(moves, ``sleep``, ``sync``, socket reads that wait for data, blocking popups)."""
 
 
 @dataclass

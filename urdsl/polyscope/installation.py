@@ -14,8 +14,9 @@ Three layouts are known:
   ``<mountingBaseAngle>``.
 
 Also read: the safety limits and planes, I/O names, point and plane features, Modbus
-signals and the raw attributes of the settings a program's preamble is written from
-(:mod:`.preamble`). URCap data is not read. Lengths in m, angles in rad, masses in kg.
+signals, the conveyors of UR's built-in conveyor tracking and the raw attributes of the
+settings a program's preamble is written from (:mod:`.preamble`). Other URCap data is not
+read. Lengths in m, angles in rad, masses in kg.
 
 A file that is not an installation, is truncated, corrupt or not XML raises
 :class:`InstallationError` naming the file.
@@ -32,7 +33,7 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 __all__ = ["Installation", "InstallationError", "Tcp", "Payload", "read_installation",
-           "ModbusSignal",
+           "ModbusSignal", "Conveyor",
            "Safety", "SafetyPlane", "parse_safety",
            "parse_installation", "find_installation", "GRAVITY"]
 
@@ -87,6 +88,31 @@ class ModbusSignal:
     frequency: float | None = None
     choice: int | None = None
     sequential: bool = False
+
+
+@dataclass(frozen=True)
+class Conveyor:
+    """One conveyor of UR's built-in conveyor tracking (the installation's ``Conveyor
+    Tracking`` node, ``<data key="NAME_N">`` entries for conveyor N), as written.
+
+    ``index``: the conveyor (and encoder) number N; ``kind``: ``conveyorType_N`` (``"1"``
+    linear, the only kind seen); ``encoder``: ``encoderType_N`` (``"1"`` incremental, seen);
+    ``decoder``: ``incrementalMode_N``, the pulse decoder of an incremental encoder;
+    ``pins``: the digital inputs of its A and B signals; ``ticks_per_meter`` (linear) and
+    ``ticks_per_revolution`` (circular); ``direction``: the two points (poses: m, rad) of the
+    line feature ``direction_N`` names, in the order the user taught them, ``None`` when the
+    installation lacks it; ``switch``: the direction reversed; ``rotate_tool`` (circular)."""
+
+    index: int
+    kind: str
+    encoder: str
+    decoder: int | None
+    pins: tuple[int, int] | None
+    ticks_per_meter: float | None
+    ticks_per_revolution: float | None
+    direction: tuple[tuple[float, ...], tuple[float, ...]] | None
+    switch: bool = False
+    rotate_tool: bool = False
 
 
 @dataclass(frozen=True)
@@ -231,6 +257,8 @@ class Installation:
     feature_variable: tuple[tuple[str, bool], ...] = ()
     """Every named feature (point, line, plane) and whether it is variable (a program may
     move it; PolyScope writes waypoints taught in it relative to it)."""
+    conveyors: tuple[Conveyor, ...] = ()
+    """The enabled conveyors of the built-in conveyor tracking, by number."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -349,7 +377,7 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
                         mounting, version, _settings(root), _features(root, path),
                         _io_names(root), _safety(root), _modbus(root, path), _urcaps(root),
-                        _feature_variable(root))
+                        _feature_variable(root), _conveyors(root, path))
 
 
 def _feature_variable(root: ElementTree.Element) -> tuple[tuple[str, bool], ...]:
@@ -513,6 +541,51 @@ _BUILT_IN = frozenset((
     "ConveyorTracking", "EthernetIP", "com.ur.urcap.profinet",
     "com.ur.polyscope.screwdriving.installation.ScrewdrivingInstallationNodeService"))
 """Installation contributions PolyScope ships whose code is not in a program's preamble."""
+
+
+def _conveyors(root: ElementTree.Element, path: str) -> tuple[Conveyor, ...]:
+    """The enabled conveyors of the built-in ``ConveyorTracking`` contribution (PolyScope 3.x
+    and 5.x write ``enabled_N``, ``apin_N`` … for conveyor N = 0, 1)."""
+    element = None
+    for candidate in root.iterfind("Contributions/URCaps/Contributed"):
+        if candidate.get("id") == "ConveyorTracking":
+            element = candidate
+    if element is None:
+        return ()
+    data = {d.get("key", ""): d.get("value", "") for d in element.iterfind("data")}
+    lines: dict[str, tuple[tuple[float, ...], tuple[float, ...]]] = {}
+    for line in root.iterfind("Features//GeomLineNode"):
+        name = line.get("name")
+        if not name:
+            continue
+        points = []
+        for tag in ("firstPoint", "secondPoint"):
+            point = line.find(f"{tag}/GeomPoseNode")
+            value = _point(point, name, path) if point is not None else None
+            if value is not None:
+                points.append(value)
+        if len(points) == 2:
+            lines.setdefault(name, (points[0], points[1]))
+    conveyors = []
+    indices = sorted({int(key.rsplit("_", 1)[1]) for key in data
+                      if key.startswith("enabled_") and key.rsplit("_", 1)[1].isdigit()})
+    for index in indices:
+        if data.get(f"enabled_{index}") != "true":
+            continue
+
+        def number(key: str, index=index) -> float | None:
+            text = data.get(f"{key}_{index}")
+            return _number(text, f"conveyor {index} {key}", path) if text else None
+
+        a, b, decoder = number("apin"), number("bpin"), number("incrementalMode")
+        conveyors.append(Conveyor(
+            index, data.get(f"conveyorType_{index}", ""), data.get(f"encoderType_{index}", ""),
+            int(decoder) if decoder is not None else None,
+            (int(a), int(b)) if a is not None and b is not None else None,
+            number("tpm"), number("tpr"), lines.get(data.get(f"direction_{index}", "")),
+            data.get(f"switchDirection_{index}") == "true",
+            data.get(f"rotateTool_{index}") == "true"))
+    return tuple(conveyors)
 
 
 def _urcaps(root: ElementTree.Element) -> tuple[tuple[str, str, str], ...]:

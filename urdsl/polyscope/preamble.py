@@ -22,6 +22,7 @@ from ..script.nodes import (
     Declare,
     Expr,
     ExprStmt,
+    FunctionDef,
     Item,
     Keyword,
     List,
@@ -34,7 +35,7 @@ from ..script.nodes import (
     ThreadDef,
     While,
 )
-from .installation import Installation, Payload
+from .installation import Conveyor, Installation, Payload
 from .urp import Expression, Program
 
 __all__ = ["BLOCKS", "initial_values", "preamble", "preamble_blocks", "step_counter"]
@@ -130,8 +131,8 @@ def _version(text: str | None) -> tuple[int, int]:
 
 _RUNSTATE = {"LOW_WHEN_PROGRAM_STOPPED": 1, "HIGH_WHEN_PROGRAM_STOPPED": 2,
              "HIGH_WHEN_PROGRAM_RUNNING_LOW_WHEN_STOPPED": 3}
-"""Output actions when the program stops → the state number of ``set_runstate_*`` (1 seen;
-2 and 3 as the URScript manual numbers them [U])."""
+"""Output actions when the program stops → the state number of ``set_runstate_*`` (1 and 2
+seen; 3 as the URScript manual numbers it [U])."""
 _GP_RUNSTATE = {"PROGRAM_RUNNING": 3}
 """A general purpose boolean output register's action → its run state number (seen: 3)."""
 _RUNSTATE_BANKS = (("DigitalOutputActions", "standard"),
@@ -155,8 +156,9 @@ def preamble_blocks(program: Program, installation: Installation | None,
     """The preamble as (kind, statements) blocks in the order urdsl writes them. Kinds:
     ``verification`` (PolyScope 5.12 on: a hidden global, always first), the movable
     blocks of :data:`BLOCKS`, then ``variables`` (the installation variables) and
-    ``features`` (feature poses, by name), ``watchdog`` (the EtherNet/IP adapter's watchdog
-    when it is enabled), ``urcaps`` (a marked block per URCap
+    ``features`` (feature poses, by name), ``conveyor`` (the built-in conveyor tracking:
+    each conveyor's encoder and its ``start_conveyor_trackingN`` function), ``watchdog``
+    (the EtherNet/IP adapter's watchdog when it is enabled), ``urcaps`` (a marked block per URCap
     installation node: its code only the URCap can generate, so the block is empty), then
     ``initial`` (the program's initial variable values, see :func:`initial_values`).
     Modbus signals' input/output actions are not written."""
@@ -186,6 +188,10 @@ def preamble_blocks(program: Program, installation: Installation | None,
                 for name, pose in sorted(installation.features if installation else ())]
     if features:
         blocks.append(("features", features))
+    conveyor = [item for c in (installation.conveyors if installation else ())
+                for item in conveyor_statements(c)]
+    if conveyor:
+        blocks.append(("conveyor", conveyor))
     ethernet_ip = (installation.settings or {}).get("EthernetIP", {}) if installation else {}
     if ethernet_ip.get("enabled") == "true" and ethernet_ip.get("watchdogAction"):
         # the EtherNet/IP adapter enabled: a watchdog on the speed slider input (seen with
@@ -286,7 +292,7 @@ def _installation_blocks(installation: Installation, major: int) -> dict[str, li
     gravity = installation.gravity
     if gravity is not None:
         blocks["gravity"] = [_stmt("set_gravity", List(tuple(_num(v) for v in gravity)))]
-    blocks["io"] = _io(settings)
+    blocks["io"] = _io(settings, major)
     blocks["modbus"] = _modbus(installation)
     payload = installation.payload
     if payload is not None:
@@ -297,9 +303,11 @@ def _installation_blocks(installation: Installation, major: int) -> dict[str, li
     return blocks
 
 
-def _io(settings: dict[str, dict[str, str]]) -> list[Item]:
+def _io(settings: dict[str, dict[str, str]], major: int = 5) -> list[Item]:
     """Analog domains (0: current, 1: voltage), input actions and the outputs' states
-    when the program stops."""
+    when the program stops. PolyScope 5 names the outputs that have a state
+    (``set_runstate_standard_digital_outputs([3, 5])``) before setting each one's;
+    PolyScope 3 (3.15, Usaakm/UR10-Conveyor-Belt) sets each one's state only."""
     items: list[Item] = []
     ranges = _ints(settings.get("IOs/analogInputRange", {}).get("value"))
     if len(ranges) == 4:
@@ -336,10 +344,10 @@ def _io(settings: dict[str, dict[str, str]]) -> list[Item]:
         actions = settings.get(f"IOs/{key}", {}).get("value", "").split(",")
         pins = [(index, _RUNSTATE[a.strip()]) for index, a in enumerate(actions)
                 if a.strip() in _RUNSTATE]
-        if pins:
+        if pins and major >= 5:
             items.append(_stmt(f"set_runstate_{bank}_digital_outputs",
                                List(tuple(Number(index) for index, _ in pins))))
-            states.extend((bank, index, state) for index, state in pins)
+        states.extend((bank, index, state) for index, state in pins)
     for bank, index, state in states:
         items.append(_stmt(f"set_runstate_{bank}_digital_output_to_value", Number(index),
                            Number(state)))
@@ -350,6 +358,40 @@ def _io(settings: dict[str, dict[str, str]]) -> list[Item]:
         if action in _GP_RUNSTATE:
             items.append(_stmt("set_runstate_gp_boolean_output_to_value", Number(index),
                                Number(_GP_RUNSTATE[action])))
+    return items
+
+
+def _count(value: float) -> Expr:
+    """A number as PolyScope writes a count it keeps as an integer (``13333``)."""
+    return Number(int(value)) if value == int(value) else _num(value)
+
+
+def conveyor_statements(conveyor: Conveyor) -> list[Item]:
+    """What a conveyor of the built-in conveyor tracking writes after the features (seen:
+    PolyScope 3.15, one linear conveyor on an incremental encoder, Usaakm/UR10-Conveyor-Belt):
+    ``encoder_enable_pulse_decode(N, decoder, A, B)``, then ``def
+    start_conveyor_trackingN(): track_conveyor_linear(pose_sub(P, Q), ticks_per_meter, N)
+    end`` that the program's conveyor tracking node calls. P and Q are the two points of
+    the direction line: the second minus the first, the first minus the second when the
+    direction is switched (both seen). Another encoder or a circular conveyor: a comment,
+    nothing written [U]."""
+    index = Number(conveyor.index)
+    items: list[Item] = []
+    if conveyor.encoder == "1" and conveyor.decoder is not None and conveyor.pins:
+        items.append(_stmt("encoder_enable_pulse_decode", index, Number(conveyor.decoder),
+                           Number(conveyor.pins[0]), Number(conveyor.pins[1])))
+    else:
+        items.append(Comment(f" urdsl: conveyor {conveyor.index}'s encoder (type "
+                             f"{conveyor.encoder or '?'}) is not written"))
+    if conveyor.kind == "1" and conveyor.direction and conveyor.ticks_per_meter is not None:
+        first, second = (Pose(tuple(_num(v) for v in point)) for point in conveyor.direction)
+        ahead, behind = (first, second) if conveyor.switch else (second, first)
+        track = _stmt("track_conveyor_linear", _call("pose_sub", ahead, behind),
+                      _count(conveyor.ticks_per_meter), index)
+        items.append(FunctionDef(f"start_conveyor_tracking{conveyor.index}", (), (track,)))
+    else:
+        items.append(Comment(f" urdsl: conveyor {conveyor.index} (type "
+                             f"{conveyor.kind or '?'}) is not written"))
     return items
 
 

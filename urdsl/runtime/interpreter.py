@@ -31,9 +31,11 @@ from ..script.binder import Binding, Signature
 from ..script.nodes import NO_SPAN, Span
 from .errors import ScriptRuntimeError
 from .unknown import (
+    IDLE_AFTER_PASSES,
     UNKNOWN_LOOP_PASSES,
     ends_program,
     first_unknown,
+    polls_devices,
     stops_motion,
     unknown_call,
 )
@@ -550,6 +552,9 @@ class _Compiler:
 
     def __init__(self, rt: Interpreter) -> None:
         self.rt = rt
+        # the polling loop (see polls_devices) whose body is being compiled: its pass count
+        self._polling: list[int] | None = None
+        self._assigned: frozenset[str] = frozenset()  # names the program assigns anywhere
 
     # -- program -----------------------------------------------------------------------------
 
@@ -557,6 +562,7 @@ class _Compiler:
         """The program's entry: a single top-level ``def`` (with nothing else but
         definitions, comments and labels) is run; otherwise the top-level statements are."""
         rt = self.rt
+        self._assigned = assigned_names(module)
         defs = [s for s in module.body if isinstance(s, n.FunctionDef)]
         statements = [s for s in module.body if isinstance(s, n.Stmt)
                       and not isinstance(s, (n.FunctionDef, n.ThreadDef, n.SecDef))]
@@ -730,6 +736,10 @@ class _Compiler:
                       stops_motion(b.body)) for b in node.elifs]
         orelse = self.block(node.orelse) if node.orelse is not None else None
         first_seen: dict[int, float] = {}  # branch -> robot time of its first unknown test
+        polling = self._polling  # [passes] of the polling loop this statement is in, or None
+        taken = ("it takes this branch for the loop's first "
+                 f"{IDLE_AFTER_PASSES} passes, then skips it (an idle device)"
+                 if polling is not None else "it takes this branch")
 
         def run(frame):
             for index, (test, body, test_node, ending, stopping) in enumerate(branches):
@@ -737,20 +747,22 @@ class _Compiler:
                 if type(value) is Unknown:
                     # follow a working device: not into an error branch (it ends the
                     # program), not against the reply the program expects, else in
-                    take = not ending and value.lean is not False
+                    working = take = not ending and value.lean is not False
                     if take and stopping:
                         # a sensor that stops a move (PolyScope's Until: tool contact, an
                         # input) fires once the move has come as far as it can go
                         seen = first_seen.setdefault(index, rt.time)
                         free_at = getattr(rt.robot, "free_at", rt.time)
                         take = rt.time > seen and free_at <= rt.time + 1e-9
+                    elif take and polling is not None and polling[0] > IDLE_AFTER_PASSES:
+                        take = False  # the device has gone idle: nothing to report
                     rt.warn_once(
                         f"this condition depends on {value.source}, which is unknown "
                         "offline; the check follows a working device: "
                         + ("it skips this branch, which ends the program" if ending
                            else "it takes this branch once the move it stops has come as "
                            "far as it can" if stopping and value.lean is not False
-                           else "it takes this branch" if take
+                           else taken if working
                            else "it skips this branch (a working device's reply does not "
                            "lead here)"),
                         test_node)
@@ -768,13 +780,22 @@ class _Compiler:
     def s_While(self, node: n.While):
         rt = self.rt
         test = self.expr(node.test)
-        body = self.block(node.body)
+        outer, polling = self._polling, ([0] if polls_devices(node.body) else None)
+        self._polling = polling
+        try:
+            body = self.block(node.body)
+        finally:
+            self._polling = outer
         test_node = node.test
 
         def run(frame):
             rt.loop_node = node
             unknown_passes = 0
+            if polling is not None:
+                polling[0] = 0
             while True:
+                if polling is not None:
+                    polling[0] += 1
                 value = test(frame)
                 if type(value) is Unknown:
                     unknown_passes += 1
@@ -919,6 +940,7 @@ class _Compiler:
         rt = self.rt
         name = node.id
         globals_ = rt.globals
+        assigned = self._assigned
 
         def read(frame):
             if name in frame.local_names:
@@ -928,6 +950,17 @@ class _Compiler:
                     pass
             elif name in globals_:
                 return globals_[name]
+            if rt.warnings and name in assigned:
+                # the program gives the name a value on a path the check did not follow
+                # because it decided on a device's or operator's reply: not certain
+                first = rt.warnings[0].span.line
+                rt.warn_once(
+                    f"name '{name}' is not defined here, on the path the check followed; the "
+                    f"program assigns '{name}' on others, so this depends on the replies the "
+                    f"check assumed (the first at line {first}); the check goes on with its "
+                    "value unknown", node)
+                return Unknown(f"'{name}' (not assigned on the path the check followed)",
+                               node.span)
             raise rt.error("undefined", f"name '{name}' is not defined", node,
                            _name_hint(name, frame, rt))
 
@@ -1256,6 +1289,17 @@ def _operator_hint(op: str, a: Any, b: Any) -> str | None:
     if type(a) is PoseValue or type(b) is PoseValue:
         return "combine poses with pose_add, pose_sub or pose_trans"
     return None
+
+
+def assigned_names(module: n.Module) -> frozenset[str]:
+    """The names a program assigns anywhere (``name = ...``, ``global name = ...``)."""
+    names = set()
+    for node in n.walk(module):
+        if isinstance(node, n.Assign) and isinstance(node.target, n.Name):
+            names.add(node.target.id)
+        elif isinstance(node, n.Declare):
+            names.add(node.name)
+    return frozenset(names)
 
 
 def _name_hint(name: str, frame: Frame, rt: Interpreter) -> str | None:

@@ -23,6 +23,9 @@ names the read and its line), never with an error:
 
 * ``if``/``elif`` on an unknown condition takes the branch unless the branch ends the program
   (``halt``, a ``popup``, a protective stop): an error branch is what a failing device causes;
+  in a loop that polls (:func:`polls_devices`: it takes time only in such branches) the
+  device reports something for :data:`IDLE_AFTER_PASSES` passes and is then idle, so that a
+  loop that spins while nothing happens is found;
 * ``while`` on an unknown condition runs at most :data:`UNKNOWN_LOOP_PASSES` passes and then
   leaves the loop, as a wait loop does when the device answers;
 * a move or a builtin with an unknown argument is not checked (noted once); an unchecked move
@@ -44,7 +47,8 @@ from ..script import nodes as n
 from .values import ListValue, StructValue, Unknown, has_unknown
 
 __all__ = [
-    "DEVICE_REPLY_TIME", "OPERATOR_REPLY_TIME", "UNCHECKED_MOVE_TIME", "UNKNOWN_LOOP_PASSES",
+    "DEVICE_REPLY_TIME", "IDLE_AFTER_PASSES", "OPERATOR_REPLY_TIME", "UNCHECKED_MOVE_TIME",
+    "UNKNOWN_LOOP_PASSES", "polls_devices",
     "DEVICE_READS", "OPERATOR_PROMPTS", "ends_program", "stops_motion", "unknown_from",
     "describe",
 ]
@@ -60,6 +64,10 @@ UNCHECKED_MOVE_TIME = 1.0
 
 UNKNOWN_LOOP_PASSES = 3
 """Passes a ``while`` loop makes while its condition is unknown before the check leaves it."""
+
+IDLE_AFTER_PASSES = 3
+"""Passes of a polling loop (:func:`polls_devices`) during which the check takes the branches
+that depend on a device; from the next pass on, the device is idle and they are skipped."""
 
 DEVICE_READS = frozenset({
     "get_standard_digital_in", "get_digital_in", "get_configurable_digital_in",
@@ -144,6 +152,42 @@ def _holds(body: Any, statements: tuple[type, ...], calls: frozenset[str]) -> bo
         elif isinstance(item, n.While):
             stack.extend(item.body)
     return False
+
+
+def polls_devices(body: Any) -> bool:
+    """Whether a loop body takes physical time only inside the branches of its ``if``
+    statements (or in inner loops, which may make no pass): a loop that polls and acts only
+    when something is reported. When its tests depend on a device, an idle device (nothing
+    to report, the usual state between two events) leaves such a loop running without
+    physical time; the check follows a working device for :data:`IDLE_AFTER_PASSES` passes,
+    then an idle one, so that such a loop spins and is reported (URS207) as on the robot.
+    A call that may take time (a blocking builtin, a function the program defines, a method
+    call) outside the branches makes the loop not a polling one."""
+    from ..script.builtins import BLOCKING_CALLS, lookup
+
+    branches = False
+    for item in body or ():
+        if isinstance(item, (n.FunctionDef, n.ThreadDef, n.SecDef)):
+            continue
+        if isinstance(item, n.Join):
+            return False
+        if isinstance(item, n.If):
+            branches = True
+            tested: list[Any] = [item.test, *(branch.test for branch in item.elifs)]
+        elif isinstance(item, n.While):
+            tested = [item.test]
+        else:
+            tested = [item]
+        for node in tested:
+            for inner in n.walk(node):
+                if not isinstance(inner, n.Call):
+                    continue
+                if not isinstance(inner.func, n.Name):
+                    return False  # a method call (XML-RPC) may wait for its reply
+                name = inner.func.id
+                if name in BLOCKING_CALLS or lookup(name) is None:
+                    return False
+    return branches
 
 
 def first_unknown(values: Any, named: dict | None = None) -> Unknown | None:

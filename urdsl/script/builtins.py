@@ -40,9 +40,26 @@ from importlib import resources
 from ..versions import ControllerVersion, parse_version
 from .binder import Binding, Problem, Signature, problems
 
-__all__ = ["BuiltinParam", "Builtin", "catalog", "lookup", "parse_version", "methods"]
+__all__ = ["BLOCKING_CALLS", "MOTION_CALLS", "BuiltinParam", "Builtin", "catalog", "lookup",
+           "parse_version", "methods"]
 
 Version = tuple[int, int]
+
+MOTION_CALLS = frozenset((
+    "movej", "movel", "movep", "movec", "optimovej", "optimovel", "servoj", "servoc", "speedj",
+    "speedl", "stopj", "stopl", "direct_torque", "mc_run_motion", "screw_driving",
+))
+"""Builtins that move the arm and take physical time (one frame at least)."""
+
+BLOCKING_CALLS = MOTION_CALLS | frozenset((
+    "sleep", "sync", "socket_read_ascii_float", "socket_read_binary_integer",
+    "socket_read_byte_list", "socket_read_line", "socket_read_string", "socket_get_var",
+    "socket_open", "interpreter_mode", "popup", "request_boolean_from_primary_client",
+    "request_float_from_primary_client", "request_integer_from_primary_client",
+    "request_string_from_primary_client", "tool_contact", "zero_ftsensor", "powerdown",
+))
+"""Builtins that take physical time, so that a loop calling them yields to other threads
+(moves, ``sleep``, ``sync``, socket reads that wait for data, blocking popups)."""
 
 
 def _series(version: Version) -> str:

@@ -384,10 +384,6 @@ class VirtualController:
 
     # ---- programs ------------------------------------------------------------------------
 
-    def framer(self) -> ScriptFramer:
-        """A framer for one client connection's script stream (see :meth:`submit_chunk`)."""
-        return ScriptFramer()
-
     def submit(self, text: str, origin: str = "<script>") -> None:
         """Take script text as the controller does from ports 30001-30003: each ``def``
         program replaces the running one, each ``sec`` program runs beside it, bare lines

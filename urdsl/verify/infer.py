@@ -482,12 +482,15 @@ _POSITION = re.compile(r"at \[(-?[\d.]+), (-?[\d.]+), (-?[\d.]+)\] m")
 
 
 def qualify(report, inference: Inference) -> None:
-    """A PolyScope program was taught on a real arm; when neither ``--robot`` nor its
-    waypoints say which, findings that hold only for the assumed model (``MODEL_DEPENDENT``)
-    are not certain: they become warnings that say so. A target that no UR model reaches
-    (farther from the shoulder than the longest arm's reach plus the TCP) stays an error."""
-    if inference.robot_source != "default" or not inference.polyscope:
+    """When neither ``--robot`` nor the program's taught waypoints say which arm it runs on,
+    findings that hold only for the assumed model (``MODEL_DEPENDENT``) are not certain: they
+    become warnings that say so (a program written for a UR10 is not wrong because a UR5e
+    cannot reach its poses). A target that no UR model reaches (farther from the shoulder
+    than the longest arm's reach plus the TCP) stays an error."""
+    if inference.robot_source != "default":
         return
+    why = ("the robot this program was taught on is not known" if inference.polyscope
+           else "the program does not say which arm it runs on")
     from ..kinematics import MODELS
 
     tcp_length = float(np.linalg.norm(inference.tcp[:3])) if inference.tcp else 0.0
@@ -505,8 +508,7 @@ def qualify(report, inference: Inference) -> None:
                     continue
             finding = replace(
                 finding, severity="warning",
-                message=f"{finding.message} (on the assumed {inference.robot}: the robot this "
-                "program was taught on is not known)",
+                message=f"{finding.message} (on the assumed {inference.robot}: {why})",
                 hint="give the robot with --robot MODEL to make this certain")
         qualified.append(finding)
     report.findings = qualified

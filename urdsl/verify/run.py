@@ -17,7 +17,6 @@ it got to and says so (URS313), and checks left undone are named.
 
 from __future__ import annotations
 
-import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,7 +31,7 @@ from ..motion.trace import sample
 from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
 from ..runtime.values import Unknown
 from ..script.diagnostics import ScriptSyntaxError
-from ..script.nodes import NO_SPAN, Assign, Declare, Name, walk
+from ..script.nodes import NO_SPAN
 from ..script.parser import parse
 from . import checks
 from .findings import Finding, nothing_runs
@@ -217,7 +216,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
         planner.end_time = max([result.time] + [s.end for s in planner.segments])
         report.events = [e for e in result.events if e.time <= result.error.time]
     if result.error is not None:
-        report.findings.append(_runtime_finding(result.error, module, result.warnings))
+        report.findings.append(_runtime_finding(result.error))
     for warning in planner.warnings:  # Overlapping Blends, or a stoppable move's far target
         code = "URS210" if warning.code == "condition" else "URS309"
         report.findings.append(Finding.of(code, warning.message, warning.span, warning.time))
@@ -279,38 +278,13 @@ def _stopped_finding(event, options: CheckOptions) -> Finding:
     return Finding.of("URS313", message, event.span, event.time, hint)
 
 
-_UNDEFINED = re.compile(r"^name '(\w+)' is not defined")
-
-
-def _runtime_finding(error, module, unknown_decisions) -> Finding:
+def _runtime_finding(error) -> Finding:
     diagnostic = error.diagnostic
     if error.kind == "ik":
         return Finding.of("URS301", diagnostic.message, error.span, error.time,
                           diagnostic.hint)
-    match = _UNDEFINED.match(diagnostic.message) if error.kind == "undefined" else None
-    decided = [w for w in unknown_decisions if w.time is None or w.time <= error.time]
-    if match and decided and _assigned(module, match.group(1)):
-        # the program gives the name a value, on a path the check did not follow because
-        # it decided on a device's or operator's reply: what follows is not certain
-        first = decided[0]
-        return Finding(diagnostic.code, "warning", f"{diagnostic.message} here, on the path "
-                       f"the check followed; the program assigns '{match.group(1)}' on "
-                       "others, so this depends on the replies the check assumed (the first "
-                       f"at line {first.span.line})", error.span, error.time,
-                       "make sure every branch gives the variable a value")
     return Finding(diagnostic.code, "error", diagnostic.message, error.span, error.time,
                    diagnostic.hint)
-
-
-def _assigned(module, name: str) -> bool:
-    """Whether the program assigns ``name`` anywhere (``name = ...``, ``global name``)."""
-    for node in walk(module):
-        if isinstance(node, Assign) and isinstance(node.target, Name) \
-                and node.target.id == name:
-            return True
-        if isinstance(node, Declare) and node.name == name:
-            return True
-    return False
 
 
 PATH_CODES = frozenset({"URS302", "URS304", "URS305", "URS306", "URS307", "URS308"})
