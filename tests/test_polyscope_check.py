@@ -250,3 +250,27 @@ def test_a_missing_installation_is_named(tmp_path, capsys):
     assert main(["check", str(program)]) == 1
     err = capsys.readouterr().err
     assert f"{program}: error: node Robot Program > Set" in err and "Traceback" not in err
+
+
+def test_a_feature_of_a_missing_installation_is_not_a_mistake_of_the_program(tmp_path,
+                                                                              capsys):
+    # a feature made a variable in the installation is defined by the installation's
+    # preamble: with the installation not beside the program, reading it is a warning that
+    # says so (lint) and an unknown value (check); the same name typed is still an error
+    feature = ('<ExpressionVariable><GeomFeatureVariable featureName="Plane_3"/>'
+               '</ExpressionVariable>')
+    program = tmp_path / "pallet.urp"
+    program.write_text(_program('<Script type="Line"><expression>' + _chars("textmsg(")
+                                + feature + _chars(")") + "</expression></Script>"))
+    assert main(["lint", str(program), "--format", "json"]) == 0
+    (found,) = json.loads(capsys.readouterr().out)
+    assert found["severity"] == "warning" and "'Plane_3'" in found["message"]
+    assert "a feature of the installation default, which is not beside the program" \
+        in found["message"]
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    program.write_text(_program('<Script type="Line"><expression>'
+                                + _chars("textmsg(Plane_3)") + "</expression></Script>"))
+    assert main(["lint", str(program)]) == 1
+    assert "URS101 name 'Plane_3' is not defined [node" in capsys.readouterr().out

@@ -156,16 +156,25 @@ def urcap_sources(generated: Generated) -> list[str]:
     return list(dict.fromkeys(name for name in names if name))
 
 
+_UNDEFINED_NAME = re.compile(r"name '(\w+)' is not defined")
+
+
 def soften_urcap_names(generated: Generated, found: list) -> list:
-    """Lint findings of a compiled program with URCap code: a name or function defined
-    nowhere in what urdsl generated (URS101, URS102) may come from that code, so it is a
-    warning naming the URCaps rather than an error."""
+    """Lint findings of a compiled program that code urdsl cannot generate or read would
+    complete: a name or function defined nowhere in what urdsl generated (URS101, URS102)
+    may come from a URCap's code, and a feature the program reads from its installation is
+    defined by the installation's preamble, which is not written when the installation is
+    missing: warnings that say so rather than errors."""
     sources = urcap_sources(generated)
-    if not sources:
-        return found
+    features = missing_features(generated)
     out = []
     for finding in found:
-        if finding.code in ("URS101", "URS102") and finding.severity == "error":
+        name = _UNDEFINED_NAME.match(finding.message) if finding.code == "URS101" else None
+        if name and name.group(1) in features and finding.severity == "error":
+            finding = replace(finding, severity="warning",
+                              message=f"{finding.message}: {features[name.group(1)]}",
+                              hint="put the program's installation beside it")
+        elif sources and finding.code in ("URS101", "URS102") and finding.severity == "error":
             finding = replace(finding, severity="warning", message=(
                 f"{finding.message}; it may come from code only a URCap generates "
                 f"({', '.join(sources)})"))
@@ -182,14 +191,29 @@ def undefined_globals(module: n.Module) -> list[str]:
     return sorted(reads)
 
 
-def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
-    """When the program has URCap nodes: the variables it reads but defines nowhere (what a
-    URCap's code defines), each with where its unknown value comes from."""
-    urcaps = generated.urcap_nodes()
-    if not urcaps:
+def missing_features(generated: Generated) -> dict[str, str]:
+    """Installation features the program reads as variables while its installation is not
+    there (the preamble that defines them is not written): each with where its value
+    would come from."""
+    if generated.installation is not None:
         return {}
-    names = ", ".join(dict.fromkeys(node.title for _number, node in urcaps))
-    return {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
+    named = generated.program.installation or "(none named)"
+    return {name: f"a feature of the installation {named}, which is not beside the program"
+            for name in sorted(generated.program.feature_variables)}
+
+
+def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
+    """The variables the program reads but defines nowhere that code urdsl cannot generate
+    or read defines: URCap nodes' results, features of a missing installation; each with
+    where its unknown value comes from."""
+    values = {}
+    urcaps = generated.urcap_nodes()
+    if urcaps:
+        names = ", ".join(dict.fromkeys(node.title for _number, node in urcaps))
+        values = {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
+    features = missing_features(generated)
+    return values | {name: why for name, why in features.items()
+                     if name in undefined_globals(module)}
 
 
 def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Module, list[str]]:
@@ -373,8 +397,8 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
                                            cell_given=bool(cell_path)))
     file_options.unknown_globals = urcap_values(generated, module)
     if file_options.unknown_globals:
-        notes.append("unknown values from URCap nodes: "
-                     + ", ".join(sorted(file_options.unknown_globals)))
+        notes.append("unknown values (URCap nodes' results, features of a missing "
+                     "installation): " + ", ".join(sorted(file_options.unknown_globals)))
     module, stand_ins = with_urcap_functions(generated, module)
     if stand_ins:
         notes.append("functions defined by code urdsl cannot generate, taken as devices: "

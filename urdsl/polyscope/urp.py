@@ -174,6 +174,9 @@ class Program:
     directory: str | None = None
     """The folder the program was saved in on the robot (``directory``: ``/programs/LE``);
     script files the program names are found relative to it."""
+    feature_variables: frozenset[str] = frozenset()
+    """Installation features the program's expressions read as variables (a feature made a
+    variable in the installation: ``pose_trans(Plane_3, p)``); the preamble defines them."""
 
     @property
     def major_version(self) -> int | None:
@@ -304,6 +307,7 @@ class _Reader:
             child: parent for parent in root.iter() for child in parent}
         self.nodes: dict[ElementTree.Element, Node] = {}
         self.positions: dict[ElementTree.Element, tuple[int, int]] = {}
+        self.feature_variables: set[str] = set()
 
     # -- references
     def resolve(self, element: ElementTree.Element) -> ElementTree.Element:
@@ -374,7 +378,7 @@ class _Reader:
                        root.get("installation"), root.get("createdIn"),
                        root.get("lastSavedIn"), kinematics, main, before, init, threads, subs,
                        others, top, root.get("installationRelativePath") or None,
-                       root.get("directory") or None)
+                       root.get("directory") or None, frozenset(self.feature_variables))
 
     def node(self, element: ElementTree.Element, parent: Node | None) -> Node:
         element = self.resolve(element)
@@ -453,6 +457,8 @@ class _Reader:
                 # "Base_var:=Base_1_const" is written ``global Base_var=p[...]``, the
                 # installation's pose of Base_1; PolyScope 5.8, loukjeab/WS2223...)
                 return ("feature", name)
+            if target.tag == "GeomFeatureVariable" and name:
+                self.feature_variables.add(name)
             return ("var", name)
         return ("token", piece.get("name", ""))
 
