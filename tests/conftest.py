@@ -5,11 +5,22 @@ script file) and stops at a folder holding ``.git``. A test's ``tmp_path`` lies 
 below the system's temporary folder, where other programs leave their own scripts; the
 session's base temporary folder is marked as a repository so that no test's project reaches
 beyond it.
+
+Hypothesis draws new examples on every run; with ``CI`` set (``.ci/run``) it draws the same
+ones on every run (``derandomize``), so that a clean clone's result does not depend on luck:
+laws are explored on developers' runs and a failing example found there becomes a fix.
 """
 
 from __future__ import annotations
 
+import os
+
 import pytest
+from hypothesis import settings
+
+settings.register_profile("ci", derandomize=True, print_blob=True)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 
 @pytest.fixture(scope="session", autouse=True)
