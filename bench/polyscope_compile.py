@@ -10,8 +10,8 @@ the .script (when PolyScope wrote it; an installation committed only after the .
 the pair's commit; ``--installation pair`` reads both at the pair's commit).
 
 Both scripts are parsed and printed canonically, statement by statement: comments and URCap
-blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare to
-1e-9, PolyScope's generated ids (``_3f89b84f_1daa_...``, the N of a ``SinglePulseN`` thread)
+blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare
+within 1e-9 (two lines that differ only in numbers that close count as equal), PolyScope's generated ids (``_3f89b84f_1daa_...``, the N of a ``SinglePulseN`` thread)
 are masked, and ``$`` markers compare by number and flag (their label text is in the
 language PolyScope ran in, which the .urp does not record). For the same reason a ``popup``
 title that is PolyScope's own title of a Popup node in another language ("Erreur",
@@ -350,6 +350,32 @@ def load_installation(gitdir: Path, commit: str, urp_path: str, name: str | None
     return installation, parse_variables(text) if text is not None else [], ""
 
 
+def _same_within(ours: str, theirs: str) -> bool:
+    """Whether two canonical lines differ only in numbers, each pair within 1e-9 (the
+    canonical print rounds to 1e-9, so two values 1e-11 apart may print one step apart)."""
+    if _NUMBER.sub("#", ours) != _NUMBER.sub("#", theirs):
+        return False
+    a = [float(m.group(0)) for m in _NUMBER.finditer(ours)]
+    b = [float(m.group(0)) for m in _NUMBER.finditer(theirs)]
+    return len(a) == len(b) and all(abs(x - y) <= 2e-9 for x, y in zip(a, b, strict=True))
+
+
+def reconcile(ours: list[str], theirs: list[str]) -> list[str]:
+    """``ours`` with each line that equals its counterpart in ``theirs`` to 1e-9 replaced by
+    it (lines paired where a stretch of ours replaces a stretch of theirs of the same
+    length), so that equality of the lists compares numbers within 1e-9, not their prints."""
+    if ours == theirs:
+        return ours
+    out = list(ours)
+    matcher = difflib.SequenceMatcher(a=theirs, b=ours, autojunk=False)
+    for tag, i1, i2, j1, j2 in matcher.get_opcodes():
+        if tag == "replace" and i2 - i1 == j2 - j1:
+            for i, j in zip(range(i1, i2), range(j1, j2), strict=True):
+                if _same_within(ours[j], theirs[i]):
+                    out[j] = theirs[i]
+    return out
+
+
 def compare(ours: list[str], theirs: list[str]) -> float:
     if not ours and not theirs:
         return 1.0
@@ -520,7 +546,11 @@ def main(argv: list[str] | None = None) -> int:
         st["pre_total"] += sum(theirs_pre.values())
         st["pre_found"] += sum((theirs_pre & ours_pre).values())
         st["pre_extra"] += sum((ours_pre - theirs_pre).values())
+        ours = reconcile(ours, theirs)
+        ours_prog = reconcile(ours_prog, theirs_prog)
         theirs_kinds, ours_kinds = by_kind(theirs_blocks), by_kind(ours_blocks)
+        ours_kinds = {kind: tuple(reconcile(list(lines), list(theirs_kinds.get(kind, ()))))
+                      for kind, lines in ours_kinds.items()}
         for kind in sorted(set(theirs_kinds) | set(ours_kinds)):
             if theirs_kinds.get(kind) != ours_kinds.get(kind):
                 st["pre_kinds"][kind] += 1
