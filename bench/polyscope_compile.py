@@ -11,8 +11,9 @@ the pair's commit; ``--installation pair`` reads both at the pair's commit).
 
 Both scripts are parsed and printed canonically, statement by statement: comments and URCap
 blocks (``# begin: URCap ...`` to ``# end: URCap ...``) are left out, numbers compare
-within 1e-9 (two lines that differ only in numbers that close count as equal), PolyScope's generated ids (``_3f89b84f_1daa_...``, the N of a ``SinglePulseN`` thread)
-are masked, and ``$`` markers compare by number and flag (their label text is in the
+within 1e-9 (two lines that differ only in numbers that close count as equal),
+PolyScope's generated ids (``_3f89b84f_1daa_...``, the N of a ``SinglePulseN`` thread) are
+masked, and ``$`` markers compare by number and flag (their label text is in the
 language PolyScope ran in, which the .urp does not record). For the same reason a ``popup``
 title that is PolyScope's own title of a Popup node in another language ("Erreur",
 "Meldung", "メッセージ": see ``POPUP_TITLES``, the languages seen) compares as its English one
