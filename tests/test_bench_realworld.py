@@ -3,27 +3,14 @@ from a git directory (no network), and scoring matches findings to labels."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import shutil
 import subprocess
-import sys
-from pathlib import Path
 
 import pytest
+from _bench import load_bench
 
-BENCH = Path(__file__).resolve().parent.parent / "bench" / "realworld.py"
-
-
-def _load():
-    spec = importlib.util.spec_from_file_location("realworld_bench", BENCH)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-rw = _load()
+rw = load_bench("realworld.py", "realworld_bench")
 
 
 #: The first id of the blind batch: every project from it on is held back (README, "The split").
