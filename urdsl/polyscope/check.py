@@ -233,22 +233,13 @@ def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Modu
         return module, []
     positional: dict[str, int] = {name: 0 for name in calls}
     keywords: dict[str, list[str]] = {name: [] for name in calls}
-    stack: list = [module]
-    while stack:
-        node = stack.pop()
+    for node in n.walk(module):
         if isinstance(node, n.Call) and isinstance(node.func, n.Name) and \
                 node.func.id in positional:
             positional[node.func.id] = max(positional[node.func.id], len(node.args))
             for keyword in node.keywords:
                 if keyword.name not in keywords[node.func.id]:
                     keywords[node.func.id].append(keyword.name)
-        if dataclasses.is_dataclass(node):
-            for f in dataclasses.fields(node):
-                value = getattr(node, f.name)
-                if isinstance(value, tuple):
-                    stack.extend(v for v in value if dataclasses.is_dataclass(v))
-                elif dataclasses.is_dataclass(value) and not isinstance(value, n.Span):
-                    stack.append(value)
     stubs = tuple(
         n.FunctionDef(name, tuple(n.Param(f"arg{i + 1}") for i in range(positional[name])) +
                       tuple(n.Param(k, n.Number(0)) for k in keywords[name]),
