@@ -60,8 +60,7 @@ class BuiltinTable:
         row = lookup(name)
         implementation = IMPLEMENTATIONS.get(name)
         if row is None and implementation is None:
-            raise rt.error("undefined", f"name '{name}' is not defined", node,
-                           _builtin_hint(name))
+            return rt.not_defined(name, "name", node, _builtin_hint(name))
         if row is not None:
             bound = self.bind(row, args, named, node)
         else:
