@@ -190,7 +190,11 @@ def _builtin_hint(name: str) -> str | None:
     import difflib
 
     from ..script.builtins import catalog
+    from ..script.urcaps import urcap_hint
 
+    hint = urcap_hint(name)
+    if hint is not None:
+        return hint
     close = difflib.get_close_matches(name, list(catalog()), n=1)
     return f"did you mean '{close[0]}'?" if close else None
 
