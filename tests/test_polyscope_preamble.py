@@ -169,7 +169,24 @@ def test_the_step_counter_and_the_verification_global_of_recent_versions(five):
     assert five["steps"][0].startswith("step_count_")
     older = _blocks(_urp("5.11.9.1010452"), _installation5())
     assert "verification" not in older and "steps" in older
-    assert "steps" not in _blocks(_urp("5.7.0.90932"), _installation5())  # before 5.8
+    # seen from 5.7.0 (o2ac/o2ac-ur) and 3.12.1 (kg398/kg_ursim); not in 3.8 and 3.5
+    assert "steps" in _blocks(_urp("5.7.0.90932"), _installation5())
+    assert "steps" in _blocks(_urp("3.12.1.90940"), _INSTALLATION3)
+    assert "steps" not in _blocks(_urp("3.8.0.61336"), _INSTALLATION3)
+    assert "steps" not in _blocks(_urp("5.6.0.90886"), _installation5())  # not seen [U]
+
+
+def test_polyscope_5_7_payload_without_centre_of_gravity_is_the_mass_alone():
+    """5.x before named payloads keeps the payload as ``toolPayload`` on the TCP settings,
+    without a centre of gravity: PolyScope 5.7.0 writes ``set_payload(0.0)``
+    (o2ac/o2ac-ur b_bot's center_object, seven programs)."""
+    installation = b"""<Installation><Version major="5" minor="7" bugfix="0"/>
+  <TCPSettings activePose="tip" toolPayload="0.8">
+    <availablePoses><tcp name="tip" offset="0.0, 0.0, 0.165, 0.0, 0.0, 0.0"/></availablePoses>
+  </TCPSettings></Installation>"""
+    blocks = _blocks(_urp("5.7.0.90932"), installation)
+    assert blocks["payload"] == ["set_payload(0.8)"]
+    assert blocks["tcp"] == ["set_tcp(p[0.0, 0.0, 0.165, 0.0, 0.0, 0.0])"]
 
 
 def test_variables_then_features_by_name_without_hidden_ones(five):
