@@ -5,6 +5,7 @@ and a missing or corrupt installation."""
 from __future__ import annotations
 
 import gzip
+import json
 import math
 
 import pytest
@@ -187,6 +188,30 @@ def test_polyscope_5_7_payload_without_centre_of_gravity_is_the_mass_alone():
     blocks = _blocks(_urp("5.7.0.90932"), installation)
     assert blocks["payload"] == ["set_payload(0.8)"]
     assert blocks["tcp"] == ["set_tcp(p[0.0, 0.0, 0.165, 0.0, 0.0, 0.0])"]
+
+
+def test_a_5_7_installation_reaches_the_check(tmp_path, capsys):
+    """The TCP, the payload without centre of gravity and a ceiling mounting of a 5.7
+    installation are what the check runs with; PolyScope's step counter thread is not
+    reported as left running."""
+    (tmp_path / "cell.installation").write_bytes(b"""<Installation>
+  <Version major="5" minor="7" bugfix="0"/>
+  <Features><CameraView><worldTransform>
+    <WorldtoMarshal baseAngle="0.0" tiltAngle="3.141592653589793"/></worldTransform>
+  </CameraView></Features>
+  <TCPSettings activePose="tip" toolPayload="0.8">
+    <availablePoses><tcp name="tip" offset="0.0, 0.0, 0.165, 0.0, 0.0, 0.0"/></availablePoses>
+  </TCPSettings></Installation>""")
+    program = tmp_path / "pre.urp"
+    program.write_bytes(_urp("5.7.0.90932"))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    inferred = report["inferred"]
+    assert inferred["tcp"]["pose"] == pytest.approx([0, 0, 0.165, 0, 0, 0])
+    assert inferred["payload"]["mass"] == pytest.approx(0.8)
+    assert inferred["payload"]["cog"] is None  # the installation gives none
+    assert inferred["gravity"] == pytest.approx([0, 0, -9.82])  # the ceiling
+    assert not report["findings"]
 
 
 def test_variables_then_features_by_name_without_hidden_ones(five):
