@@ -515,3 +515,15 @@ def test_polyscope_3_sets_each_outputs_stop_state_only():
     five = _blocks(_urp("5.11.5.1010327"), _conveyor_installation(major="5"))
     assert five["io"] == ["set_runstate_standard_digital_outputs([7])",
                           "set_runstate_standard_digital_output_to_value(7, 2)"]
+
+
+def test_a_plane_never_taught_is_the_zero_pose():
+    """A variable plane whose three points were never taught (all at zero) is written as
+    ``p[0, 0, 0, 0, 0, 0]`` (srs827/Robot-Cello-ResidualRL, 5.17: ``Plane_4``)."""
+    points = "".join(_point(tag, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+                     for tag in ("firstPoint", "secondPoint", "thirdPoint"))
+    installation = f"""<Installation><Version major="5" minor="17" bugfix="3"/><Features>
+  <GeomPlaneNode><GeomPlaneNode name="Plane_4" userHasPoints="false" isVariable="true">
+  {points}</GeomPlaneNode></GeomPlaneNode></Features></Installation>""".encode()
+    blocks = _blocks(_urp("5.17.3"), installation)
+    assert blocks["features"] == ["global Plane_4 = p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]"]
