@@ -426,8 +426,8 @@ def step_counter(program: Program) -> list[Item]:
     """The thread PolyScope (3.12 and 5.7 on) starts in every program to count its
     controller steps; its names carry a generated id (here derived from the program's
     name, so that compiling twice gives the same text). Seen from 5.7.0 (o2ac/o2ac-ur's
-    b_bot programs) and 3.12.1 (kg398/kg_ursim); not in 3.8 and 3.5 scripts; 3.9-3.11 and
-    5.0-5.6 are not seen [U]."""
+    b_bot programs) and 3.12.1 (kg398/kg_ursim, build 90940, the series of 5.7.0's 90932); not
+    in 3.8 and 3.5 scripts; 3.9-3.12.0 and 5.0-5.6 are not seen [U]."""
     major, minor = _version(program.saved_in or program.created_in)
     if not ((major == 3 and minor >= 12) or (major == 5 and minor >= 7) or major > 5):
         return []
