@@ -80,3 +80,30 @@ def test_polyscope3_movep_without_a_tcp_writes_the_pose_as_it_is():
     lines = compiled(move, version="3.5.4.10845")
     moves = [line for line in lines if line.startswith("movep(")]
     assert len(moves) == 1 and "get_tcp_offset" not in moves[0]
+
+
+OLD_NODES = """
+        <Script type="File">
+          <cachedContents>def hello():
+  textmsg("hi")
+end
+</cachedContents>
+          <file>/programs/hello.script</file>
+        </Script>
+        <Popup type="Error" haltProgram="false" message="Lost"/>"""
+
+
+def test_polyscope_3_2_writes_no_marker_for_a_script_file_and_titles_popups_message():
+    # KeyenceRobotVisionSample (3.2.20175): the file's code without its marker; an Error
+    # popup titled "Message" with its error flag
+    lines = compiled(OLD_NODES, version="3.2.20175")
+    assert not any(line.startswith("$") and "Script" in line for line in lines)
+    assert "def hello():" in lines
+    assert 'popup("Lost", "Message", False, True, blocking=True)' in lines
+
+
+def test_later_polyscope_marks_a_script_file_and_titles_an_error_popup_error():
+    for version in ("3.15.4.106291", "5.11.5"):
+        lines = compiled(OLD_NODES, version=version)
+        assert any(line.startswith("$") and "Script: hello.script" in line for line in lines)
+        assert 'popup("Lost", "Error", False, True, blocking=True)' in lines

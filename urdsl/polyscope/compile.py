@@ -477,6 +477,11 @@ class _Compiler:
         # no marker for the Robot Program node [U: between 3.5 and 3.15]
         self.flags = not (saved[0] == 3 and saved < (3, 15))
         self.main_marker = not ((3, 6) <= saved < (3, 15))
+        # PolyScope 3.2 (seen: nedlecky/UR KeyenceRobotVisionSample, 3.2.20175) writes no
+        # marker for a Script node of a file and titles every Popup "Message" (an Error
+        # popup too: ``popup("…", "Message", False, True, blocking=True)``); 3.5 on as now
+        # [U: between 3.2 and 3.5]
+        self.old_polyscope3 = saved[0] == 3 and saved < (3, 5)
 
     # -- numbering
     def _number_tree(self, node: Node) -> None:
@@ -1054,6 +1059,8 @@ class _Compiler:
             path = str(node.fields.get("file", ""))
             contents = self.script_file(path) or contents
             label = f"Script: {path.rsplit('/', 1)[-1]}"
+            if self.old_polyscope3:
+                return self.code(contents, node)
         else:
             label = "Script"
         return [self.marker(node, label), *self.code(contents, node)]
@@ -1076,7 +1083,7 @@ class _Compiler:
         kind = str(node.fields.get("type", "Message"))
         message = str(node.fields.get("message", ""))
         halt = bool(node.fields.get("halt"))
-        title = _POPUP_TITLES.get(kind, kind)
+        title = "Message" if self.old_polyscope3 else _POPUP_TITLES.get(kind, kind)
         text: Expr = String(message.replace('"', "'"))
         if node.fields.get("input") == "Variable" and node.fields.get("variable"):
             variable = str(node.fields["variable"])
