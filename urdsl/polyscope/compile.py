@@ -958,7 +958,7 @@ class _Compiler:
         if not name or payload is None or self.installation is None:
             return self.n_unknown(node)
         return [self.marker(node, f"Set Payload: {name}"),
-                *payload_statements(self.installation, payload, self.version)]
+                *payload_statements(self.installation, payload)]
 
     def set_pulse(self, node: Node) -> list[Item]:
         """A Set node's single digital pulse: a thread sets the output high, sleeps the
