@@ -296,7 +296,7 @@ def _installation_blocks(installation: Installation, major: int) -> dict[str, li
     blocks["modbus"] = _modbus(installation)
     payload = installation.payload
     if payload is not None:
-        blocks["payload"] = payload_statements(installation, payload, major)
+        blocks["payload"] = payload_statements(installation, payload)
     tcp = installation.tcp
     if tcp is not None:
         blocks["tcp"] = [_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset)))]
@@ -441,7 +441,7 @@ def step_counter(program: Program) -> list[Item]:
         ExprStmt(Run(thread))]
 
 
-def payload_statements(installation: Installation, payload: Payload, major: int) -> list[Item]:
+def payload_statements(installation: Installation, payload: Payload) -> list[Item]:
     """What PolyScope writes to select one of the installation's payloads (mass kg, centre
     of gravity m, inertia kg m²): ``set_target_payload`` when the installation gives its
     inertia, else ``set_payload``; without a centre of gravity (the ``toolPayload`` of
