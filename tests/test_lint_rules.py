@@ -102,6 +102,9 @@ CLEAN = [
     ("URS105", "movej([0, -1.57, 0, -1.57, 0, 0], 1.4, 1.05, 0, 0)\n", {}),
     ("URS106", "q_home = [0, 0, 0, 0, 0, 0]\nmovej(q_home, v=1.0)\ns = struct(a=1, b=2)\n", {}),
     ("URS107", "set_standard_digital_out(3, True)\nmovej([0, 0, 0, 0, 0, 0])\n", {}),
+    # two preambles define the name: a nested one-parameter helper and a top-level function
+    ("URS107", "def setup():\n  def node(force):\n    return force\n  end\n  x = node(2)\nend\n"
+     "def node(a, b, c):\n  return a + b + c\nend\nsetup()\ny = node(1, 2, 3)\n", {}),
     ("URS108", "movej([d2r(0), d2r(-90), d2r(0), d2r(-90), d2r(0), d2r(0)])\n"
      "movel([0, -1.57, 0, -1.57, 0, 0])\nmovel(p[0.1, 0.2, 0.3, 0, 0, 0])\n", {}),
     ("URS109", "movej([0, d2r(-90), 0, d2r(-90), 0, 0])\nx = p[0.1, 0.2, 0.3, 0, 3.14, 0]\n"

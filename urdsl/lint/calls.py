@@ -88,10 +88,19 @@ def _problems(ctx: LintContext, call: n.Call) -> list[Problem]:
     keywords = tuple(k.name for k in call.keywords)
     definitions = ctx.analysis.functions.get(name)
     if definitions:
-        params = definitions[-1].params
-        signature = Signature(name, tuple(p.name for p in params),
-                              tuple(p.default is None for p in params))
-        return problems(signature, len(call.args), keywords)
+        # a file may define a name more than once (a URCap preamble's function and another
+        # preamble's nested helper of the same name): a call that fits one of them is fine;
+        # otherwise it is judged against the last, which the controller keeps at top level
+        found: list[Problem] = []
+        for definition in reversed(definitions):
+            params = definition.params
+            signature = Signature(name, tuple(p.name for p in params),
+                                  tuple(p.default is None for p in params))
+            mistakes = problems(signature, len(call.args), keywords)
+            if not mistakes:
+                return []
+            found = found or mistakes
+        return found
     builtin = ctx.builtin(call)
     if builtin is None or not builtin.callable:
         return []
