@@ -409,3 +409,12 @@ def test_the_program_itself_still_stops_at_a_name_defined_nowhere():
     result = run(GOES_ON + "cell()\n", devices="quiet")
     assert result.error is not None and result.error.kind == "undefined"
     assert result.error.span.line == 2 and result.undefined == []
+
+
+def test_a_dotted_xmlrpc_method_is_a_device_call():
+    # Robotiq Copilot's preamble calls a server's dotted method names
+    result = run('client = rpc_factory("xmlrpc", "http://127.0.0.1:4243/RPC2")\n'
+                 "regs = client.ModbusServiceWrapper.readRegisters(1, 0, 4)\n"
+                 "ready = regs[0] == 1\n")
+    assert result.error is None
+    assert "ModbusServiceWrapper.readRegisters()" in result.globals["regs"].source

@@ -155,6 +155,7 @@ class BuiltinTable:
             bound = self.bind(row, args, named, node)
             return _list_method(rt, node, receiver, method, bound)
         if type(receiver) is _RemoteHandle:
+            method = receiver.prefix + method
             if rt.unknown:  # a blocking call: the server's reply is unknown offline
                 rt.wait(DEVICE_REPLY_TIME)
                 return Unknown(f"the {receiver.kind} reply of {method}() at line "
@@ -177,13 +178,20 @@ _ARRAY_LENGTHS = {
 
 
 class _RemoteHandle:
-    """What ``rpc_factory`` and URCap factories give: calls on it are recorded, not made."""
+    """What ``rpc_factory`` and URCap factories give: calls on it are recorded, not made.
+    A member of it (``handle.ModbusServiceWrapper``) is a handle for the server's dotted
+    methods (XML-RPC ``ModbusServiceWrapper.readRegisters``); ``prefix`` is that path."""
 
-    __slots__ = ("kind", "url")
+    __slots__ = ("kind", "url", "prefix")
 
-    def __init__(self, kind: str, url: str) -> None:
+    def __init__(self, kind: str, url: str, prefix: str = "") -> None:
         self.kind = kind
         self.url = url
+        self.prefix = prefix
+
+    def member(self, name: str) -> _RemoteHandle:
+        """The handle of the server's methods under ``name.``."""
+        return _RemoteHandle(self.kind, self.url, f"{self.prefix}{name}.")
 
 
 def _builtin_hint(name: str) -> str | None:

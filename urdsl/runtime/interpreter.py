@@ -1187,6 +1187,8 @@ class _Compiler:
         return get
 
     def e_Attribute(self, node: n.Attribute):
+        from .builtins import _RemoteHandle as remote
+
         rt = self.rt
         container = self.expr(node.value)
         attr = node.attr
@@ -1201,6 +1203,8 @@ class _Compiler:
                                    node) from None
             if type(target) is Unknown:
                 return target
+            if type(target) is remote:  # an XML-RPC server's dotted method names
+                return target.member(attr)
             raise rt.error("type", f"a {type_name(target)} has no field '{attr}'", node)
 
         return get
