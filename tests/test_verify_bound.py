@@ -85,7 +85,7 @@ def test_a_long_toolpath_stops_at_a_small_bound_and_says_so():
 def test_findings_of_a_stopped_check_are_a_prefix_of_the_whole_check():
     # a joint-speed error first, then a toolpath repeated for 3000 s of robot time
     text = ("movej([0, -1.5, 1.5, -1.5, -1.5, 0])\n"
-            "movej([3, -1.5, 1.5, -1.5, -1.5, 0], a=40, v=6)\n" + SQUARE)
+            "movej([3, -1.5, 1.5, -1.5, -1.5, 0], t=0.3)\n" + SQUARE)
     whole = check_text(text, "p.script", options=CheckOptions(timeout=None, max_time=3000,
                                                              self_collision=False))
     short = check_text(text, "p.script", options=CheckOptions(timeout=0.5, max_time=3000,

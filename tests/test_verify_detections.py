@@ -91,10 +91,22 @@ def test_joint_position_limit():
 def test_joint_speed_over_the_model_limit():
     report = check(f"""
         {READY}
-        movej([3, -1.9, 1.9, -1.57, -1.57, 0], a=20, v=5)
+        movej([3, -1.9, 1.9, -1.57, -1.57, 0], t=0.2)
         """)
     (finding,) = only(report, "URS304")
     assert finding.span.line == 2 and "base" in finding.message
+
+
+def test_a_movej_asked_faster_than_its_joints_go_is_timed_at_their_top_speed():
+    # PolyScope's MoveJ offers 180 deg/s on a UR10, whose base tops at 120 deg/s: the move
+    # takes as long as the base needs, and nothing stops
+    report = check(f"""
+        {READY}
+        movej([3, -1.9, 1.9, -1.57, -1.57, 0], a=20, v=5)
+        """, robot="ur10")
+    assert "URS304" not in report.codes(), report.render_text()
+    move = report.moves[-1]
+    assert 3.0 / math.radians(120) < move.duration < 3.0 / math.radians(120) + 0.2
 
 
 def test_wrist_singularity_during_a_movel():
@@ -310,7 +322,7 @@ def test_a_bug_in_a_loop_is_reported_once_with_how_often_and_when_first():
         i = 0
         while i < 12:
           movej([0, -1.9, 1.9, -1.57, -1.57, 0])
-          movej([0, -1.9, 1.9, -1.57, -1.57, 3.0], a=40, v=6.0)
+          movej([0, -1.9, 1.9, -1.57, -1.57, 3.0], t=0.5)
           i = i + 1
         end
         """)

@@ -342,9 +342,25 @@ class MotionPlanner:
         q_from = self._q
         delta = np.abs(q - q_from)
         lead = int(np.argmax(delta))  # equal a, v for all joints: the longest way leads
-        profile = Trapezoid.plan(float(delta[lead]), v, a, t)
+        profile = Trapezoid.plan(float(delta[lead]), self._joint_speed(delta, lead, v), a, t)
         return self._add(self._segment("movej", profile, q_from, q, r, span,
                                        {"a": a, "v": v, "t": t, "lead": lead}), now)
+
+    def _joint_speed(self, delta: np.ndarray, lead: int, v: float) -> float:
+        """The leading axis's speed (rad/s) for a movej asked for ``v``: at most what keeps
+        every joint within the model's top speed (joint ``i`` turns ``delta[i]/delta[lead]``
+        as fast as the leading one). The controller's trajectory generator knows each joint's
+        top speed (the primary interface's configuration data sends them) and PolyScope's
+        MoveJ offers 180 °/s on models whose base tops at 120 °/s: a faster ``v`` is taken
+        as the fastest the joints allow, not a stop [U: no UR text states it]."""
+        qd_max = getattr(self.kinematics, "qd_max", None)
+        if qd_max is None or delta[lead] <= 0.0:
+            return v
+        ratios = delta / delta[lead]
+        moving = ratios > 1e-12
+        if not moving.any():
+            return v
+        return min(v, float(np.min(np.asarray(qd_max, dtype=float)[moving] / ratios[moving])))
 
     def movel(self, pose: np.ndarray, a: float, v: float, t: float, r: float, span: Span,
               now: float, kind: str = "movel", a_rot: float | None = None,

@@ -453,14 +453,16 @@ def _joint_limits(ctx: TraceContext) -> list[Finding]:
     "URS304", "joint-speed-limit", "error", "joint speeds",
     summary="A joint turns faster than the robot model allows.",
     explanation="""
-Each joint of a UR model has a top speed (e.g. 180 °/s for the base and shoulder of a UR5e,
-360 °/s for its wrists; see 'urdsl models'). urdsl samples the planned motion at the
-controller rate (2 ms e-Series, 8 ms CB3) and reports the first move in which a joint is
-faster than its limit, with the joint and its peak speed. A movej with a high v, or a linear
-move near a singularity, where the joints must turn fast for a slow TCP, causes it; the
-controller stops the robot there.""",
-    example=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], a=20, v=5)",
-    fixed=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], a=1.4, v=1.05)",
+Each joint of a UR model has a top speed (e.g. 180 °/s for every joint of a UR5e, 120 °/s
+for the base and shoulder of a UR10; see 'urdsl models'). urdsl samples the planned motion at
+the controller rate (2 ms e-Series, 8 ms CB3) and reports the first move in which a joint is
+faster than its limit, with the joint and its peak speed. A linear move near a singularity,
+where the joints must turn fast for a slow TCP, causes it (the robot speeds up and stops with
+a joint limit violation [U: UR distributor Zacobria's notes on singularities]), and so does a
+movej whose time t is too short. A movej with a v over a joint's top speed is not: it is
+timed at the fastest speed the joints allow [U], and 'urdsl lint' warns about the v (URS110).""",
+    example=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], t=0.2)",
+    fixed=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], t=2.0)",
 )
 def _joint_speeds(ctx: TraceContext) -> list[Finding]:
     qd_max = np.asarray(ctx.robot.qd_max, dtype=float)
