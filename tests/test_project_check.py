@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from urdsl.cli import main
+from urdsl.lint import lint_text
 from urdsl.project.check import in_context, needed_names
 from urdsl.script.parser import parse
 
@@ -273,3 +274,21 @@ def test_a_fragment_that_reads_a_host_variable_before_it_sets_it_takes_the_hosts
     status, report = check(capsys, str(tmp_path / "step.script"))
     assert status == 0, report["findings"]
     assert "run_program" in report["context"]
+
+
+def test_a_program_def_sent_with_its_call_is_the_program(tmp_path, capsys):
+    # a RoboDK station sends Robotiq's driver as `def gripper(): ... end` and `gripper()`:
+    # the def's first-level names are the program's globals, which its nested functions see
+    text = ("def gripper():\n  ACT = 1\n  def rq_get():\n    return ACT\n  end\n"
+            "  textmsg(rq_get())\nend\ngripper()\n")
+    (tmp_path / "GripperClose.script").write_text(text)
+    status, report = check(capsys, str(tmp_path / "GripperClose.script"))
+    assert status == 0, report["findings"]
+    assert [e["message"] for e in report["events"]] == ["1"]
+    assert not [d for d in lint_text(text, "GripperClose.script") if d.severity == "error"]
+    # a def called with other statements around it stays an ordinary function: its
+    # first-level names are its locals
+    (tmp_path / "GripperClose.script").write_text(text + "textmsg(ACT)\n")
+    status, report = check(capsys, str(tmp_path / "GripperClose.script"))
+    assert status == 1
+    assert [f["line"] for f in report["findings"] if f["code"] == "URS201"] == [4]

@@ -244,8 +244,12 @@ class _Builder:
 
 
 def program_def(module: n.Module) -> n.FunctionDef | n.SecDef | None:
-    """The outer ``def`` (or ``sec``) when the file is one program, else None."""
+    """The outer ``def`` (or ``sec``) when the file is one program, else None: a file that
+    is one ``def`` without parameters, or one followed by nothing but a call of it (a
+    program a tool sends with its call, ``def gripper(): ... end`` then ``gripper()``)."""
     statements_ = [item for item in module.body if isinstance(item, n.Stmt)]
+    if len(statements_) == 2 and n.calls_itself(statements_[0], statements_[1]):
+        return statements_[0]  # type: ignore[return-value]
     if len(statements_) != 1:
         return None
     only = statements_[0]

@@ -595,7 +595,10 @@ class _Compiler:
         statements = [s for s in module.body if isinstance(s, n.Stmt)
                       and not isinstance(s, (n.FunctionDef, n.ThreadDef, n.SecDef))]
         self.collect(module.body)
-        if not statements and len(defs) == 1 and not defs[0].params:
+        if len(defs) == 1 and not defs[0].params and (not statements or (
+                len(statements) == 1 and n.calls_itself(defs[0], statements[0]))):
+            # the program's def, alone or followed by its call: its first-level names are
+            # the program's globals, which its nested functions see
             body = rt.functions[defs[0].name].body  # compiled once, by collect()
         elif not statements and not defs:
             secs = [s for s in module.body if isinstance(s, n.SecDef)]

@@ -26,7 +26,7 @@ __all__ = [
     "EnterCritical", "ExitCritical", "Join", "Kill", "If", "Elif", "While", "Param",
     "FunctionDef", "ThreadDef", "SecDef", "Comment", "Blank", "Marker", "Module",
     "Item", "BINARY_PRECEDENCE", "PREFIX_PRECEDENCE", "ATOM_PRECEDENCE", "precedence",
-    "walk", "to_dict",
+    "walk", "to_dict", "calls_itself",
 ]
 
 
@@ -621,3 +621,11 @@ class _Text(str):
 
 def _newline(indent: int | None, level: int) -> str:
     return "" if indent is None else "\n" + " " * (indent * level)
+
+
+def calls_itself(first: Stmt, second: Stmt) -> bool:
+    """Whether ``first`` is a ``def`` without parameters and ``second`` a bare call of it."""
+    return (isinstance(first, FunctionDef) and not first.params
+            and isinstance(second, ExprStmt) and isinstance(second.expr, Call)
+            and isinstance(second.expr.func, Name) and second.expr.func.id == first.name
+            and not second.expr.args and not second.expr.keywords)
