@@ -5,6 +5,7 @@ and a missing or corrupt installation."""
 from __future__ import annotations
 
 import gzip
+import json
 import math
 
 import pytest
@@ -169,7 +170,48 @@ def test_the_step_counter_and_the_verification_global_of_recent_versions(five):
     assert five["steps"][0].startswith("step_count_")
     older = _blocks(_urp("5.11.9.1010452"), _installation5())
     assert "verification" not in older and "steps" in older
-    assert "steps" not in _blocks(_urp("5.7.0.90932"), _installation5())  # before 5.8
+    # seen from 5.7.0 (o2ac/o2ac-ur) and 3.12.1 (kg398/kg_ursim); not in 3.8 and 3.5
+    assert "steps" in _blocks(_urp("5.7.0.90932"), _installation5())
+    assert "steps" in _blocks(_urp("3.12.1.90940"), _INSTALLATION3)
+    assert "steps" not in _blocks(_urp("3.8.0.61336"), _INSTALLATION3)
+    assert "steps" not in _blocks(_urp("5.6.0.90886"), _installation5())  # not seen [U]
+
+
+def test_polyscope_5_7_payload_without_centre_of_gravity_is_the_mass_alone():
+    """5.x before named payloads keeps the payload as ``toolPayload`` on the TCP settings,
+    without a centre of gravity: PolyScope 5.7.0 writes ``set_payload(0.0)``
+    (o2ac/o2ac-ur b_bot's center_object, seven programs)."""
+    installation = b"""<Installation><Version major="5" minor="7" bugfix="0"/>
+  <TCPSettings activePose="tip" toolPayload="0.8">
+    <availablePoses><tcp name="tip" offset="0.0, 0.0, 0.165, 0.0, 0.0, 0.0"/></availablePoses>
+  </TCPSettings></Installation>"""
+    blocks = _blocks(_urp("5.7.0.90932"), installation)
+    assert blocks["payload"] == ["set_payload(0.8)"]
+    assert blocks["tcp"] == ["set_tcp(p[0.0, 0.0, 0.165, 0.0, 0.0, 0.0])"]
+
+
+def test_a_5_7_installation_reaches_the_check(tmp_path, capsys):
+    """The TCP, the payload without centre of gravity and a ceiling mounting of a 5.7
+    installation are what the check runs with; PolyScope's step counter thread is not
+    reported as left running."""
+    (tmp_path / "cell.installation").write_bytes(b"""<Installation>
+  <Version major="5" minor="7" bugfix="0"/>
+  <Features><CameraView><worldTransform>
+    <WorldtoMarshal baseAngle="0.0" tiltAngle="3.141592653589793"/></worldTransform>
+  </CameraView></Features>
+  <TCPSettings activePose="tip" toolPayload="0.8">
+    <availablePoses><tcp name="tip" offset="0.0, 0.0, 0.165, 0.0, 0.0, 0.0"/></availablePoses>
+  </TCPSettings></Installation>""")
+    program = tmp_path / "pre.urp"
+    program.write_bytes(_urp("5.7.0.90932"))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    inferred = report["inferred"]
+    assert inferred["tcp"]["pose"] == pytest.approx([0, 0, 0.165, 0, 0, 0])
+    assert inferred["payload"]["mass"] == pytest.approx(0.8)
+    assert inferred["payload"]["cog"] is None  # the installation gives none
+    assert inferred["gravity"] == pytest.approx([0, 0, -9.82])  # the ceiling
+    assert not report["findings"]
 
 
 def test_variables_then_features_by_name_without_hidden_ones(five):
@@ -473,3 +515,15 @@ def test_polyscope_3_sets_each_outputs_stop_state_only():
     five = _blocks(_urp("5.11.5.1010327"), _conveyor_installation(major="5"))
     assert five["io"] == ["set_runstate_standard_digital_outputs([7])",
                           "set_runstate_standard_digital_output_to_value(7, 2)"]
+
+
+def test_a_plane_never_taught_is_the_zero_pose():
+    """A variable plane whose three points were never taught (all at zero) is written as
+    ``p[0, 0, 0, 0, 0, 0]`` (srs827/Robot-Cello-ResidualRL, 5.17: ``Plane_4``)."""
+    points = "".join(_point(tag, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+                     for tag in ("firstPoint", "secondPoint", "thirdPoint"))
+    installation = f"""<Installation><Version major="5" minor="17" bugfix="3"/><Features>
+  <GeomPlaneNode><GeomPlaneNode name="Plane_4" userHasPoints="false" isVariable="true">
+  {points}</GeomPlaneNode></GeomPlaneNode></Features></Installation>""".encode()
+    blocks = _blocks(_urp("5.17.3"), installation)
+    assert blocks["features"] == ["global Plane_4 = p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]"]

@@ -169,6 +169,25 @@ def test_a_global_another_file_sets_again_is_unknown_not_its_first_value(tmp_pat
     assert "tool_mass" in report["context"]
 
 
+def test_a_global_whose_elements_another_file_sets_is_unknown(tmp_path, capsys):
+    # an OnRobot-style preamble: a data thread fills the grip flags the grip function reads;
+    # checked from a file that borrows the function, the flags are not their first value
+    # (which would halt the program as if the grip had failed)
+    (tmp_path / "export.script").write_text(
+        "global grip_detected = [False, False]\n"
+        "thread data_thread():\n  while True:\n    grip_detected[0] = True\n    sync()\n"
+        "  end\nend\n"
+        "def grip(index):\n  if not grip_detected[index]:\n"
+        '    popup("did not grip", error=True)\n    halt\n  end\nend\n'
+        "run data_thread()\n")
+    (tmp_path / "mine.script").write_text("grip(0)\ntextmsg(\"gripped\")\n")
+    status, report = check(capsys, str(tmp_path / "mine.script"))
+    assert status == 0, report["findings"]
+    assert "did not grip" not in [e["message"] for e in report["events"]]
+    assert "gripped" in [e["message"] for e in report["events"]]
+    assert "grip_detected" in report["context"]
+
+
 def test_a_constant_another_file_gives_once_keeps_its_value(tmp_path, capsys):
     (tmp_path / "setup.script").write_text(
         "def init():\n  global dist = 3.0\nend\n")

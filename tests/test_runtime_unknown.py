@@ -365,3 +365,47 @@ def test_a_name_left_unassigned_by_a_branch_the_check_skipped_is_a_warning():
     report = check_text(text.replace("textmsg(kind)", "textmsg(knid)"), "ask.script")
     (finding,) = [f for f in report.findings if f.code == "URS201"]
     assert finding.severity == "error"
+
+
+GOES_ON = """\
+def cell():
+  rq_activate_and_wait()
+  i = 0
+  while i < 3:
+    rq_move_and_wait(gripper_width)
+    movej(home_q)
+    i = i + 1
+  end
+  movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])
+  while True:
+    count = 1
+  end
+end
+"""
+
+
+def test_a_name_defined_nowhere_is_reported_once_and_the_check_goes_on():
+    from urdsl.verify.run import check_text
+
+    report = check_text(GOES_ON, "cell.script")
+    undefined = [f for f in report.findings if f.code == "URS201"]
+    # one error per missing name, at its first use, however often the loop meets it
+    assert sorted((f.span.line, f.message) for f in undefined) == [
+        (2, "name 'rq_activate_and_wait' is not defined"),
+        (5, "name 'gripper_width' is not defined"),
+        (5, "name 'rq_move_and_wait' is not defined"),
+        (6, "name 'home_q' is not defined")]
+    assert all(f.severity == "error" and "went on" in f.hint for f in undefined)
+    # what depends on a missing name is no device warning; the rest of the program is checked
+    assert not [f for f in report.findings if f.code == "URS210"]
+    assert [m.span.line for m in report.moves] == [9]
+    (spin,) = [f for f in report.findings if f.code == "URS207"]
+    assert spin.span.line == 10
+
+
+def test_the_program_itself_still_stops_at_a_name_defined_nowhere():
+    # the virtual controller runs programs as the controller does: the first missing name
+    # stops the program
+    result = run(GOES_ON + "cell()\n", devices="quiet")
+    assert result.error is not None and result.error.kind == "undefined"
+    assert result.error.span.line == 2 and result.undefined == []

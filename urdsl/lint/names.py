@@ -9,6 +9,7 @@ from collections.abc import Iterator
 from ..script import nodes as n
 from ..script.builtins import catalog, lookup, methods
 from ..script.diagnostics import Diagnostic
+from ..script.urcaps import urcap_hint
 from .context import LintContext
 from .registry import rule
 from .scope import BUILTIN_VARIABLES, Scope
@@ -222,7 +223,7 @@ def unknown_function(ctx: LintContext) -> Iterator[Diagnostic]:
         if name in methods():
             hint = f"{name} is a method: write my_list.{name}(...)"
         else:
-            hint = _suggest(name, set(catalog()) | set(analysis.functions))
+            hint = urcap_hint(name) or _suggest(name, set(catalog()) | set(analysis.functions))
         yield ctx.diagnostic("URS102", call.func, f"unknown function '{name}'", hint)
 
 

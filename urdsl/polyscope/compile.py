@@ -477,6 +477,11 @@ class _Compiler:
         # no marker for the Robot Program node [U: between 3.5 and 3.15]
         self.flags = not (saved[0] == 3 and saved < (3, 15))
         self.main_marker = not ((3, 6) <= saved < (3, 15))
+        # PolyScope 3.2 (seen: nedlecky/UR KeyenceRobotVisionSample, 3.2.20175) writes no
+        # marker for a Script node of a file and titles every Popup "Message" (an Error
+        # popup too: ``popup("…", "Message", False, True, blocking=True)``); 3.5 on as now
+        # [U: between 3.2 and 3.5]
+        self.old_polyscope3 = saved[0] == 3 and saved < (3, 5)
 
     # -- numbering
     def _number_tree(self, node: Node) -> None:
@@ -953,7 +958,7 @@ class _Compiler:
         if not name or payload is None or self.installation is None:
             return self.n_unknown(node)
         return [self.marker(node, f"Set Payload: {name}"),
-                *payload_statements(self.installation, payload, self.version)]
+                *payload_statements(self.installation, payload)]
 
     def set_pulse(self, node: Node) -> list[Item]:
         """A Set node's single digital pulse: a thread sets the output high, sleeps the
@@ -1054,6 +1059,8 @@ class _Compiler:
             path = str(node.fields.get("file", ""))
             contents = self.script_file(path) or contents
             label = f"Script: {path.rsplit('/', 1)[-1]}"
+            if self.old_polyscope3:
+                return self.code(contents, node)
         else:
             label = "Script"
         return [self.marker(node, label), *self.code(contents, node)]
@@ -1076,7 +1083,7 @@ class _Compiler:
         kind = str(node.fields.get("type", "Message"))
         message = str(node.fields.get("message", ""))
         halt = bool(node.fields.get("halt"))
-        title = _POPUP_TITLES.get(kind, kind)
+        title = "Message" if self.old_polyscope3 else _POPUP_TITLES.get(kind, kind)
         text: Expr = String(message.replace('"', "'"))
         if node.fields.get("input") == "Variable" and node.fields.get("variable"):
             variable = str(node.fields["variable"])
@@ -1262,6 +1269,7 @@ class _Compiler:
                     # the radius it had when it was a blend, but does not write it)
         speed = move.fields.get("speed") if move is not None else None
         accel = move.fields.get("acceleration") if move is not None else None
+        move_accel = accel
         params = _floats_or_none(node.attrs.get("toolParams"))
         if params is not None and len(params) == 2:
             speed, accel = params
@@ -1290,25 +1298,27 @@ class _Compiler:
             Assign(Name(flag), Number(0)),
             Assign(Name(handle), Run(thread)),
         ]
-        items.append(self.until_loop(untils, flag, handle, accel))
+        items.append(self.until_loop(untils, flag, handle, accel, move_accel))
         others = [child for child in node.children if child.kind != "Until"]
         items.extend(self.block(others))
         return items
 
     def until_loop(self, untils: list[Node], flag: str, handle: str,
-                   accel: float | None) -> While:
+                   accel: float | None, move_accel: float | None = None) -> While:
         """The loop that waits, while a move thread runs, for the first of its Until
         conditions: tool contact (checked first, whatever the order), a condition (an
         expression: the move stops at the Until's ``deceleration``, m/s², else the move's
         acceleration; seen: PolyScope 5.10), and the end of the move (distance, reached
-        waypoint), in the node order."""
+        waypoint), in the node order. ``accel`` is the motion's own acceleration (m/s²: a
+        Direction's ``toolParams``), ``move_accel`` its Move node's (when it differs)."""
         loop: list[Item] = []
         ordered = sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION")
         for until in ordered:
             kind = until.attrs.get("type", "")
             label = f"Until ({kind.lower()})"
             if kind == "TOOL_CONTACT_DETECTION":
-                loop.extend(self._tool_contact(until, handle, accel))
+                loop.extend(self._tool_contact(
+                    until, handle, move_accel if move_accel is not None else accel))
                 continue
             expression = until.fields.get("expression")
             if isinstance(expression, Expression) and expression:
@@ -1333,7 +1343,9 @@ class _Compiler:
     def _tool_contact(self, until: Node, handle: str, accel: float | None) -> list[Item]:
         """The wait of a Direction that stops on tool contact: back off along the way it
         came by ``retraction`` (m), decelerating at ``decelerationAcceleration`` (m/s²; older
-        files have none: the Direction's own acceleration)."""
+        files have none: the Move node's acceleration, not a Direction's own ``toolParams``
+        one: nedlecky/UR L03_Touchoff, PolyScope 5.9, ``toolParams="0.01, 0.8"`` under a
+        MoveL of 1.2 writes ``stopl(1.2)`` and retracts at ``a=1.2``)."""
         decel = float(until.attrs.get("decelerationAcceleration",
                                       accel if accel is not None else 3.0))
         retraction_text = until.attrs.get("retraction", "0.0")
@@ -1463,10 +1475,16 @@ class _Compiler:
                 # PolyScope 3 (no positionType): a move that uses no TCP goes to the
                 # waypoint's joint angles, a MoveL too (seen: 3.5 ``movel([q], ...)``)
                 target = q_expr
-            elif motion == "MoveJ":
-                target = _call("get_inverse_kin", pose_expr, qnear=q_expr)
             else:
-                target = pose_expr
+                if move.attrs.get("useActiveTCP") == "false" and not move.fields.get("tcp") \
+                        and move.attrs.get("positionType") == "CartesianPose":
+                    # "Ignore Active TCP" (PolyScope 5): the waypoint is a flange pose; the
+                    # active TCP goes where the flange would be (seen: MoveJ, 5.9;
+                    # [U] MoveL/MoveP the same). PolyScope 3 (no positionType) writes the
+                    # pose as it is (3.5 MoveP, Sander-ONeil)
+                    pose_expr = _call("pose_trans", pose_expr, _call("get_tcp_offset"))
+                target = _call("get_inverse_kin", pose_expr, qnear=q_expr) \
+                    if motion == "MoveJ" else pose_expr
         elif kind == "Relative":
             label = name
             to: Expr = Name(f"{name}_to_p")

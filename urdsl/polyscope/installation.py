@@ -459,8 +459,13 @@ def _rotvec(m: list[list[float]]) -> tuple[float, float, float]:
 def _plane(points: list[tuple[float, ...]]) -> tuple[float, ...] | None:
     """PolyScope's pose of a plane feature taught by three points (each a pose): origin
     at the first point, y towards the second, z along the normal on the side of the first
-    point's tool z axis, x = y × z. None for collinear points."""
+    point's tool z axis, x = y × z. Three points at one place (a plane never taught: all
+    zero, ``userHasPoints="false"``) give the first point's pose, as PolyScope writes it
+    (srs827/Robot-Cello-ResidualRL's ``Plane_4``: ``p[0, 0, 0, 0, 0, 0]``) [U: only the
+    zero pose seen]; None for other collinear points [U: not seen]."""
     p1, p2, p3 = (p[:3] for p in points)
+    if all(math.dist(p1, q) < 1e-12 for q in (p2, p3)):
+        return tuple(points[0])
     u = [b - a for a, b in zip(p1, p2, strict=True)]
     v = [b - a for a, b in zip(p1, p3, strict=True)]
     normal = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]

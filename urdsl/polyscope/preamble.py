@@ -296,7 +296,7 @@ def _installation_blocks(installation: Installation, major: int) -> dict[str, li
     blocks["modbus"] = _modbus(installation)
     payload = installation.payload
     if payload is not None:
-        blocks["payload"] = payload_statements(installation, payload, major)
+        blocks["payload"] = payload_statements(installation, payload)
     tcp = installation.tcp
     if tcp is not None:
         blocks["tcp"] = [_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset)))]
@@ -423,13 +423,13 @@ def _modbus(installation: Installation) -> list[Item]:
 
 
 def step_counter(program: Program) -> list[Item]:
-    """The thread PolyScope (3.15 and 5.8 on) starts in every program to count its
+    """The thread PolyScope (3.12 and 5.7 on) starts in every program to count its
     controller steps; its names carry a generated id (here derived from the program's
-    name, so that compiling twice gives the same text)."""
-    version = program.saved_in or program.created_in or ""
-    parts = [int(p) if p.isdigit() else 0 for p in version.split(".")[:2]] + [0, 0]
-    major, minor = parts[0], parts[1]
-    if not ((major == 3 and minor >= 15) or (major == 5 and minor >= 8) or major > 5):
+    name, so that compiling twice gives the same text). Seen from 5.7.0 (o2ac/o2ac-ur's
+    b_bot programs) and 3.12.1 (kg398/kg_ursim, build 90940, the series of 5.7.0's 90932); not
+    in 3.8 and 3.5 scripts; 3.9-3.12.0 and 5.0-5.6 are not seen [U]."""
+    major, minor = _version(program.saved_in or program.created_in)
+    if not ((major == 3 and minor >= 12) or (major == 5 and minor >= 7) or major > 5):
         return []
     count = "step_count_" + _generated_id(program.name, "count")
     thread = "Step_Counter_Thread_" + _generated_id(program.name, "thread")
@@ -441,11 +441,12 @@ def step_counter(program: Program) -> list[Item]:
         ExprStmt(Run(thread))]
 
 
-def payload_statements(installation: Installation, payload: Payload, major: int) -> list[Item]:
+def payload_statements(installation: Installation, payload: Payload) -> list[Item]:
     """What PolyScope writes to select one of the installation's payloads (mass kg, centre
     of gravity m, inertia kg m²): ``set_target_payload`` when the installation gives its
-    inertia, else ``set_payload`` (PolyScope 3 without a centre of gravity: the mass
-    alone). Used by the preamble (the default payload) and a Set Payload node."""
+    inertia, else ``set_payload``; without a centre of gravity (the ``toolPayload`` of
+    PolyScope 3 and of 5.x before named payloads: 5.7.0, o2ac/o2ac-ur) the mass alone.
+    Used by the preamble (the default payload) and a Set Payload node."""
     raw = installation.settings.get(f"Payload/{payload.name}") if installation.settings \
         else None
     if raw is not None and raw.get("inertiaParameters"):
@@ -453,7 +454,7 @@ def payload_statements(installation: Installation, payload: Payload, major: int)
         return [_stmt("set_target_payload", _num(payload.mass),
                       List(tuple(_num(v) for v in payload.cog or (0, 0, 0))),
                       List(tuple(_num(v) for v in inertia)))]
-    if payload.cog is None and major < 5:
+    if payload.cog is None:
         return [_stmt("set_payload", _num(payload.mass))]
     return [_stmt("set_payload", _num(payload.mass),
                   List(tuple(_num(v) for v in payload.cog or (0, 0, 0))))]

@@ -203,15 +203,21 @@ _WRITES: dict[int, tuple[object, dict[str, int]]] = {}
 
 
 def _writes(script) -> dict[str, int]:
-    """How many statements of ``script`` give each variable a value (cached per file)."""
+    """How many statements of ``script`` give each variable a value (cached per file); an
+    assignment of an element or member (``grip_detected[i] = True``) counts for the variable
+    that holds it, as it changes what the variable holds."""
     cached = _WRITES.get(id(script))
     if cached is not None and cached[0] is script:
         return cached[1]
     counts: dict[str, int] = {}
     if script.module is not None:
         for node in n.walk(script.module):
-            if isinstance(node, n.Assign) and isinstance(node.target, n.Name):
-                counts[node.target.id] = counts.get(node.target.id, 0) + 1
+            if isinstance(node, n.Assign):
+                target = node.target
+                while isinstance(target, (n.Index, n.Attribute)):
+                    target = target.value
+                if isinstance(target, n.Name):
+                    counts[target.id] = counts.get(target.id, 0) + 1
             elif isinstance(node, n.Declare) and node.value is not None:
                 counts[node.name] = counts.get(node.name, 0) + 1
     if len(_WRITES) > 512:

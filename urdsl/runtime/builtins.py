@@ -60,8 +60,7 @@ class BuiltinTable:
         row = lookup(name)
         implementation = IMPLEMENTATIONS.get(name)
         if row is None and implementation is None:
-            raise rt.error("undefined", f"name '{name}' is not defined", node,
-                           _builtin_hint(name))
+            return rt.not_defined(name, "name", node, _builtin_hint(name))
         if row is not None:
             bound = self.bind(row, args, named, node)
         else:
@@ -191,7 +190,11 @@ def _builtin_hint(name: str) -> str | None:
     import difflib
 
     from ..script.builtins import catalog
+    from ..script.urcaps import urcap_hint
 
+    hint = urcap_hint(name)
+    if hint is not None:
+        return hint
     close = difflib.get_close_matches(name, list(catalog()), n=1)
     return f"did you mean '{close[0]}'?" if close else None
 

@@ -81,6 +81,10 @@ class RuntimeConfig:
     ``deadline``: a ``time.monotonic()`` value (s of wall-clock time) after which the run
     stops and says how far it got (``RunResult.stopped_early``); ``None``: no bound.
     ``max_threads``: threads that may run at once (:data:`MAX_THREADS`).
+    ``go_on_after_undefined``: a name or function that is not defined is recorded once per
+    name (``RunResult.undefined``) and read as an unknown value, so the run goes on and one
+    missing name does not hide the rest of the program (the verifier); ``False`` (the virtual
+    controller): it stops the program as the controller does.
     """
 
     step_time: float = 0.002
@@ -89,6 +93,7 @@ class RuntimeConfig:
     max_call_depth: int = 200
     deadline: float | None = None
     max_threads: int = MAX_THREADS
+    go_on_after_undefined: bool = False
     pace: Callable[[float], None] | None = None
     """Called with the robot time (s) the program is about to advance to, before it does:
     the virtual controller sleeps there to run in real time. ``None`` (the verifier): robot
@@ -123,6 +128,9 @@ class RunResult:
     once per statement."""
     events_dropped: int = 0
     """Events not kept beyond :data:`EVENT_LIMIT`."""
+    undefined: list[ScriptRuntimeError] = field(default_factory=list)
+    """Names and functions found not defined, the first use of each, when the run went on
+    past them (``RuntimeConfig.go_on_after_undefined``)."""
     stopped_early: Event | None = None
     """Why the run stopped before the program's end without an error: ``"blocked"`` (the
     program waits forever, e.g. a read with timeout 0 that nothing answers) or
@@ -213,6 +221,8 @@ class Interpreter:
         # replies taken for device reads compared with constants (see _device_reply)
         self.device_replies: dict[str, object] = {}
         self.warnings: list[Event] = []
+        self.undefined: dict[str, ScriptRuntimeError] = {}
+        self._undefined_sources: set[str] = set()
         self._dead = 0
         self.events_dropped = 0
         self.depth = 0
@@ -254,6 +264,7 @@ class Interpreter:
         result.events = self.events
         result.globals = self.globals
         result.warnings = self.warnings
+        result.undefined = list(self.undefined.values())
         result.events_dropped = self.events_dropped
         if self.events_dropped:
             self.events.append(Event(self.time, "dropped", f"{self.events_dropped:,} more "
@@ -410,7 +421,11 @@ class Interpreter:
                              f"stopped at robot time {self.time:.3f} s{where}", span))
 
     def warn_once(self, message: str, node: Any, unknown: Unknown | None = None) -> None:
-        """A warning about what depends on a value unknown offline, once per statement."""
+        """A warning about what depends on a value unknown offline, once per statement.
+        None when ``unknown`` stands for a name that is not defined: its error says that the
+        check went on with the value unknown, and what follows is not about a device."""
+        if unknown is not None and unknown.source in self._undefined_sources:
+            return
         span = node.span if node is not None and hasattr(node, "span") else NO_SPAN
         key = ("unknown", span)
         if key in self._once:
@@ -452,6 +467,19 @@ class Interpreter:
     def error(self, kind: str, message: str, node: Any = None, hint: str | None = None):
         span = node.span if node is not None and hasattr(node, "span") else NO_SPAN
         return ScriptRuntimeError(kind, message, span, hint, self.time)
+
+    def not_defined(self, name: str, what: str, node: Any, hint: str | None) -> Unknown:
+        """A name or function ``name`` that nothing defined: the error that stops the
+        program, or, when the run goes on past such names (the verifier), the error recorded
+        once per name and an unknown value in its place."""
+        error = self.error("undefined", f"{what} '{name}' is not defined", node, hint)
+        if not self.config.go_on_after_undefined:
+            raise error
+        if name not in self.undefined:
+            self.undefined[name] = error
+        source = f"'{name}' (not defined)"
+        self._undefined_sources.add(source)
+        return Unknown(source, error.span)
 
     def start_thread(self, name: str, node: n.Node) -> ThreadHandle:
         body = self.threads_defs.get(name)
@@ -765,7 +793,7 @@ class _Compiler:
                            else taken if working
                            else "it skips this branch (a working device's reply does not "
                            "lead here)"),
-                        test_node)
+                        test_node, value)
                     if not take:
                         continue
                     return body(frame)
@@ -803,13 +831,14 @@ class _Compiler:
                         rt.warn_once(
                             f"this loop's condition depends on {value.source}, which is "
                             "unknown offline; the check follows a working device, whose "
-                            "reply ends the loop", test_node)
+                            "reply ends the loop", test_node, value)
                         break
                     if unknown_passes == 1:
                         rt.warn_once(
                             f"this loop's condition depends on {value.source}, which is "
                             "unknown offline; the check follows a working device and leaves "
-                            f"the loop after at most {UNKNOWN_LOOP_PASSES} passes", test_node)
+                            f"the loop after at most {UNKNOWN_LOOP_PASSES} passes", test_node,
+                            value)
                     if unknown_passes > UNKNOWN_LOOP_PASSES:
                         break
                 elif not _truth(value, rt, test_node):
@@ -961,8 +990,7 @@ class _Compiler:
                     "value unknown", node)
                 return Unknown(f"'{name}' (not assigned on the path the check followed)",
                                node.span)
-            raise rt.error("undefined", f"name '{name}' is not defined", node,
-                           _name_hint(name, frame, rt))
+            return rt.not_defined(name, "name", node, _name_hint(name, frame, rt))
 
         return read
 

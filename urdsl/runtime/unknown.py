@@ -241,7 +241,7 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
         if type(where) is not Unknown:
             return call(values, named, node)
         rt.warn_once(f"which output {name}() writes depends on {found.source}, which is "
-                     "unknown offline; not checked", node)
+                     "unknown offline; not checked", node, found)
         return None
     if kind == "motion":
         # a servo or speed command lasts a controller frame; a move is taken as
@@ -249,7 +249,7 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
         frame = name.startswith(_FRAME_COMMANDS)
         took = f"{rt.config.step_time:g}" if frame else f"{UNCHECKED_MOVE_TIME:g}"
         rt.warn_once(f"this move depends on {found.source}, which is unknown offline; the "
-                     f"move is not checked (taken as {took} s)", node)
+                     f"move is not checked (taken as {took} s)", node, found)
         if rt.robot is not None:
             rt.robot.stop_blending(rt.time)
             # where the arm went is unknown until a move to a known target
@@ -262,19 +262,19 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
         return None
     if kind == "sleep":
         rt.warn_once(f"this wait depends on {found.source}, which is unknown offline; taken "
-                     "as one controller frame", node)
+                     "as one controller frame", node, found)
         rt.sync()
         return None
     if kind == "procedure":
         rt.warn_once(f"{name}() depends on {found.source}, which is unknown offline; not "
-                     "checked", node)
+                     "checked", node, found)
         return None
     if kind == "read":
         # a socket read whose timeout (or socket, or count) is unknown still waits for the
         # device: at least one controller frame (UR's External Control script reads its
         # command socket with a timeout the driver sent, in a loop that has no other wait)
         rt.warn_once(f"{name}() depends on {found.source}, which is unknown offline; its "
-                     "wait is taken as one controller frame and its reply is unknown", node)
+                     "wait is taken as one controller frame and its reply is unknown", node, found)
         rt.sync()
         return unknown_from(name, node)
     return found

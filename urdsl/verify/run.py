@@ -18,7 +18,7 @@ it got to and says so (URS313), and checks left undone are named.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -191,7 +191,8 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     if options.tcp is not None:
         planner.tcp = np.asarray(options.tcp, dtype=float)
     deadline = None if options.timeout is None else started + RUN_SHARE * options.timeout
-    config = RuntimeConfig(step_time=step, max_time=options.max_time, deadline=deadline)
+    config = RuntimeConfig(step_time=step, max_time=options.max_time, deadline=deadline,
+                           go_on_after_undefined=True)
     environment = options.environment
     if environment is None:
         environment = Environment(devices="unknown")
@@ -215,6 +216,11 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
         result.time = min(result.time, result.error.time)
         planner.end_time = max([result.time] + [s.end for s in planner.segments])
         report.events = [e for e in result.events if e.time <= result.error.time]
+    for error in result.undefined:  # the run went on with the value unknown
+        finding = _runtime_finding(error)
+        went_on = "the check went on with its value unknown (what depends on it is not checked)"
+        hint = f"{finding.hint}; {went_on}" if finding.hint else went_on
+        report.findings.append(replace(finding, hint=hint))
     if result.error is not None:
         report.findings.append(_runtime_finding(result.error))
     for warning in planner.warnings:  # Overlapping Blends, or a stoppable move's far target
