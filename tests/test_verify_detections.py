@@ -653,3 +653,18 @@ def test_a_builtin_that_is_not_simulated_gives_a_list_of_its_own_length():
         set_payload(1.2, get_target_payload_cog())
         """)
     assert not [f for f in report.findings if f.severity == "error"], report.render_text()
+
+
+@pytest.mark.parametrize(("target", "reported"), [
+    # the forearm folded back until upper arm and wrist 1 overlap by 2 mm: within what the
+    # approximate link shapes can tell (arms taught on the robot pass such poses)
+    ("[-0.7169, -0.0399, -2.886, -0.0877, 2.8188, -1.3079]", False),
+    # ... and folded further, 20 mm deep: a self-collision
+    ("[-0.7241, -0.0211, -2.9342, -0.0728, 2.863, -1.3211]", True),
+])
+def test_a_self_collision_is_one_deeper_than_the_link_shapes_can_tell(target, reported):
+    report = check(f"""
+        {READY}
+        movej({target})
+        """)
+    assert ("URS308" in report.codes()) is reported, report.render_text()
