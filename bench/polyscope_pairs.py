@@ -11,7 +11,11 @@ markers (PolyScope writes them; a ``.script`` without them was written by someth
 
 ``--tsv SPLITS`` prints the rows to add to ``pairs.tsv``: the repositories in the order
 listed (owner/name, case-insensitive), split by position: ``--tsv tune4,tune4,held`` gives
-every third project ``held`` and the others ``tune4``.
+every third project ``held`` and the others ``tune4``. Only pairs PolyScope 3.x-5.x wrote
+are rows (root ``<URProgram>``, a ``.script`` with markers: not PolyScope 1.x's serialised
+programs, a generator's files, a ``__MACOSX`` resource fork); a repository with none is not
+a project. ``--studied REPO`` (repeatable): a repository whose programs a helper has already
+compiled is not blind: it takes the first split and no position in the cycle.
 
 Usage: ``python bench/polyscope_pairs.py --repos /work/.mirror [--tsv tune4,tune4,held]``
 """
@@ -148,6 +152,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repos", type=Path, required=True)
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
     parser.add_argument("--tsv", help="comma-separated splits by position, repeated")
+    parser.add_argument("--studied", action="append", default=[],
+                        help="a repository already compiled by a helper (repeatable)")
     args = parser.parse_args(argv)
     have, authors = known(args.pairs)
     projects: list[tuple[str, list[Pair]]] = []
@@ -164,9 +170,17 @@ def main(argv: list[str] | None = None) -> int:
         if pairs:
             projects.append((repo, pairs))
     splits = args.tsv.split(",") if args.tsv else []
-    for index, (repo, pairs) in enumerate(projects):
+    position = 0
+    for repo, pairs in projects:
         if splits:
-            split = splits[index % len(splits)]
+            pairs = [p for p in pairs if p.root == "URProgram" and p.markers]
+            if not pairs:
+                continue
+            if repo in args.studied:
+                split = splits[0]
+            else:
+                split = splits[position % len(splits)]
+                position += 1
             for pair in pairs:
                 print("\t".join((repo, pair.commit, pair.urp, pair.script,
                                  "none (referenced only)", split)))
