@@ -1304,13 +1304,17 @@ class _Compiler:
         return items
 
     def until_loop(self, untils: list[Node], flag: str, handle: str,
-                   accel: float | None, move_accel: float | None = None) -> While:
+                   accel: float | None, move_accel: float | None = None,
+                   reaches_end: bool = False) -> While:
         """The loop that waits, while a move thread runs, for the first of its Until
         conditions: tool contact (checked first, whatever the order), a condition (an
         expression: the move stops at the Until's ``deceleration``, m/s², else the move's
         acceleration; seen: PolyScope 5.10), and the end of the move (distance, reached
         waypoint), in the node order. ``accel`` is the motion's own acceleration (m/s²: a
-        Direction's ``toolParams``), ``move_accel`` its Move node's (when it differs)."""
+        Direction's ``toolParams``), ``move_accel`` its Move node's (when it differs).
+        ``reaches_end``: the motion ends by itself (a waypoint's move); when no Until waits
+        for that end, the loop still ends with the move, with no marker (PolyScope 5.17,
+        srs827/Robot-Cello-ResidualRL: a Waypoint with only an expression Until)."""
         loop: list[Item] = []
         ordered = sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION")
         for until in ordered:
@@ -1337,6 +1341,11 @@ class _Compiler:
             done.append(Break())
             loop.append(_stmt("sleep", _num(1e-10)))
             loop.append(If(Paren(BinOp(">", Name(flag), Number(1))), tuple(done)))
+        if reaches_end and all(u.attrs.get("type") in ("EXPRESSION", "TOOL_CONTACT_DETECTION")
+                               for u in untils):
+            loop.append(_stmt("sleep", _num(1e-10)))
+            loop.append(If(Paren(BinOp(">", Name(flag), Number(1))),
+                           (Join(Name(handle)), Break())))
         loop.append(_stmt("sync"))
         return While(Paren(Bool(True)), tuple(loop))
 
@@ -1522,7 +1531,8 @@ class _Compiler:
                 Assign(Name(flag), Number(0)),
                 Assign(Name(handle), Run(thread)),
                 self.until_loop(untils, flag, handle,
-                                accel.value if isinstance(accel, Number) else None)]
+                                accel.value if isinstance(accel, Number) else None,
+                                reaches_end=True)]
 
     def move_tcp(self, move: Node, waypoint: Node) -> list[Item]:
         """``set_tcp`` before a waypoint's motion when its move names its own TCP
