@@ -472,11 +472,12 @@ class _Compiler:
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
         saved = _version(program.saved_in or program.created_in)
-        # PolyScope before 3.15 (seen: 3.5.0 and 3.8.0; 3.15.3 on write them) writes its
-        # markers without the breakAfter/noBreak flags; 3.8.0 (not 3.5.0, not 3.15) writes
-        # no marker for the Robot Program node [U: between 3.5 and 3.15]
-        self.flags = not (saved[0] == 3 and saved < (3, 15))
-        self.main_marker = not ((3, 6) <= saved < (3, 15))
+        # PolyScope before 3.12 (seen: 3.5.0 and 3.8.0; 3.12.1, 3.14.1, 3.15 on write them)
+        # writes its markers without the breakAfter/noBreak flags; 3.8.0 (not 3.5.0, not
+        # 3.12.1, 3.14.1 or 3.15) writes no marker for the Robot Program node
+        # [U: 3.9 to 3.11]
+        self.flags = not (saved[0] == 3 and saved < (3, 12))
+        self.main_marker = not ((3, 6) <= saved < (3, 12))
         # PolyScope 3.2 (seen: nedlecky/UR KeyenceRobotVisionSample, 3.2.20175) writes no
         # marker for a Script node of a file and titles every Popup "Message" (an Error
         # popup too: ``popup("…", "Message", False, True, blocking=True)``); 3.5 on as now
