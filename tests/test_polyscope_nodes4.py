@@ -6,6 +6,13 @@ from __future__ import annotations
 
 from test_polyscope_programs import EXPRESSION, WAYPOINT_UNTIL, lines_of, program
 from test_polyscope_variants import WAYPOINT_MOVE, compiled
+from test_polyscope_variants import program as variants_program
+
+from urdsl.polyscope.compile import compile_program
+from urdsl.polyscope.installation import parse_installation
+from urdsl.polyscope.urp import parse_urp
+from urdsl.script import parse
+from urdsl.script.printer import format as print_tree
 
 
 def test_a_waypoint_with_only_an_expression_until_still_ends_with_its_move():
@@ -28,3 +35,66 @@ def test_polyscope_3_12_and_3_14_write_flags_and_the_robot_program_marker():
         markers = [line for line in compiled(WAYPOINT_MOVE, version=version)
                    if line.startswith("$")]
         assert markers == ['$ 1 "Robot Program"', '$ 2 "MoveJ"', '$ 3 "Start" "breakAfter"']
+
+
+VARIABLE_BASE = """<Installation name="cell">
+  <TCPSettings activePose="TCP"><tcp name="TCP" offset="0.0, 0.0, 0.1, 0.0, 0.0, 0.0"/>
+  </TCPSettings>
+  <Features>
+    <BaseView><BaseView showAxes="true" joggable="true" isVariable="{variable}"/></BaseView>
+    <ToolView><ToolView showAxes="true" joggable="true" isVariable="false"/></ToolView>
+  </Features>
+</Installation>"""
+
+BASE_MOVES = """
+        <Move motionType="MoveL" speed="0.5" acceleration="0.5" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            <Waypoint type="Fixed" name="home" kinematicsFlags="3">
+              <motionParameters/>
+              <position joints="0.0, -1.5, 1.5, -1.5, -1.5, 0.0"
+                        pose="0.3, -0.4, 0.5, 0.0, 3.14, 0.0"/>
+            </Waypoint>
+            <Waypoint type="Variable" name="approach" kinematicsFlags="-1">
+              <motionParameters/>
+              <variable name="APPROACH"/>
+            </Waypoint>
+          </children>
+        </Move>
+        <Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            <Waypoint type="Variable" name="sp" kinematicsFlags="-1">
+              <motionParameters/>
+              <variable name="sp"/>
+            </Waypoint>
+          </children>
+        </Move>"""
+
+
+def base_lines(variable: str) -> list[str]:
+    prog = parse_urp(variants_program(BASE_MOVES, version="3.14.1.1031110").encode(),
+                     "prod.urp")
+    inst = parse_installation(VARIABLE_BASE.format(variable=variable).encode(),
+                              "cell.installation")
+    text = compile_program(prog, inst).text
+    assert print_tree(parse(text)) == text
+    return [line.strip() for line in text.splitlines()]
+
+
+def test_polyscope_3_moves_in_a_variable_base_go_relative_to_it():
+    # ldalepfi/UR-Simulation-Prod (3.14.1): the installation's base is variable
+    # (<BaseView isVariable="true">): ``global Base=p[0.0,…]`` in the preamble, a MoveL to
+    # ``pose_trans(Base, p[…])`` and ``pose_trans(Base, APPROACH)``, a MoveJ to ``sp``
+    lines = base_lines("true")
+    assert "global Base = p[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]" in lines
+    moves = [line for line in lines if line.startswith(("movel(", "movej("))]
+    assert moves == ["movel(pose_trans(Base, p[0.3, -0.4, 0.5, 0.0, 3.14, 0.0]), a=0.5, v=0.5)",
+                     "movel(pose_trans(Base, APPROACH), a=0.5, v=0.5)",
+                     "movej(sp, a=1.4, v=1.05)"]
+
+
+def test_polyscope_3_moves_in_a_fixed_base_are_unchanged():
+    lines = base_lines("false")
+    assert not any(line.startswith("global Base") for line in lines)
+    assert "movel(p[0.3, -0.4, 0.5, 0.0, 3.14, 0.0], a=0.5, v=0.5)" in lines

@@ -469,6 +469,7 @@ class _Compiler:
         self.counter = 0
         self.labels: dict[int, str] = {}
         self.pins = dict(getattr(installation, "io_names", ()) or ())
+        self.base_variable = bool(getattr(installation, "base_variable", False))
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
         saved = _version(program.saved_in or program.created_in)
@@ -787,6 +788,9 @@ class _Compiler:
             feature = move.fields.get("feature")
             if feature and feature not in _BASE_FEATURES:
                 target = _call("pose_trans", Name(str(feature)), target)
+            elif self.in_variable_base(move):
+                if move.attrs.get("motionType") != "MoveJ":
+                    target = _call("pose_trans", Name("Base"), target)
             elif self.version < 5:
                 # PolyScope 3 writes a variable waypoint in the base as relative to the
                 # base's pose too (seen once, saved by 3.15)
@@ -806,6 +810,15 @@ class _Compiler:
         if known.get(str(feature), True) is False:
             return None
         return str(feature)
+
+    def in_variable_base(self, move: Node) -> bool:
+        """A PolyScope 3 move in a variable base feature (seen: 3.14.1, ldalepfi/UR-
+        Simulation-Prod): a MoveL goes to ``pose_trans(Base, p[…])`` and to
+        ``pose_trans(Base, var)``, a MoveJ to a variable waypoint as it is [U: a fixed
+        waypoint of a MoveJ, a MoveP]."""
+        feature = move.fields.get("feature")
+        return self.version < 5 and self.base_variable and (
+            not feature or feature in _BASE_FEATURES)
 
     def in_variable_feature(self, node: Node, move: Node, pose: Expr) -> Expr:
         """A fixed waypoint's pose under a move in a variable feature, as PolyScope writes
@@ -1478,6 +1491,8 @@ class _Compiler:
             label = name
             pose_expr, q_expr = self.fixed_values(node)
             pose_expr = self.in_variable_feature(node, move, pose_expr)
+            if motion != "MoveJ" and self.in_variable_base(move):
+                pose_expr = _call("pose_trans", Name("Base"), pose_expr)
             if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
                 target = q_expr
             elif "positionType" not in move.attrs and motion in ("MoveJ", "MoveL") and \
