@@ -88,6 +88,7 @@ from urdsl.polyscope.urp import UrpError, parse_urp  # noqa: E402
 from urdsl.script import parse  # noqa: E402
 from urdsl.script.diagnostics import ScriptError  # noqa: E402
 from urdsl.script.nodes import (  # noqa: E402
+    Blank,
     Comment,
     Declare,
     FunctionDef,
@@ -213,7 +214,9 @@ def _clean(module: Module) -> Module:
                 changes[f.name] = tuple(replace(e, body=block(e.body)) for e in value)
         return replace(node, **changes) if changes else node
 
-    return Module(block(module.body))
+    # blank lines at the top level are layout: a comment an editor put above the program
+    # leaves one (Roma4286/UniversalRobots Robot1.script: "#Code begins from 1560 line")
+    return Module(tuple(item for item in block(module.body) if not isinstance(item, Blank)))
 
 
 def _number(match: re.Match) -> str:
