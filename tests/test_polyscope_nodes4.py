@@ -5,7 +5,7 @@ are PolyScope's."""
 from __future__ import annotations
 
 from test_polyscope_programs import EXPRESSION, WAYPOINT_UNTIL, lines_of, program
-from test_polyscope_variants import WAYPOINT_MOVE, compiled
+from test_polyscope_variants import DIRECTION, WAYPOINT_MOVE, compiled
 from test_polyscope_variants import program as variants_program
 
 from urdsl.polyscope.compile import compile_program
@@ -98,3 +98,14 @@ def test_polyscope_3_moves_in_a_fixed_base_are_unchanged():
     lines = base_lines("false")
     assert not any(line.startswith("global Base") for line in lines)
     assert "movel(p[0.3, -0.4, 0.5, 0.0, 3.14, 0.0], a=0.5, v=0.5)" in lines
+
+
+def test_a_direction_under_a_movep_moves_with_movep():
+    # Roma4286/UniversalRobots Robot1 (5.12): "Направление: Инструмент Z-" under a MoveP
+    # writes ``movep(towardsPos, a=…, v=…)``; under a MoveL ``movel`` as before
+    process = [line for line in compiled(DIRECTION.format(kind="BLEND").replace(
+        'motionType="MoveL"', 'motionType="MoveP"')) if "(towardsPos" in line]
+    assert process and all(line.startswith("movep(towardsPos") for line in process)
+    linear = [line for line in compiled(DIRECTION.format(kind="BLEND"))
+              if "(towardsPos" in line]
+    assert linear and all(line.startswith("movel(towardsPos") for line in linear)

@@ -1301,7 +1301,10 @@ class _Compiler:
             Assign(Name(flag), Number(1)),
             Declare("local", "towardsPos", _call("calculate_point_to_move_towards",
                                                  feature_pose, vector, _num(distance))),
-            ExprStmt(Call(Name("movel"), (Name("towardsPos"),), tuple(keywords))),
+            # a Direction under a MoveP moves with movep (5.12: Roma4286/UniversalRobots)
+            ExprStmt(Call(Name("movep" if move is not None and move.attrs.get("motionType")
+                               == "MoveP" else "movel"), (Name("towardsPos"),),
+                          tuple(keywords))),
             Assign(Name(flag), Number(2)),
             ExitCritical(),
         )
