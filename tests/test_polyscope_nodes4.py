@@ -109,3 +109,12 @@ def test_a_direction_under_a_movep_moves_with_movep():
     linear = [line for line in compiled(DIRECTION.format(kind="BLEND"))
               if "(towardsPos" in line]
     assert linear and all(line.startswith("movel(towardsPos") for line in linear)
+
+
+def test_a_program_named_with_a_keyword_is_prefixed_with_p():
+    # Baxterminator/RoboTech-24 robot/run.urp (5.13.1): ``def Prun():``
+    for name, expected in (("run", "def Prun():"), ("pick", "def pick():")):
+        data = variants_program(WAYPOINT_MOVE).replace('name="variants"', f'name="{name}"')
+        text = compile_program(parse_urp(data.encode(), f"{name}.urp")).text
+        assert print_tree(parse(text)) == text
+        assert text.splitlines()[0] == expected
