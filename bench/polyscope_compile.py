@@ -140,7 +140,10 @@ def popup_title(line: str) -> str:
 
 def git_dir(repos: Path, repo: str) -> Path:
     base = repos / repo.replace("/", "+")
-    return base / "repo" if (base / "repo").exists() else base
+    for candidate in (base / "repo" / ".git", base / "repo"):  # a work tree's, a bare one
+        if (candidate / "HEAD").exists():
+            return candidate
+    return base
 
 
 def git_show(gitdir: Path, commit: str, path: str) -> bytes | None:
