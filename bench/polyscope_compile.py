@@ -49,7 +49,9 @@ installation.
 Prints, per split (``tune``: used while writing the compiler; ``held``: projects held back;
 ``extra``: projects found later, used to find the variants the tune pairs lack; ``tune2``:
 projects found after those, two of every three in the order they were added, the third
-``held``; ``tune3``: the same for the projects found after the ``tune2`` ones),
+``held``; ``tune3``: the same for the projects found after the ``tune2`` ones; ``tune4``: the
+same for the projects of the repositories fetched for the real-world benchmark, listed by
+``bench/polyscope_pairs.py``),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most; then each project's share of programs exact (program part, whole, whole among
 the programs with their installation) and the mean of these over the projects, each project
@@ -86,6 +88,7 @@ from urdsl.polyscope.urp import UrpError, parse_urp  # noqa: E402
 from urdsl.script import parse  # noqa: E402
 from urdsl.script.diagnostics import ScriptError  # noqa: E402
 from urdsl.script.nodes import (  # noqa: E402
+    Blank,
     Comment,
     Declare,
     FunctionDef,
@@ -137,7 +140,10 @@ def popup_title(line: str) -> str:
 
 def git_dir(repos: Path, repo: str) -> Path:
     base = repos / repo.replace("/", "+")
-    return base / "repo" if (base / "repo").exists() else base
+    for candidate in (base / "repo" / ".git", base / "repo"):  # a work tree's, a bare one
+        if (candidate / "HEAD").exists():
+            return candidate
+    return base
 
 
 def git_show(gitdir: Path, commit: str, path: str) -> bytes | None:
@@ -211,7 +217,9 @@ def _clean(module: Module) -> Module:
                 changes[f.name] = tuple(replace(e, body=block(e.body)) for e in value)
         return replace(node, **changes) if changes else node
 
-    return Module(block(module.body))
+    # blank lines at the top level are layout: a comment an editor put above the program
+    # leaves one (Roma4286/UniversalRobots Robot1.script: "#Code begins from 1560 line")
+    return Module(tuple(item for item in block(module.body) if not isinstance(item, Blank)))
 
 
 def _number(match: re.Match) -> str:
@@ -428,7 +436,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repos", type=Path, default=Path("/work/.mirror"),
                         help="folder of owner+name git dirs")
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
-    parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "tune3", "all"),
+    parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "tune3", "tune4",
+                                                   "all"),
                         default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
     parser.add_argument("--script-files", choices=("file", "cache"), default="file",
@@ -439,6 +448,11 @@ def main(argv: list[str] | None = None) -> int:
                         help="read the installation (and .variables) as of the commit that "
                              "last wrote the .script (saved), or as of the pair's commit")
     parser.add_argument("--only", default="", help="only pairs whose .urp path contains this")
+    parser.add_argument("--repo", action="append", default=[],
+                        help="only pairs of this repository (owner/name; repeatable)")
+    parser.add_argument("--not-repo", action="append", default=[],
+                        help="leave out the pairs of this repository (repeatable): the "
+                             "held projects of one round apart from another's")
     args = parser.parse_args(argv)
 
     rows = [line.rstrip("\n").split("\t") for line in args.pairs.read_text().splitlines()
@@ -449,6 +463,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.split != "all" and split != args.split:
             continue
         if args.only and args.only not in urp_path:
+            continue
+        if (args.repo and repo not in args.repo) or repo in args.not_repo:
             continue
         st = stats.setdefault(split, {"n": 0, "exact": 0, "exact_prog": 0, "share": 0.0,
                                       "share_prog": 0.0, "errors": collections.Counter(),

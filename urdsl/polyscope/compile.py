@@ -307,6 +307,11 @@ _GET_FUNCTIONS = {
 _DEFAULT_CASE = "2147483647"
 """The ``caseValue`` of a Switch's Default Case (Java's ``Integer.MAX_VALUE``; seen in files
 of PolyScope 5.8 and 5.15)."""
+_RESERVED = frozenset((
+    "def", "thread", "run", "kill", "join", "if", "elif", "else", "while", "end", "return",
+    "global", "local", "True", "False", "and", "or", "not", "xor", "sec", "halt", "break",
+    "continue", "pass", "enter_critical", "exit_critical"))
+"""URScript's keywords: a program named with one cannot be a function of that name."""
 _BASE_FEATURES = frozenset(("Joint_0_name", "Base", "base"))
 """Names PolyScope gives the base frame in a move's feature reference."""
 _TOOL_FEATURES = frozenset(("Joint_6_name", "Tool", "tool"))
@@ -469,14 +474,16 @@ class _Compiler:
         self.counter = 0
         self.labels: dict[int, str] = {}
         self.pins = dict(getattr(installation, "io_names", ()) or ())
+        self.base_variable = bool(getattr(installation, "base_variable", False))
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
         saved = _version(program.saved_in or program.created_in)
-        # PolyScope before 3.15 (seen: 3.5.0 and 3.8.0; 3.15.3 on write them) writes its
-        # markers without the breakAfter/noBreak flags; 3.8.0 (not 3.5.0, not 3.15) writes
-        # no marker for the Robot Program node [U: between 3.5 and 3.15]
-        self.flags = not (saved[0] == 3 and saved < (3, 15))
-        self.main_marker = not ((3, 6) <= saved < (3, 15))
+        # PolyScope before 3.12 (seen: 3.5.0 and 3.8.0; 3.12.1, 3.14.1, 3.15 on write them)
+        # writes its markers without the breakAfter/noBreak flags; 3.8.0 (not 3.5.0, not
+        # 3.12.1, 3.14.1 or 3.15) writes no marker for the Robot Program node
+        # [U: 3.9 to 3.11]
+        self.flags = not (saved[0] == 3 and saved < (3, 12))
+        self.main_marker = not ((3, 6) <= saved < (3, 12))
         # PolyScope 3.2 (seen: nedlecky/UR KeyenceRobotVisionSample, 3.2.20175) writes no
         # marker for a Script node of a file and titles every Popup "Message" (an Error
         # popup too: ``popup("…", "Message", False, True, blocking=True)``); 3.5 on as now
@@ -543,6 +550,11 @@ class _Compiler:
         name = re.sub(r"[^A-Za-z0-9_]", "", program.name) or "program"
         if name[0].isdigit():
             name = "_" + name
+        if name in _RESERVED:
+            # a program named with a word of the language: PolyScope prefixes a P
+            # (5.13.1: ``run.urp`` is ``def Prun():``, Baxterminator/RoboTech-24)
+            # [U: other words]
+            name = "P" + name
         module = _ascii_names(Module((FunctionDef(name, (), tuple(body)),)))
         return Compiled(module, self.numbers, self.labels)
 
@@ -786,6 +798,9 @@ class _Compiler:
             feature = move.fields.get("feature")
             if feature and feature not in _BASE_FEATURES:
                 target = _call("pose_trans", Name(str(feature)), target)
+            elif self.in_variable_base(move):
+                if move.attrs.get("motionType") != "MoveJ":
+                    target = _call("pose_trans", Name("Base"), target)
             elif self.version < 5:
                 # PolyScope 3 writes a variable waypoint in the base as relative to the
                 # base's pose too (seen once, saved by 3.15)
@@ -805,6 +820,15 @@ class _Compiler:
         if known.get(str(feature), True) is False:
             return None
         return str(feature)
+
+    def in_variable_base(self, move: Node) -> bool:
+        """A PolyScope 3 move in a variable base feature (seen: 3.14.1, ldalepfi/UR-
+        Simulation-Prod): a MoveL goes to ``pose_trans(Base, p[…])`` and to
+        ``pose_trans(Base, var)``, a MoveJ to a variable waypoint as it is [U: a fixed
+        waypoint of a MoveJ, a MoveP]."""
+        feature = move.fields.get("feature")
+        return self.version < 5 and self.base_variable and (
+            not feature or feature in _BASE_FEATURES)
 
     def in_variable_feature(self, node: Node, move: Node, pose: Expr) -> Expr:
         """A fixed waypoint's pose under a move in a variable feature, as PolyScope writes
@@ -1287,7 +1311,10 @@ class _Compiler:
             Assign(Name(flag), Number(1)),
             Declare("local", "towardsPos", _call("calculate_point_to_move_towards",
                                                  feature_pose, vector, _num(distance))),
-            ExprStmt(Call(Name("movel"), (Name("towardsPos"),), tuple(keywords))),
+            # a Direction under a MoveP moves with movep (5.12: Roma4286/UniversalRobots)
+            ExprStmt(Call(Name("movep" if move is not None and move.attrs.get("motionType")
+                               == "MoveP" else "movel"), (Name("towardsPos"),),
+                          tuple(keywords))),
             Assign(Name(flag), Number(2)),
             ExitCritical(),
         )
@@ -1304,13 +1331,17 @@ class _Compiler:
         return items
 
     def until_loop(self, untils: list[Node], flag: str, handle: str,
-                   accel: float | None, move_accel: float | None = None) -> While:
+                   accel: float | None, move_accel: float | None = None,
+                   reaches_end: bool = False) -> While:
         """The loop that waits, while a move thread runs, for the first of its Until
         conditions: tool contact (checked first, whatever the order), a condition (an
         expression: the move stops at the Until's ``deceleration``, m/s², else the move's
         acceleration; seen: PolyScope 5.10), and the end of the move (distance, reached
         waypoint), in the node order. ``accel`` is the motion's own acceleration (m/s²: a
-        Direction's ``toolParams``), ``move_accel`` its Move node's (when it differs)."""
+        Direction's ``toolParams``), ``move_accel`` its Move node's (when it differs).
+        ``reaches_end``: the motion ends by itself (a waypoint's move); when no Until waits
+        for that end, the loop still ends with the move, with no marker (PolyScope 5.17,
+        srs827/Robot-Cello-ResidualRL: a Waypoint with only an expression Until)."""
         loop: list[Item] = []
         ordered = sorted(untils, key=lambda u: u.attrs.get("type") != "TOOL_CONTACT_DETECTION")
         for until in ordered:
@@ -1337,6 +1368,11 @@ class _Compiler:
             done.append(Break())
             loop.append(_stmt("sleep", _num(1e-10)))
             loop.append(If(Paren(BinOp(">", Name(flag), Number(1))), tuple(done)))
+        if reaches_end and all(u.attrs.get("type") in ("EXPRESSION", "TOOL_CONTACT_DETECTION")
+                               for u in untils):
+            loop.append(_stmt("sleep", _num(1e-10)))
+            loop.append(If(Paren(BinOp(">", Name(flag), Number(1))),
+                           (Join(Name(handle)), Break())))
         loop.append(_stmt("sync"))
         return While(Paren(Bool(True)), tuple(loop))
 
@@ -1468,6 +1504,8 @@ class _Compiler:
             label = name
             pose_expr, q_expr = self.fixed_values(node)
             pose_expr = self.in_variable_feature(node, move, pose_expr)
+            if motion != "MoveJ" and self.in_variable_base(move):
+                pose_expr = _call("pose_trans", Name("Base"), pose_expr)
             if motion == "MoveJ" and move.attrs.get("positionType") == "JointAngles":
                 target = q_expr
             elif "positionType" not in move.attrs and motion in ("MoveJ", "MoveL") and \
@@ -1522,7 +1560,8 @@ class _Compiler:
                 Assign(Name(flag), Number(0)),
                 Assign(Name(handle), Run(thread)),
                 self.until_loop(untils, flag, handle,
-                                accel.value if isinstance(accel, Number) else None)]
+                                accel.value if isinstance(accel, Number) else None,
+                                reaches_end=True)]
 
     def move_tcp(self, move: Node, waypoint: Node) -> list[Item]:
         """``set_tcp`` before a waypoint's motion when its move names its own TCP

@@ -259,6 +259,10 @@ class Installation:
     move it; PolyScope writes waypoints taught in it relative to it)."""
     conveyors: tuple[Conveyor, ...] = ()
     """The enabled conveyors of the built-in conveyor tracking, by number."""
+    base_variable: bool = False
+    """The base feature is variable (``<BaseView isVariable="true">``, seen in a 3.14
+    installation): PolyScope 3 then writes ``global Base`` (its pose, ``p[0, 0, 0, 0, 0,
+    0]``) and waypoints in the base relative to it."""
 
     @property
     def tcp(self) -> Tcp | None:
@@ -377,7 +381,8 @@ def _modern(root: ElementTree.Element, path: str) -> Installation:
     return Installation(path, tuple(tcps), active_tcp, tuple(payloads), active_payload,
                         mounting, version, _settings(root), _features(root, path),
                         _io_names(root), _safety(root), _modbus(root, path), _urcaps(root),
-                        _feature_variable(root), _conveyors(root, path))
+                        _feature_variable(root), _conveyors(root, path),
+                        root.find("Features/BaseView/BaseView[@isVariable='true']") is not None)
 
 
 def _feature_variable(root: ElementTree.Element) -> tuple[tuple[str, bool], ...]:

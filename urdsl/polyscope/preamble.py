@@ -186,6 +186,10 @@ def preamble_blocks(program: Program, installation: Installation | None,
     # (``u28857_1``, seen), and sorted as written
     features = [Declare("global", name, Pose(tuple(_num(v) for v in pose)))
                 for name, pose in sorted(installation.features if installation else ())]
+    if installation is not None and installation.base_variable and major < 5:
+        # a variable base (3.14: ldalepfi/UR-Simulation-Prod) is a global at the base's
+        # own pose [U: 5.x not seen]
+        features.insert(0, Declare("global", "Base", Pose(tuple(_num(0.0) for _ in range(6)))))
     if features:
         blocks.append(("features", features))
     conveyor = [item for c in (installation.conveyors if installation else ())
