@@ -255,3 +255,14 @@ def test_old_combined_io_builtins_reach_the_tool_io():
     result = Interpreter(parse("e = get_digital_in(10)\n", "io.script"),
                          environment=Environment()).run()
     assert result.error is not None and "0..9; 8..9 are the tool's" in result.error.message
+
+
+def test_integer_to_binary_list_takes_a_whole_float_and_refuses_a_fraction():
+    from urdsl import parse
+    from urdsl.runtime import Interpreter
+
+    result = Interpreter(parse("bits = integer_to_binary_list(5.0)\n", "b.script")).run()
+    assert result.error is None
+    assert list(result.globals["bits"])[:4] == [True, False, True, False]
+    result = Interpreter(parse("bits = integer_to_binary_list(2.5)\n", "b.script")).run()
+    assert result.error is not None and result.error.kind == "type"

@@ -467,6 +467,10 @@ def _binary_list_to_integer(rt, node, l):  # noqa: E741 - the catalog's paramete
 
 @implements("integer_to_binary_list")
 def _integer_to_binary_list(rt, node, x):
+    if isinstance(x, float) and x.is_integer():
+        x = int(x)  # a whole number read as a float (a register, a list of replies)
+    if isinstance(x, bool) or not isinstance(x, int):
+        raise rt.error("type", f"integer_to_binary_list takes an integer, not {x!r}", node)
     return ListValue([bool((x >> i) & 1) for i in range(32)])
 
 
