@@ -460,6 +460,8 @@ def _transpose(rt, node, m):
 
 @implements("binary_list_to_integer")
 def _binary_list_to_integer(rt, node, l):  # noqa: E741 - the catalog's parameter name
+    if type(l) is not ListValue:
+        raise rt.error("type", f"binary_list_to_integer takes a list of bools, not {l!r}", node)
     if len(l) > 32:
         raise rt.error("index", "binary_list_to_integer takes at most 32 bools", node)
     return sum(1 << i for i, bit in enumerate(l) if bit)
