@@ -77,6 +77,7 @@ from ..script.nodes import (
     UnaryOp,
     While,
 )
+from ..script.parser import keywords
 from ..script.printer import format as print_tree
 from .installation import Installation
 from .preamble import _call, _num, _stmt, _version, payload_statements, preamble
@@ -307,11 +308,6 @@ _GET_FUNCTIONS = {
 _DEFAULT_CASE = "2147483647"
 """The ``caseValue`` of a Switch's Default Case (Java's ``Integer.MAX_VALUE``; seen in files
 of PolyScope 5.8 and 5.15)."""
-_RESERVED = frozenset((
-    "def", "thread", "run", "kill", "join", "if", "elif", "else", "while", "end", "return",
-    "global", "local", "True", "False", "and", "or", "not", "xor", "sec", "halt", "break",
-    "continue", "pass", "enter_critical", "exit_critical"))
-"""URScript's keywords: a program named with one cannot be a function of that name."""
 _BASE_FEATURES = frozenset(("Joint_0_name", "Base", "base"))
 """Names PolyScope gives the base frame in a move's feature reference."""
 _TOOL_FEATURES = frozenset(("Joint_6_name", "Tool", "tool"))
@@ -550,7 +546,7 @@ class _Compiler:
         name = re.sub(r"[^A-Za-z0-9_]", "", program.name) or "program"
         if name[0].isdigit():
             name = "_" + name
-        if name in _RESERVED:
+        if name in keywords():
             # a program named with a word of the language: PolyScope prefixes a P
             # (5.13.1: ``run.urp`` is ``def Prun():``, Baxterminator/RoboTech-24)
             # [U: other words]

@@ -649,6 +649,12 @@ def _default_parser() -> Parser:
     return Parser()
 
 
+def keywords() -> frozenset[str]:
+    """The words of the language (``def``, ``while``, ``True``, ...), as the grammar has them:
+    no name may be one."""
+    return frozenset(_default_parser().lexer.keywords)
+
+
 def parse(text: str, filename: str = "<string>") -> Module:
     """Parse URScript text into a :class:`~urdsl.script.nodes.Module`.
 
