@@ -266,3 +266,15 @@ def test_integer_to_binary_list_takes_a_whole_float_and_refuses_a_fraction():
     assert list(result.globals["bits"])[:4] == [True, False, True, False]
     result = Interpreter(parse("bits = integer_to_binary_list(2.5)\n", "b.script")).run()
     assert result.error is not None and result.error.kind == "type"
+
+
+@pytest.mark.parametrize("call", ["str_sub(1, 2, 3)", "str_find(1, 2)"])
+def test_a_builtin_model_that_fails_on_its_arguments_is_an_error_at_the_call(call):
+    # the string builtins' models were written for strings: a number is a program error
+    # at the call (file:line:col), never a Python traceback
+    from urdsl.verify.run import check_text
+
+    report = check_text(f"textmsg(1)\nx = {call}\n", "s.script")
+    (error,) = [f for f in report.findings if f.severity == "error"]
+    assert error.code == "URS203" and (error.span.line, error.span.column) == (2, 5)
+    assert "cannot take these arguments" in error.message

@@ -69,7 +69,10 @@ class BuiltinTable:
                 bound["__args__"] = args
         if implementation is None:
             return self.unsupported(row, node)
-        return implementation(rt, node, **bound)
+        try:
+            return implementation(rt, node, **bound)
+        except _PYTHON_FAILURES as error:
+            raise _failed(rt, name, node, error) from error
 
     def prepare(self, name: str, positional: int, keywords: tuple[str, ...]):
         """A faster :meth:`call` for one call site — ``call(values, named, node)`` — when
@@ -96,7 +99,10 @@ class BuiltinTable:
             bound = dict(zip(params, values, strict=True))
             if named:
                 bound.update(named)
-            return implementation(rt, node, **bound)
+            try:
+                return implementation(rt, node, **bound)
+            except _PYTHON_FAILURES as error:
+                raise _failed(rt, name, node, error) from error
 
         return call
 
@@ -192,6 +198,23 @@ class _RemoteHandle:
     def member(self, name: str) -> _RemoteHandle:
         """The handle of the server's methods under ``name.``."""
         return _RemoteHandle(self.kind, self.url, f"{self.prefix}{name}.")
+
+
+_PYTHON_FAILURES = (TypeError, ValueError, AttributeError, LookupError, ArithmeticError)
+"""What a builtin's Python model raises on arguments it was not written for."""
+
+
+def _failed(rt: Any, name: str, node: Node, error: Exception) -> Exception:
+    """The program error for a builtin whose model failed on its arguments (never a Python
+    traceback): a URS203 at the call, saying so; an error of urdsl's kinematics passes."""
+    from ..kinematics.errors import KinematicsError
+
+    if isinstance(error, KinematicsError):
+        return error
+    return rt.error("type", f"{name}() cannot take these arguments "
+                    f"({type(error).__name__}: {error})", node,
+                    f"if they are valid URScript, urdsl's model of {name}() lacks this case: "
+                    "please report it")
 
 
 def _builtin_hint(name: str) -> str | None:
