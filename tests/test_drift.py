@@ -175,3 +175,30 @@ def test_law_the_flange_stays_within_the_bound_of_the_shoulder(model, seed):
     shoulder = np.array([0.0, 0.0, spec.d1])
     farthest = max(np.linalg.norm(robot.fk(row)[:3, 3] - shoulder) for row in q)
     assert farthest <= flange_reach(spec) + 1e-9
+
+
+def test_a_direction_node_from_an_unknown_start_is_no_move_to_its_far_target(tmp_path, capsys):
+    # PolyScope's Direction node aims 1000 m away from where the arm is and a condition stops
+    # it: from an unknown start that target is relative to it, and no destination
+    direction = """  thread move_thread_3():
+    enter_critical
+    movel(pose_add(get_target_tcp_pose(), p[0, 0, -1000, 0, 0, 0]), a=1.2, v=0.1)
+    exit_critical
+  end
+  move_thread_han_3 = run move_thread_3()
+  while (True):
+    if (tool_contact(direction=get_target_tcp_speed()) > 0):
+      kill move_thread_han_3
+      stopl(3.0)
+      break
+    end
+    sync()
+  end
+"""
+    text = export("    sleep(1)", direction)
+    report = check(tmp_path, capsys, text, "--robot", "ur5e")
+    assert errors(report) == []
+    # the same move without the condition is out of reach whatever the start
+    plain = "    movel(pose_add(get_target_tcp_pose(), p[0, 0, -1000, 0, 0, 0]), a=1.2, v=0.1)"
+    assert [f["line"] for f in errors(check(tmp_path, capsys, export(plain),
+                                            "--robot", "ur5e"))] == [8]

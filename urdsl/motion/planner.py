@@ -429,13 +429,19 @@ class MotionPlanner:
         """A move (at ``span``, by ``holder``) to a pose relative to an unknown start: why no
         start makes it reachable (:func:`urdsl.motion.drift.drift_error`; the move then
         does not happen), or None, and the arm's position is then unknown (``why``), known
-        relative to that start when the move ends there (``settles``: it does not blend)."""
+        relative to that start when the move ends there (``settles``: it does not blend, and
+        no condition stops it: :attr:`stoppable`)."""
         tcp = _tcp_position(self._tcp)
+        self.unknown_at = (why, span)
+        if span in self.stoppable:
+            # a condition may stop it on the way (a Direction node aims far away on purpose):
+            # the target is no destination, and where the arm stops is unknown
+            self.drift = None
+            return None
         spec = getattr(self.kinematics, "spec", None)
         problem = drift_error(relative, tcp, span, spec, self.model_assumed)
         if problem is not None:
             return problem
-        self.unknown_at = (why, span)
         self.drift = Drift.after(relative, tcp, span, holder) if settles else None
         return None
 
