@@ -898,7 +898,7 @@ class _Compiler:
                 except TypeError as error:
                     found = _first_unknown_key(keys)
                     if found is not None:  # which element changed is unknown
-                        store_container(frame, found)
+                        store_container(frame, found.plain())
                         return
                     raise rt.error("type", f"an index must be an int, not a {error}", node) \
                         from None
@@ -912,7 +912,7 @@ class _Compiler:
                     elif kind is PoseValue:
                         _check_bounds(positions[0], 6, rt, node)
                         if type(value) is Unknown:
-                            store_container(frame, value)
+                            store_container(frame, value.plain())
                             return
                         if not is_number(value):
                             raise rt.error("type", f"a pose holds numbers, not a "
@@ -1032,7 +1032,7 @@ class _Compiler:
             for value, item in zip(values, node.items, strict=True):
                 if not is_number(value):
                     if type(value) is Unknown:  # a pose with an unknown part is unknown
-                        return value
+                        return value.plain()
                     raise rt.error("type", f"a pose holds numbers, not a {type_name(value)}",
                                    item)
             return PoseValue(values)
@@ -1087,11 +1087,11 @@ class _Compiler:
                     else:
                         return a.leaning(False if False in (a.lean, b.lean) else
                                          a.lean and b.lean)
-                    return a
+                    return a.plain()
                 if not _bool_operand(a, rt, node):
                     return False
                 b = right(frame)
-                return b if type(b) is Unknown else _bool_operand(b, rt, node)
+                return b.plain() if type(b) is Unknown else _bool_operand(b, rt, node)
             return conj
         if op == "or":
             def disj(frame):
@@ -1105,11 +1105,11 @@ class _Compiler:
                     else:
                         return a.leaning(True if True in (a.lean, b.lean) else
                                          None if None in (a.lean, b.lean) else False)
-                    return a
+                    return a.plain()
                 if _bool_operand(a, rt, node):
                     return True
                 b = right(frame)
-                return b if type(b) is Unknown else _bool_operand(b, rt, node)
+                return b.plain() if type(b) is Unknown else _bool_operand(b, rt, node)
             return disj
         operation = binary(op)
         if op in ("==", "!="):
@@ -1164,12 +1164,12 @@ class _Compiler:
             except TypeError as error:
                 found = has_unknown(target) or _first_unknown_key(keys)
                 if found is not None:
-                    return found
+                    return found.plain()
                 raise rt.error("type", f"an index must be an int, not a {error}", node) \
                     from None
             kind = type(target)
             if kind is Unknown:
-                return target
+                return target.plain()
             if kind is ListValue or kind is PoseValue:
                 size = len(target)
                 first = positions[0]
@@ -1205,7 +1205,7 @@ class _Compiler:
                     raise rt.error("undefined", f"the struct has no member '{attr}'",
                                    node) from None
             if type(target) is Unknown:
-                return target
+                return target.plain()
             if type(target) is remote:  # an XML-RPC server's dotted method names
                 return target.member(attr)
             raise rt.error("type", f"a {type_name(target)} has no field '{attr}'", node)
