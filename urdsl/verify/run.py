@@ -35,7 +35,7 @@ from ..script.nodes import NO_SPAN
 from ..script.parser import parse
 from . import checks
 from .findings import Finding, nothing_runs
-from .report import Move, Report
+from .report import Loop, Move, Report
 
 __all__ = ["CheckOptions", "Progress", "check_text", "check_tree", "check_file", "DEFAULT_START",
            "DEFAULT_TIMEOUT"]
@@ -269,6 +269,9 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
                    deadline=final, reserve=CHECK_RESERVE)
     report.trace = trace
     report.cycle_time = float(min(max(result.time, trace.duration), options.max_time))
+    report.loop = _forever(result)
+    if report.loop is not None:
+        report.cycle_time = report.loop.pass_time
     report.moves = [Move(s.kind, s.span, s.start, s.duration, s.params.get("lead"))
                     for s in planner.segments]
     _phase(options, "checking the motion")
@@ -276,6 +279,22 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
                                            module.span))
     report.sort()
     return report
+
+
+def _forever(result) -> Loop | None:
+    """The loop the program runs forever (:class:`~urdsl.verify.report.Loop`), when the run
+    stopped inside it only because the check stopped (``--max-time``, the wall-clock bound)
+    after at least one complete pass; otherwise None."""
+    passes = result.forever
+    stopped = result.stopped_at_max_time or result.stopped or (
+        result.stopped_early is not None and result.stopped_early.kind == "deadline")
+    if passes is None or not stopped or passes.pass_time is None:
+        return None
+    later = passes.count - 2  # complete passes after the first
+    shortest = passes.shortest if later > 0 else passes.first_pass
+    longest = passes.longest if later > 0 else passes.first_pass
+    return Loop(passes.span, passes.count - 1, passes.first_pass, passes.pass_time,
+                shortest, longest)
 
 
 def _stopped_finding(event, options: CheckOptions) -> Finding:
