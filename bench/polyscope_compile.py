@@ -51,7 +51,9 @@ Prints, per split (``tune``: used while writing the compiler; ``held``: projects
 projects found after those, two of every three in the order they were added, the third
 ``held``; ``tune3``: the same for the projects found after the ``tune2`` ones; ``tune4``: the
 same for the projects of the repositories fetched for the real-world benchmark, listed by
-``bench/polyscope_pairs.py``),
+``bench/polyscope_pairs.py``; ``tune5``: the same for the projects found by their
+repositories' file lists (a folder holding ``default.installation``, a program's name),
+listed the same way),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most; then each project's share of programs exact (program part, whole, whole among
 the programs with their installation) and the mean of these over the projects, each project
@@ -437,7 +439,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="folder of owner+name git dirs")
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
     parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "tune3", "tune4",
-                                                   "all"),
+                                                   "tune5", "all"),
                         default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
     parser.add_argument("--script-files", choices=("file", "cache"), default="file",
