@@ -937,6 +937,12 @@ class _Compiler:
         """A Set node: its action (an output), then the TCP it selects (``set_tcp``), as
         PolyScope writes them."""
         items = self.set_action(node)
+        payload = _floats_or_none(node.attrs.get("payload"))
+        if payload:
+            # the payload the Set selects (kg): ``set_payload(m)`` after the action (seen:
+            # PolyScope 3.12 and 3.15, ``tcpAsCog="true"``; with the centre of gravity given
+            # otherwise, and in 5.x, not seen [U])
+            items.append(_stmt("set_payload", _num(payload[0])))
         if node.fields.get("tcp"):
             items.extend(self.set_tcp(str(node.fields["tcp"])))
         return items
