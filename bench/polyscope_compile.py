@@ -28,7 +28,10 @@ is not there, the one named like the ``.urp`` beside it (renamed with the progra
 node's file is read from the repository as it was in the last commit that changed the
 .script (PolyScope compiles the file's contents when it saves, not the copy the .urp keeps;
 ``--script-files cache`` takes that copy instead). A script file edited after the save but
-committed with it makes a pair differ: that is stale data, not a compiler error.
+committed with it makes a pair differ: that is stale data, not a compiler error. A Script
+node whose file is the program's own ``.script`` (abutreca/imh-robotica ``prueba.urp`` runs
+``prueba.script``) read the user's file and overwrote it with its output in one save: the
+copy the ``.urp`` keeps is then what it read.
 
 The preamble (what the installation generates before the program tree) is compared block
 by block in any order, each block's statements in order (blocks: the step-counter thread,
@@ -538,8 +541,15 @@ def main(argv: list[str] | None = None) -> int:
         try:
             folder = PurePosixPath(urp_path).parent
 
-            def files(relative: str, folder=folder, gitdir=gitdir, saved=saved):
-                return git_show(gitdir, saved, _join(folder, relative))
+            def files(relative: str, folder=folder, gitdir=gitdir, saved=saved,
+                      script_path=script_path):
+                path = _join(folder, relative)
+                if path == script_path:
+                    # the Script node's file is where PolyScope writes this program's
+                    # .script: the save read the user's file and then overwrote it with its
+                    # output, so what it read is only in the copy the .urp keeps
+                    return None
+                return git_show(gitdir, saved, path)
 
             compiled = compile_program(program, installation, variables,
                                        files if args.script_files == "file" else None)
