@@ -166,7 +166,9 @@ def select_files(project: Project, names: list[str]) -> list[str]:
 
 
 def extract(projects: list[Project], repos: Path, out: Path) -> int:
-    """Write every project's files to ``out/<id>/``; return the number of failures."""
+    """Write every project's files to ``out/<id>/``, each marked as a checkout's top (an
+    empty ``.git`` folder: urdsl's project search stops there and takes a fragment's
+    repository from there, as in a clone); return the number of failures."""
     failures = 0
     for project in projects:
         git_dir = find_git_dir(repos / project.mirror_name)
@@ -195,6 +197,8 @@ def extract(projects: list[Project], repos: Path, out: Path) -> int:
             path = target / name
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_bytes(data)
+        # the top of a checkout: urdsl's project search stops there, as in the repository
+        (target / ".git").mkdir(exist_ok=True)
         print(f"{project.id}: {project.repo} {project.folder} -> {target} ({len(chosen)} files)")
     return failures
 

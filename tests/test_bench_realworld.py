@@ -71,6 +71,7 @@ def test_extract_reads_the_pinned_commit_from_a_nested_git_dir(tmp_path):
     assert (out / "7" / "main.script").read_text() == "def main():\n  helper()\nend\n"
     assert (out / "7" / "lib" / "helper.script").exists()
     assert not (out / "7" / "notes.md").exists()
+    assert (out / "7" / ".git").is_dir()  # a checkout's top: urdsl's project search stops there
 
     missing = rw.Project("8", "someone/absent", commit, ".", ("*",), "none", "cb3", "none",
                          "tune", "")

@@ -292,3 +292,59 @@ def test_a_program_def_sent_with_its_call_is_the_program(tmp_path, capsys):
     status, report = check(capsys, str(tmp_path / "GripperClose.script"))
     assert status == 1
     assert [f["line"] for f in report["findings"] if f["code"] == "URS201"] == [4]
+
+
+# ---- a fragment whose definitions are in another folder of its repository --------------------
+
+GRIPPER = """def gripper_prog():
+  global opened = False
+  def open_gripper(width):
+    opened = True
+    textmsg(width)
+  end
+  open_gripper(0.08)
+end
+"""
+PIECE = "open_gripper(0.05)\nmovej([0.0, -1.57, 1.57, -1.57, -1.57, 0.0], a=1.0, v=0.5)\n"
+
+
+def _repository(root: Path, depth: int = 1) -> Path:
+    """A repository (tmp_path is one, see conftest.py) with a program in ``objects/`` and a
+    generated piece ``depth`` folders down from its top that calls the program's function."""
+    (root / "objects").mkdir()
+    (root / "objects" / "gripper.script").write_text(GRIPPER)
+    folder = root.joinpath(*[f"gen{i}" for i in range(depth)])
+    folder.mkdir(parents=True)
+    (folder / "piece.script").write_text(PIECE)
+    return folder / "piece.script"
+
+
+def test_a_fragment_sees_the_definitions_of_its_repository(tmp_path, capsys):
+    piece = _repository(tmp_path)
+    status, report = check(capsys, str(piece))
+    assert status == 0 and not [f for f in report["findings"] if f["severity"] == "error"]
+    assert "gripper.script" in report["context"]
+    status = main(["lint", "--format", "json", str(piece)])
+    found = json.loads(capsys.readouterr()[0])
+    assert status == 0
+    assert [(f["code"], f["severity"]) for f in found] == [("URS102", "warning")]
+    assert "objects/gripper.script:3" in found[0]["message"]
+
+
+def test_a_name_the_repository_does_not_define_stays_an_error(tmp_path, capsys):
+    piece = _repository(tmp_path)
+    piece.write_text("close_gripper()\n")
+    assert check(capsys, str(piece))[0] == 1
+    assert main(["lint", str(piece)]) == 1
+
+
+def test_a_program_does_not_take_names_from_its_repository(tmp_path, capsys):
+    piece = _repository(tmp_path)
+    piece.write_text("def job():\n  open_gripper(0.05)\nend\njob()\n")
+    status, report = check(capsys, str(piece))
+    assert status == 1 and report["findings"][0]["code"] == "URS201"
+
+
+def test_a_repository_top_far_above_is_not_searched(tmp_path, capsys):
+    piece = _repository(tmp_path, depth=4)  # four folders down: more than HOST_LEVELS
+    assert check(capsys, str(piece))[0] == 1

@@ -1,7 +1,9 @@
 """The files of one PolyScope project and the names each file can see.
 
 A project is a folder tree (for one file, the file's folder, or the folder up to three
-levels above whose program includes the file) holding:
+levels above whose program includes the file; for a fragment that no program includes, also
+the script files of its repository when the repository's top, a folder holding ``.git``, is
+at most three levels above) holding:
 
 * script files (``*.script``, ``*.urscript``, ``*.urs``). A **host** is a complete program as
   PolyScope exports it: one top-level ``def`` without parameters wrapping the program,
@@ -269,6 +271,8 @@ class Project:
                 if beside is not None:
                     keys = {_key(p) for p in found}
                     found += [p for p in _listing(beside) if _key(p) not in keys]
+                else:
+                    found += _neighbours(path, root, {_key(p) for p in found})
             if above is not None:  # the program that includes the file is further up
                 root = above
                 tree = _bounded_tree(above, MAX_TREE_FILES)
@@ -394,6 +398,33 @@ def _bounded_tree(folder: Path, limit: int | None) -> list[Path] | None:
                 if limit is not None and len(found) > limit:
                     return None
     return sorted(found)
+
+
+def _neighbours(path: Path, root: Path, known: set[str]) -> list[Path]:
+    """For a fragment (a script file without a program of its own) that no program
+    includes, inside a repository whose top (a folder holding ``.git``) is at most
+    :data:`HOST_LEVELS` folders above its own: the project files of that repository, as
+    ``urdsl lint`` of it sees them (a generator's pieces kept in one folder, the programs
+    whose definitions they use in another: names found there are not "defined nowhere"):
+    its script files only (another folder's installation is not this file's). Nothing for
+    a program, outside a repository (a download or temporary folder holds
+    unrelated files), or when the repository is too large for a project."""
+    script = load_script(path)
+    if script is None or script.module is None or script.is_host:
+        return []
+    try:
+        folder = root.resolve()
+    except OSError:
+        return []
+    for _level in range(HOST_LEVELS):
+        if (folder / ".git").exists() or folder.parent == folder:
+            return []  # the file's folder is the repository's top, or there is none
+        folder = folder.parent
+        if (folder / ".git").exists():
+            tree = _bounded_tree(folder, MAX_TREE_FILES)
+            return [p for p in tree or () if p.suffix in SCRIPT_SUFFIXES
+                    and _key(p) not in known]
+    return []
 
 
 def _listing(folder: Path) -> list[Path]:
