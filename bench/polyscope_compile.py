@@ -28,7 +28,10 @@ is not there, the one named like the ``.urp`` beside it (renamed with the progra
 node's file is read from the repository as it was in the last commit that changed the
 .script (PolyScope compiles the file's contents when it saves, not the copy the .urp keeps;
 ``--script-files cache`` takes that copy instead). A script file edited after the save but
-committed with it makes a pair differ: that is stale data, not a compiler error.
+committed with it makes a pair differ: that is stale data, not a compiler error. A Script
+node whose file is the program's own ``.script`` (abutreca/imh-robotica ``prueba.urp`` runs
+``prueba.script``) read the user's file and overwrote it with its output in one save: the
+copy the ``.urp`` keeps is then what it read.
 
 The preamble (what the installation generates before the program tree) is compared block
 by block in any order, each block's statements in order (blocks: the step-counter thread,
@@ -51,7 +54,9 @@ Prints, per split (``tune``: used while writing the compiler; ``held``: projects
 projects found after those, two of every three in the order they were added, the third
 ``held``; ``tune3``: the same for the projects found after the ``tune2`` ones; ``tune4``: the
 same for the projects of the repositories fetched for the real-world benchmark, listed by
-``bench/polyscope_pairs.py``),
+``bench/polyscope_pairs.py``; ``tune5``: the same for the projects found by their
+repositories' file lists (a folder holding ``default.installation``, a program's name),
+listed the same way),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most; then each project's share of programs exact (program part, whole, whole among
 the programs with their installation) and the mean of these over the projects, each project
@@ -437,7 +442,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="folder of owner+name git dirs")
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
     parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "tune3", "tune4",
-                                                   "all"),
+                                                   "tune5", "all"),
                         default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
     parser.add_argument("--script-files", choices=("file", "cache"), default="file",
@@ -536,8 +541,15 @@ def main(argv: list[str] | None = None) -> int:
         try:
             folder = PurePosixPath(urp_path).parent
 
-            def files(relative: str, folder=folder, gitdir=gitdir, saved=saved):
-                return git_show(gitdir, saved, _join(folder, relative))
+            def files(relative: str, folder=folder, gitdir=gitdir, saved=saved,
+                      script_path=script_path):
+                path = _join(folder, relative)
+                if path == script_path:
+                    # the Script node's file is where PolyScope writes this program's
+                    # .script: the save read the user's file and then overwrote it with its
+                    # output, so what it read is only in the copy the .urp keeps
+                    return None
+                return git_show(gitdir, saved, path)
 
             compiled = compile_program(program, installation, variables,
                                        files if args.script_files == "file" else None)

@@ -11,7 +11,7 @@ from ..script import nodes as n
 from ..script.builtins import lookup
 from ..script.diagnostics import Diagnostic
 from .context import BLOCKING_CALLS, MOTION_CALLS, LintContext
-from .names import KEYWORDS, PYTHON_HABITS
+from .names import PYTHON_HABITS, keywords
 from .registry import rule
 from .scope import Scope, statements
 
@@ -47,7 +47,7 @@ def no_effect(ctx: LintContext) -> Iterator[Diagnostic]:
         elif isinstance(expr, n.Name):
             if expr.id in PYTHON_HABITS and not ctx.analysis.defined(expr.id, scope):
                 continue  # URS119 explains it
-            close = difflib.get_close_matches(expr.id, KEYWORDS, n=1, cutoff=0.7)
+            close = difflib.get_close_matches(expr.id, keywords(), n=1, cutoff=0.7)
             if close:
                 hint = f"did you mean `{close[0]}`?"
             elif lookup(expr.id) is not None or expr.id in ctx.analysis.functions:

@@ -14,13 +14,15 @@ from .context import LintContext
 from .registry import rule
 from .scope import BUILTIN_VARIABLES, Scope
 
-__all__ = ["PYTHON_HABITS", "KEYWORDS"]
+__all__ = ["PYTHON_HABITS", "keywords"]
 
-KEYWORDS = (
-    "def", "sec", "thread", "end", "if", "elif", "else", "while", "return", "halt", "break",
-    "continue", "run", "join", "kill", "enter_critical", "exit_critical", "global", "local",
-    "and", "or", "xor", "not", "True", "False", "None",
-)
+def keywords() -> tuple[str, ...]:
+    """The language's words as the grammar has them (sorted), for "did you mean" hints; built
+    when a rule first asks, so importing the linter does not build the parser."""
+    from ..script.parser import keywords as grammar_keywords
+
+    return tuple(sorted(grammar_keywords()))
+
 
 PYTHON_HABITS: dict[str, str] = {
     "print": "write textmsg(value) (it shows in the log; popup(text) shows a dialog)",
@@ -167,7 +169,7 @@ def undefined_name(ctx: LintContext) -> Iterator[Diagnostic]:
             elif lookup(name.id) is not None:
                 hint = f"{name.id} is a builtin function: call it, {name.id}(...)"
             else:
-                hint = _suggest(name.id, _visible(ctx, scope) | set(KEYWORDS))
+                hint = _suggest(name.id, _visible(ctx, scope) | set(keywords()))
             yield ctx.diagnostic("URS101", name, f"name '{name.id}' is not defined", hint)
         for run in scope.runs:
             if run.thread not in analysis.threads:

@@ -37,7 +37,9 @@ from typing import Protocol
 import numpy as np
 
 from ..kinematics.errors import KinematicsError
+from ..runtime.values import Relative
 from ..script.nodes import Span
+from .drift import Drift, drift_error
 from .profiles import Trapezoid
 
 __all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel", "JOINT_SPACE",
@@ -189,6 +191,12 @@ class MotionPlanner:
         # where the arm is, when something outside the program decided it (see
         # :meth:`unknown_position`): what left it there, and that statement's span
         self.unknown_at: tuple[str, Span] | None = None
+        # while unknown_at is set: what is known of the TCP's position (moves relative to an
+        # unknown start, :mod:`urdsl.motion.drift`), or None
+        self.drift: Drift | None = None
+        # whether the model is only assumed (not given nor inferred): a bound that must hold
+        # for the real arm then takes the widest UR model's
+        self.model_assumed = False
         self._tcp: np.ndarray | None = None
         self._pending: Segment | None = None  # the last move, if it may still blend
         self._q_end = self.q_start.copy()  # joints at the end of the last resolved move
@@ -391,13 +399,51 @@ class MotionPlanner:
         if params.get("until"):
             # where the arm ends depends on the condition
             self.unknown_at = (f"the move at line {span.line}, which a condition stops", span)
+            self.drift = None
         return end
 
-    def unknown_position(self, why: str, span: Span) -> None:
+    def unknown_position(self, why: str, span: Span, still: str | None = None,
+                         holder=None) -> None:
         """From now on the arm stands where something outside the program put it, unknown
         offline, until a move to a known target: ``why`` says what (``"freedrive at line
-        12, where the operator moves the arm by hand"``), ``span`` is that statement."""
+        12, where the operator moves the arm by hand"``), ``span`` is that statement.
+
+        ``still``: when the arm stands still there (the program's start; the end of a move
+        that does not blend), that place for messages ("where the arm stood when the program
+        started"): reads of the TCP pose are then followed relative to it
+        (:meth:`relative_pose`); ``holder`` is the only thread that may read it (None: any).
+        None: the arm may be moving (by hand, a speed command), nothing is followed."""
         self.unknown_at = (why, span)
+        self.drift = None if still is None else Drift(still, holder=holder)
+
+    def relative_pose(self, tcp, holder) -> Relative | None:
+        """What a read by ``holder`` of the pose of the TCP ``tcp`` (a pose in the flange
+        frame, or None for the flange) knows while the arm's position is unknown: the
+        unknown start plus a known displacement (:class:`Relative`), or None."""
+        if self.unknown_at is None or self.drift is None:
+            return None
+        return self.drift.read(_tcp_position(tcp), holder)
+
+    def relative_move(self, relative: Relative, why: str, span: Span, settles: bool,
+                      holder) -> str | None:
+        """A move (at ``span``, by ``holder``) to a pose relative to an unknown start: why no
+        start makes it reachable (:func:`urdsl.motion.drift.drift_error`; the move then
+        does not happen), or None, and the arm's position is then unknown (``why``), known
+        relative to that start when the move ends there (``settles``: it does not blend, and
+        no condition stops it: :attr:`stoppable`)."""
+        tcp = _tcp_position(self._tcp)
+        self.unknown_at = (why, span)
+        if span in self.stoppable:
+            # a condition may stop it on the way (a Direction node aims far away on purpose):
+            # the target is no destination, and where the arm stops is unknown
+            self.drift = None
+            return None
+        spec = getattr(self.kinematics, "spec", None)
+        problem = drift_error(relative, tcp, span, spec, self.model_assumed)
+        if problem is not None:
+            return problem
+        self.drift = Drift.after(relative, tcp, span, holder) if settles else None
+        return None
 
     def _far(self, pose: np.ndarray) -> bool:
         """Whether a target (4x4) lies further from the base than :data:`FAR_TARGET` times
@@ -602,6 +648,7 @@ class MotionPlanner:
         if self.unknown_at is not None:  # its path from there is not known; its target is
             segment.params["from_unknown"] = self.unknown_at[0]
         self.unknown_at = None  # a move to a known target: the arm's position is known again
+        self.drift = None
         previous = self._pending
         radius = segment.radius
         previous_radius = previous.radius if previous is not None else 0.0
@@ -808,6 +855,11 @@ def _distance(pose: np.ndarray, other: np.ndarray) -> float:
     """Distance (m) between the positions of two 4x4 poses (scalar maths: one move at a time
     is the planner's hot path)."""
     return math.dist(pose[:3, 3].tolist(), other[:3, 3].tolist())
+
+
+def _tcp_position(tcp) -> np.ndarray:
+    """The position (m) of a TCP (a pose in the flange frame, or None: the flange)."""
+    return np.zeros(3) if tcp is None else np.asarray(tcp, dtype=float)[:3]
 
 
 def _tcp_length(segment: Segment) -> float:

@@ -371,6 +371,26 @@ def _no_break(item: Item) -> Item:
     return replace(item, **changes) if changes else item  # type: ignore[type-var]
 
 
+def _no_markers(item: Item) -> Item | None:
+    """``item`` without the ``$`` markers in it (nested blocks too); None for a marker."""
+    from dataclasses import fields, replace
+
+    if isinstance(item, Marker):
+        return None
+
+    def kept(block: tuple[Item, ...]) -> tuple[Item, ...]:
+        return tuple(inner for i in block if (inner := _no_markers(i)) is not None)
+
+    changes: dict[str, object] = {}
+    for f in fields(item):  # type: ignore[arg-type]
+        value = getattr(item, f.name)
+        if f.name in ("body", "orelse") and isinstance(value, tuple):
+            changes[f.name] = kept(value)
+        elif f.name == "elifs" and isinstance(value, tuple):
+            changes[f.name] = tuple(replace(e, body=kept(e.body)) for e in value)
+    return replace(item, **changes) if changes else item  # type: ignore[type-var]
+
+
 def _direction_helper() -> list[Item]:
     """The function PolyScope defines for Direction nodes: the waypoint ``position_distance``
     (m) from the target along ``direction`` given in ``feature``."""
@@ -474,12 +494,15 @@ class _Compiler:
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
         saved = _version(program.saved_in or program.created_in)
-        # PolyScope before 3.12 (seen: 3.5.0 and 3.8.0; 3.12.1, 3.14.1, 3.15 on write them)
-        # writes its markers without the breakAfter/noBreak flags; 3.8.0 (not 3.5.0, not
-        # 3.12.1, 3.14.1 or 3.15) writes no marker for the Robot Program node
-        # [U: 3.9 to 3.11]
+        # PolyScope before 3.12 (seen: 3.5.0, 3.8.0 and 3.10.1; 3.12.1, 3.14.1, 3.15 on
+        # write them) writes its markers without the breakAfter/noBreak flags, and (seen:
+        # 3.10.1, alan1982br/gs1_carnaval_Photobooth_robot_arm_UR) none for a Case node nor
+        # for the nodes in a Thread node, which it numbers all the same; 3.8.0 (not 3.5.0,
+        # 3.10.1, 3.12.1, 3.14.1 or 3.15) writes no marker for the Robot Program node
+        # [U: 3.9 and 3.11; Case and Thread markers before 3.10]
         self.flags = not (saved[0] == 3 and saved < (3, 12))
-        self.main_marker = not ((3, 6) <= saved < (3, 12))
+        self.inner_markers = self.flags
+        self.main_marker = not ((3, 6) <= saved < (3, 10))
         # PolyScope 3.2 (seen: nedlecky/UR KeyenceRobotVisionSample, 3.2.20175) writes no
         # marker for a Script node of a file and titles every Popup "Message" (an Error
         # popup too: ``popup("…", "Message", False, True, blocking=True)``); 3.5 on as now
@@ -752,7 +775,8 @@ class _Compiler:
             if value == _DEFAULT_CASE:
                 value = None  # the Default Case
             label = f"Case {value}" if value is not None else "Default Case"
-            body = (self.marker(case, label), *self.block(case.children))
+            marker = self.marker(case, label)
+            body = ((marker,) if self.inner_markers else ()) + tuple(self.block(case.children))
             if case.kind == "Case" and value is not None:
                 tests.append((Paren(BinOp("==", self.expr(value, case), Name(variable))),
                               body))
@@ -762,8 +786,10 @@ class _Compiler:
             return items + list(default or ())
         first, *rest = tests
         # the first case's marker stands before the `if`, the others inside their branch
-        items.append(first[1][0])
-        items.append(If(first[0], first[1][1:], tuple(Elif(test, body) for test, body in rest),
+        if self.inner_markers:
+            items.append(first[1][0])
+            first = (first[0], first[1][1:])
+        items.append(If(first[0], first[1], tuple(Elif(test, body) for test, body in rest),
                         default))
         return items
 
@@ -937,6 +963,12 @@ class _Compiler:
         """A Set node: its action (an output), then the TCP it selects (``set_tcp``), as
         PolyScope writes them."""
         items = self.set_action(node)
+        payload = _floats_or_none(node.attrs.get("payload"))
+        if payload:
+            # the payload the Set selects (kg): ``set_payload(m)`` after the action (seen:
+            # PolyScope 3.12 and 3.15, ``tcpAsCog="true"``; with the centre of gravity given
+            # otherwise, and in 5.x, not seen [U])
+            items.append(_stmt("set_payload", _num(payload[0])))
         if node.fields.get("tcp"):
             items.extend(self.set_tcp(str(node.fields["tcp"])))
         return items
@@ -946,11 +978,16 @@ class _Compiler:
         if kind == "DigitalOutput":
             pin = str(node.fields.get("pin"))
             value = node.fields.get("digitalValue") in ("1", "true", "True")
+            label = f"Set {self.pin_label(pin)}={'On' if value else 'Off'}"
+            if pin not in self.pins and self.modbus_signal(pin) is not None:
+                # a Modbus output signal of the installation (seen: 3.10.1,
+                # alan1982br/gs1_carnaval_Photobooth_robot_arm_UR venosa draft3)
+                return [self.marker(node, label),
+                        _stmt("modbus_set_output_signal", String(pin), Bool(value))]
             bank, index = self.resolve_pin(pin, node)
             function = _SET_FUNCTIONS.get(bank)
             if function is None:
                 raise self.error(node, f"cannot set the I/O {pin!r}")
-            label = f"Set {self.pin_label(pin)}={'On' if value else 'Off'}"
             return [self.marker(node, label), _stmt(function, Number(index), Bool(value))]
         if kind == "AnalogOutput":
             pin = str(node.fields.get("pin"))
@@ -1129,6 +1166,8 @@ class _Compiler:
     def thread(self, node: Node) -> list[Item]:
         name = node.name or "Thread"
         body = self.block(node.children)
+        if not self.inner_markers:
+            body = [inner for item in body if (inner := _no_markers(item)) is not None]
         if node.attrs.get("runOnlyOnce") != "true":
             body = [While(Paren(Bool(True)), tuple(body))]
         return [self.marker(node, name), ThreadDef(name, tuple(body)),

@@ -170,7 +170,7 @@ class BuiltinTable:
                      "nothing here", node.span)
             return None
         if type(receiver) is Unknown:
-            return receiver
+            return receiver.plain()
         raise rt.error("type", f"a {type_name(receiver)} has no method '{method}'", node)
 
 

@@ -131,10 +131,55 @@ class RunResult:
     undefined: list[ScriptRuntimeError] = field(default_factory=list)
     """Names and functions found not defined, the first use of each, when the run went on
     past them (``RuntimeConfig.go_on_after_undefined``)."""
+    forever: LoopPasses | None = None
+    """The innermost ``while True`` loop of the main thread that was still running when the
+    run stopped (at ``max_time``, the wall-clock bound or a stop), with its pass times."""
     stopped_early: Event | None = None
     """Why the run stopped before the program's end without an error: ``"blocked"`` (the
     program waits forever, e.g. a read with timeout 0 that nothing answers) or
     ``"deadline"`` (the wall-clock bound); its time and span say how far it got."""
+
+
+class LoopPasses:
+    """The passes of a ``while True`` loop of the main thread: how many began, and when (robot
+    time, s). A pass runs from one start of the loop's body to the next."""
+
+    __slots__ = ("span", "count", "first", "second", "last", "shortest", "longest")
+
+    def __init__(self, span: Span) -> None:
+        self.span = span
+        self.count = 0
+        self.first = self.second = self.last = 0.0
+        self.shortest = math.inf
+        self.longest = 0.0
+
+    def begin(self, time: float) -> None:
+        """A pass begins at robot time ``time`` (s)."""
+        self.count += 1
+        if self.count == 1:
+            self.first = time
+        else:
+            if self.count == 2:
+                self.second = time
+            else:
+                took = time - self.last
+                self.shortest = min(self.shortest, took)
+                self.longest = max(self.longest, took)
+        self.last = time
+
+    @property
+    def first_pass(self) -> float | None:
+        """How long the first pass took (s; it includes the way from where the arm stood),
+        or None before a second pass began."""
+        return self.second - self.first if self.count >= 2 else None
+
+    @property
+    def pass_time(self) -> float | None:
+        """The mean time (s) of the complete passes after the first (the first when it is the
+        only complete one); None before a second pass began."""
+        if self.count >= 3:
+            return (self.last - self.second) / (self.count - 2)
+        return self.first_pass
 
 
 class _StopRun(Exception):
@@ -217,6 +262,8 @@ class Interpreter:
         self._waits = 0
         self.calls = 0  # user function calls so far
         self.loop_node: n.Node | None = None  # the loop last entered (for "how far")
+        # the main thread's ``while True`` loops that are running, outermost first
+        self.forever: list[LoopPasses] = []
         self.unknown = getattr(self.env, "devices", "quiet") == "unknown"
         # replies taken for device reads compared with constants (see _device_reply)
         self.device_replies: dict[str, object] = {}
@@ -257,6 +304,8 @@ class Interpreter:
             for thread in self._threads:
                 if thread.glet is not None and not thread.glet.dead:
                     thread.glet.throw(greenlet.GreenletExit)
+        if result.error is None and self.forever:
+            result.forever = self.forever[-1]
         if self.robot is not None:
             self.robot.finish(self.time)
             self.time = max(self.time, getattr(self.robot, "end_time", self.time))
@@ -818,13 +867,29 @@ class _Compiler:
         finally:
             self._polling = outer
         test_node = node.test
+        literal = test_node
+        while type(literal) is n.Paren:
+            literal = literal.expr
+        forever = type(literal) is n.Bool and literal.value  # PolyScope's ``while (True):``
 
         def run(frame):
             rt.loop_node = node
-            unknown_passes = 0
             if polling is not None:
                 polling[0] = 0
+            passes = None
+            if forever and rt.current is not None and rt.current.parent is None:
+                passes = LoopPasses(node.span)  # the main thread's: its passes are timed
+                rt.forever.append(passes)
+            signal = _loop(frame, passes)
+            if passes is not None:  # left (an error, or the run's end, leaves it on the list)
+                rt.forever.remove(passes)
+            return signal
+
+        def _loop(frame, passes):
+            unknown_passes = 0
             while True:
+                if passes is not None:
+                    passes.begin(rt.time)
                 if polling is not None:
                     polling[0] += 1
                 value = test(frame)
@@ -898,7 +963,7 @@ class _Compiler:
                 except TypeError as error:
                     found = _first_unknown_key(keys)
                     if found is not None:  # which element changed is unknown
-                        store_container(frame, found)
+                        store_container(frame, found.plain())
                         return
                     raise rt.error("type", f"an index must be an int, not a {error}", node) \
                         from None
@@ -912,7 +977,7 @@ class _Compiler:
                     elif kind is PoseValue:
                         _check_bounds(positions[0], 6, rt, node)
                         if type(value) is Unknown:
-                            store_container(frame, value)
+                            store_container(frame, value.plain())
                             return
                         if not is_number(value):
                             raise rt.error("type", f"a pose holds numbers, not a "
@@ -1032,7 +1097,7 @@ class _Compiler:
             for value, item in zip(values, node.items, strict=True):
                 if not is_number(value):
                     if type(value) is Unknown:  # a pose with an unknown part is unknown
-                        return value
+                        return value.plain()
                     raise rt.error("type", f"a pose holds numbers, not a {type_name(value)}",
                                    item)
             return PoseValue(values)
@@ -1087,11 +1152,11 @@ class _Compiler:
                     else:
                         return a.leaning(False if False in (a.lean, b.lean) else
                                          a.lean and b.lean)
-                    return a
+                    return a.plain()
                 if not _bool_operand(a, rt, node):
                     return False
                 b = right(frame)
-                return b if type(b) is Unknown else _bool_operand(b, rt, node)
+                return b.plain() if type(b) is Unknown else _bool_operand(b, rt, node)
             return conj
         if op == "or":
             def disj(frame):
@@ -1105,11 +1170,11 @@ class _Compiler:
                     else:
                         return a.leaning(True if True in (a.lean, b.lean) else
                                          None if None in (a.lean, b.lean) else False)
-                    return a
+                    return a.plain()
                 if _bool_operand(a, rt, node):
                     return True
                 b = right(frame)
-                return b if type(b) is Unknown else _bool_operand(b, rt, node)
+                return b.plain() if type(b) is Unknown else _bool_operand(b, rt, node)
             return disj
         operation = binary(op)
         if op in ("==", "!="):
@@ -1164,12 +1229,12 @@ class _Compiler:
             except TypeError as error:
                 found = has_unknown(target) or _first_unknown_key(keys)
                 if found is not None:
-                    return found
+                    return found.plain()
                 raise rt.error("type", f"an index must be an int, not a {error}", node) \
                     from None
             kind = type(target)
             if kind is Unknown:
-                return target
+                return target.plain()
             if kind is ListValue or kind is PoseValue:
                 size = len(target)
                 first = positions[0]
@@ -1205,7 +1270,7 @@ class _Compiler:
                     raise rt.error("undefined", f"the struct has no member '{attr}'",
                                    node) from None
             if type(target) is Unknown:
-                return target
+                return target.plain()
             if type(target) is remote:  # an XML-RPC server's dotted method names
                 return target.member(attr)
             raise rt.error("type", f"a {type_name(target)} has no field '{attr}'", node)

@@ -222,19 +222,25 @@ def _stop(rt, node, a, aRot="a"):  # noqa: N803
 # ---- robot state -----------------------------------------------------------------------------
 
 
-def _stopped_by_condition(rt, arm) -> Unknown | None:
+def _stopped_by_condition(rt, arm, tcp: Any = False) -> Unknown | None:
     """Where the arm is when something outside the program decided it, unknown offline
     until a move to a known target (:meth:`urdsl.motion.planner.MotionPlanner.unknown_position`):
     after a move that a condition stops (PolyScope's Direction node: until tool contact, an
     input); after ``freedrive_mode()`` or ``teach_mode()``, when the operator moves the arm by
     hand (PolyScope programs put the tool "close to the corner" this way, behind a popup that
     says so); after a move to an unknown target; at the start of a program that starts
-    wherever the arm was left."""
+    wherever the arm was left.
+
+    ``tcp``: for a read of a TCP pose, that TCP (a pose in the flange frame; None: the
+    flange): while the arm stands still where it is unknown, the value says so
+    (:meth:`urdsl.motion.planner.MotionPlanner.relative_pose`); False: a read of anything
+    else (joints)."""
     unknown_at = getattr(arm, "unknown_at", None)
     if unknown_at is None or not rt.unknown:
         return None
     why, span = unknown_at
-    return Unknown(f"the arm's position after {why}", span)
+    relative = None if tcp is False else arm.relative_pose(tcp, rt.current)
+    return Unknown(f"the arm's position after {why}", span, relative=relative)
 
 
 @implements("freedrive_mode", "teach_mode", "freedrive_mode_no_incorrect_payload_check")
@@ -260,7 +266,7 @@ def _joints(rt, node):
 @implements("get_actual_tcp_pose", "get_target_tcp_pose")
 def _tcp_pose(rt, node):
     arm = _arm(rt, node)
-    return _stopped_by_condition(rt, arm) or _to_pose(arm.tcp_at(rt.time))
+    return _stopped_by_condition(rt, arm, arm.tcp) or _to_pose(arm.tcp_at(rt.time))
 
 
 @implements("get_actual_joint_speeds", "get_target_joint_speeds")
@@ -288,10 +294,10 @@ def _tcp_speed(rt, node):
 @implements("get_forward_kin")
 def _forward_kin(rt, node, q="current_joint_positions", tcp="active_tcp"):
     arm = _arm(rt, node)
-    if isinstance(q, str) and (unknown := _stopped_by_condition(rt, arm)) is not None:
+    offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
+    if isinstance(q, str) and (unknown := _stopped_by_condition(rt, arm, offset)) is not None:
         return unknown
     joints = arm.joints_at(rt.time) if isinstance(q, str) else _numbers(rt, node, q, 6, "q")
-    offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
     return _to_pose(arm.kinematics.fk(joints, tcp=offset))
 
 
@@ -437,7 +443,8 @@ def _wrench_trans(rt, node, T_from_to, w_from):  # noqa: N803 - the catalog's pa
 @implements("get_actual_tool_flange_pose")
 def _flange_pose(rt, node):
     arm = _arm(rt, node)
-    return _stopped_by_condition(rt, arm) or _to_pose(arm.kinematics.fk(arm.joints_at(rt.time)))
+    return (_stopped_by_condition(rt, arm, None)
+            or _to_pose(arm.kinematics.fk(arm.joints_at(rt.time))))
 
 
 @implements("get_target_waypoint")

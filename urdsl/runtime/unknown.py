@@ -41,10 +41,11 @@ operator's answer to a prompt or a blocking popup.
 from __future__ import annotations
 
 import functools
+import math
 from typing import Any
 
 from ..script import nodes as n
-from .values import ListValue, StructValue, Unknown, has_unknown
+from .values import ListValue, PoseValue, StructValue, Unknown, has_unknown
 
 __all__ = [
     "DEVICE_REPLY_TIME", "IDLE_AFTER_PASSES", "OPERATOR_REPLY_TIME", "UNCHECKED_MOVE_TIME",
@@ -232,8 +233,20 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
                  call: Any) -> Any:
     """Call the builtin ``name`` whose arguments hold the unknown value ``found``: a move is
     not planned (noted once, it takes :data:`UNCHECKED_MOVE_TIME`), a procedure is skipped
-    (noted once), a function gives an unknown result."""
+    (noted once), a function gives an unknown result.
+
+    A pose relative to an unknown start (:class:`~urdsl.runtime.values.Relative`) is
+    followed through ``pose_add``/``pose_sub`` with a known pose and checked as a move's
+    target (:mod:`urdsl.motion.drift`); everywhere else it is plainly unknown."""
     kind = _kind(name, len(values), tuple(named))
+    if kind == "function" and name in _POSE_MATHS:
+        shifted = _relative_maths(name, values, named)
+        if shifted is not None:
+            return shifted
+    target = _relative_target(name, values, named) if kind == "motion" else None
+    values = [v.plain() if type(v) is Unknown else v for v in values]
+    named = {k: v.plain() if type(v) is Unknown else v for k, v in named.items()}
+    found = found.plain()
     if kind == "call":
         return call(values, named, node)
     if kind == "store":
@@ -248,13 +261,25 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
         # UNCHECKED_MOVE_TIME
         frame = name.startswith(_FRAME_COMMANDS)
         took = f"{rt.config.step_time:g}" if frame else f"{UNCHECKED_MOVE_TIME:g}"
+        robot = rt.robot
+        why = f"the move at line {node.span.line} to an unknown target"
+        # the thread goes on when the move has ended, unless it blends
+        settles = not frame and _settles(name, values, named)
+        if target is not None and robot is not None:
+            problem = robot.relative_move(target, why, node.span, settles, rt.current)
+            if problem is not None:
+                error = rt.error("ik", problem, node, _DRIFT_HINT)
+                error.drift = True  # the verifier's URS301 says it holds whatever the start
+                raise error
         rt.warn_once(f"this move depends on {found.source}, which is unknown offline; the "
                      f"move is not checked (taken as {took} s)", node, found)
-        if rt.robot is not None:
-            rt.robot.stop_blending(rt.time)
-            # where the arm went is unknown until a move to a known target
-            rt.robot.unknown_position(f"the move at line {node.span.line} to an unknown "
-                                      "target", node.span)
+        if robot is not None:
+            robot.stop_blending(rt.time)
+            if target is None:
+                # where the arm went is unknown until a move to a known target
+                still = f"where the move at line {node.span.line} left the arm"
+                robot.unknown_position(why, node.span, still if settles else None,
+                                       rt.current)
         if frame:
             rt.sync()
         else:
@@ -278,6 +303,64 @@ def unknown_call(rt: Any, name: str, values: list, named: dict, found: Unknown, 
         rt.sync()
         return unknown_from(name, node)
     return found
+
+
+_POSE_MATHS = {"pose_add": ("p_1", "p_2"), "pose_sub": ("p_to", "p_from")}
+"""The pose maths followed for poses relative to an unknown start, with their parameters."""
+
+_DRIFT_HINT = ("a move relative to where the arm is (pose_add(get_target_tcp_pose(), ...)) "
+               "adds the same displacement at every pass of a loop; move to a taught waypoint "
+               "in the loop, or end the loop")
+
+_TARGETS = {"movej": "q", "movel": "pose", "movep": "pose"}
+"""Moves whose target (first argument) may be a pose relative to an unknown start."""
+
+
+def _arguments(values: list, named: dict, params: tuple[str, ...]) -> list | None:
+    """The arguments ``params`` of a call, positional then by name, or None if missing."""
+    arguments = list(values[:len(params)])
+    for param in params[len(arguments):]:
+        if param not in named:
+            return None
+        arguments.append(named[param])
+    return arguments
+
+
+def _relative_maths(name: str, values: list, named: dict) -> Unknown | None:
+    """``pose_add``/``pose_sub`` of a pose relative to an unknown start and a known pose:
+    the start plus the known displacement (position ``p_1 + p_2``, ``p_to − p_from``; the
+    rotation stays unknown), or None (plainly unknown)."""
+    arguments = _arguments(values, named, _POSE_MATHS[name])
+    if arguments is None or len(values) + len(named) != 2:
+        return None
+    first, second = arguments
+    if name == "pose_add" and type(first) is PoseValue:
+        first, second = second, first  # the positions add up in either order
+    if type(first) is not Unknown or first.relative is None or type(second) is not PoseValue:
+        return None
+    if not all(type(v) in (int, float) and math.isfinite(v) for v in second):
+        return None
+    shifted = first.relative.shifted(second, -1.0 if name == "pose_sub" else 1.0)
+    return Unknown(first.source, first.span, relative=shifted)
+
+
+def _relative_target(name: str, values: list, named: dict):
+    """The :class:`~urdsl.runtime.values.Relative` target of a move, or None."""
+    param = _TARGETS.get(name)
+    if param is None:
+        return None
+    target = values[0] if values else named.get(param)
+    return target.relative if type(target) is Unknown else None
+
+
+def _settles(name: str, values: list, named: dict) -> bool:
+    """Whether the thread goes on only once the arm has stopped at the move's end: a
+    ``movej``/``movel``/``movep`` whose blend radius ``r`` (positional after q, a, v, t) is a
+    known 0."""
+    if name not in _TARGETS:
+        return False
+    radius = values[4] if len(values) > 4 else named.get("r", 0)
+    return type(radius) in (int, float) and radius == 0
 
 
 @functools.lru_cache(maxsize=1024)

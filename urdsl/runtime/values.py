@@ -29,7 +29,8 @@ from typing import Any
 
 __all__ = [
     "PoseValue", "ListValue", "StructValue", "ThreadHandle", "copy_value", "type_name",
-    "format_value", "is_number", "Unknown", "has_unknown", "exceeds", "LIST_LIMIT",
+    "format_value", "is_number", "Unknown", "Anchor", "Relative", "has_unknown", "exceeds",
+    "LIST_LIMIT",
 ]
 
 LIST_LIMIT = 1_000_000
@@ -95,6 +96,55 @@ class ThreadHandle:
         return f"<thread {self.thread.name}>"
 
 
+class Anchor:
+    """A place the arm stood still at while the checker did not know where: the TCP point
+    (with the TCP then active) at that moment, unknown offline but fixed.
+
+    ``where`` says which moment, for messages ("where the arm stood when the program
+    started"); ``tcp_length`` (m) is the length of the TCP offset the point was read with
+    (the point lies at most that far from the flange's origin). Compared by identity.
+    """
+
+    __slots__ = ("where", "tcp_length")
+
+    def __init__(self, where: str, tcp_length: float) -> None:
+        self.where = where
+        self.tcp_length = tcp_length
+
+    def __repr__(self) -> str:
+        return f"<anchor: {self.where}>"
+
+
+class Relative:
+    """What is known of a pose whose position is an :class:`Anchor`'s point plus a known
+    displacement, its rotation unknown: ``pose_add(get_target_tcp_pose(), d)`` while the
+    arm stands where the checker does not know.
+
+    ``offset``: the displacement (x, y, z) in m, in the Base frame; ``moves``: how many moves
+    to such poses took the arm from the anchor to where this pose was read (0: it was read at
+    the anchor); ``statements``: the spans of those moves. Immutable.
+    """
+
+    __slots__ = ("anchor", "offset", "moves", "statements")
+
+    def __init__(self, anchor: Anchor, offset: tuple[float, float, float], moves: int = 0,
+                 statements: frozenset = frozenset()) -> None:
+        self.anchor = anchor
+        self.offset = (float(offset[0]), float(offset[1]), float(offset[2]))
+        self.moves = moves
+        self.statements = statements
+
+    def shifted(self, by: Any, sign: float = 1.0) -> Relative:
+        """This pose moved by ``sign`` times the position (first three numbers) of ``by``."""
+        return Relative(self.anchor, tuple(o + sign * float(b) for o, b in
+                                           zip(self.offset, by[:3], strict=True)),
+                        self.moves, self.statements)
+
+    def __repr__(self) -> str:
+        x, y, z = self.offset
+        return f"<{self.anchor.where} + [{x:.4g}, {y:.4g}, {z:.4g}] m>"
+
+
 class Unknown:
     """A value the program read from the outside world, which the checker cannot know.
 
@@ -105,18 +155,32 @@ class Unknown:
     ``lean``: for a condition, the truth a working device would give, when there is one: a
     reply compared with ``==`` to what the program expects is taken as equal (True), with
     ``!=`` as not different (False); ``not`` flips it; None: no lean.
+
+    ``relative``: for a pose read of the arm while its position is unknown, what is known of
+    it (a :class:`Relative`: an unknown start plus a known displacement), else None. Only
+    ``pose_add``/``pose_sub`` and the moves read it; every other operation gives
+    :meth:`plain` (an element of such a pose, a pose made from its elements, ... is simply
+    unknown).
     """
 
-    __slots__ = ("source", "span", "lean")
+    __slots__ = ("source", "span", "lean", "relative")
 
-    def __init__(self, source: str, span: Any = None, lean: bool | None = None) -> None:
+    def __init__(self, source: str, span: Any = None, lean: bool | None = None,
+                 relative: Relative | None = None) -> None:
         self.source = source
         self.span = span
         self.lean = lean
+        self.relative = relative
 
     def leaning(self, lean: bool | None) -> Unknown:
-        """The same unknown value with another lean."""
-        return self if lean is self.lean else Unknown(self.source, self.span, lean)
+        """The same unknown value with another lean (and no :attr:`relative`)."""
+        if lean is self.lean and self.relative is None:
+            return self
+        return Unknown(self.source, self.span, lean)
+
+    def plain(self) -> Unknown:
+        """This value without :attr:`relative`: what an operation on it gives."""
+        return self if self.relative is None else Unknown(self.source, self.span, self.lean)
 
     def __repr__(self) -> str:
         return f"<unknown: {self.source}>"

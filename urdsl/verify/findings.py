@@ -104,7 +104,9 @@ _rule("URS301", "unreachable-pose", "error",
       """
 The robot cannot put its TCP (with the active TCP offset) at the pose: it is further than
 the arm reaches, too close to the base, or the orientation is impossible there. The
-controller stops the program at the move; nothing after it runs.""",
+controller stops the program at the move; nothing after it runs. Where the arm started is
+unknown (no taught start), a loop of moves relative to it (pose_add of the TCP pose) is
+reported once its target is farther from every possible start than the arm reaches.""",
       f"{_READY}\nmovel(p[1.5, 0.2, 0.3, 0, 3.1416, 0])",
       f"{_READY}\nmovel(p[0.5, 0.2, 0.3, 0, 3.1416, 0])")
 _rule("URS309", "overlapping-blends", "warning",

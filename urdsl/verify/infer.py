@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..script import nodes as n
-from .run import DEFAULT_START, CheckOptions
+from .run import DEFAULT_START, DRIFT, CheckOptions
 
 __all__ = ["WaypointPair", "Inference", "waypoint_pairs", "static_tcp", "static_tcps",
            "static_payload",
@@ -496,6 +496,9 @@ def qualify(report, inference: Inference) -> None:
     tcp_length = float(np.linalg.norm(inference.tcp[:3])) if inference.tcp else 0.0
     qualified = []
     for finding in report.findings:
+        if finding.cause == DRIFT:  # judged on the widest UR model already
+            qualified.append(finding)
+            continue
         if finding.severity == "error" and finding.code in MODEL_DEPENDENT:
             match = _POSITION.search(finding.message) if finding.code == "URS301" else None
             if match is not None:
@@ -518,6 +521,7 @@ def apply(options: CheckOptions, inference: Inference, tcp_given: bool) -> Check
     """``options`` with the inferred robot and start joints (and the installation's TCP as the
     TCP before the program sets one, unless ``--tcp`` was given)."""
     changes: dict[str, Any] = {"robot": inference.robot,
+                               "robot_assumed": inference.robot_source == "default",
                                "start_joints": inference.start_joints,
                                "start_unknown": inference.start_source == "default"}
     if not tcp_given and inference.tcp is not None and inference.tcp_from.startswith("TCP "):

@@ -3,6 +3,8 @@
 JSON shape (``urdsl check --json``), one document::
 
     {"file": "pick.script", "robot": "ur5e", "ok": false, "cycle_time": 4.182,
+     "loop": {"line": 12, "column": 3, "passes": 1505, "pass_time": 4.182,
+              "first_pass": 5.31, "shortest": 4.182, "longest": 4.182},
      "summary": {"error": 1, "warning": 0, "info": 0},
      "findings": [{"code": "URS303", "severity": "error", "message": "...",
                    "file": "pick.script", "line": 7, "column": 1, "hint": "...",
@@ -14,7 +16,11 @@ JSON shape (``urdsl check --json``), one document::
                   "start": {"joints": [...], "source": "inferred", "from": "Waypoint_1_q",
                             "line": 40}, "text": ["robot ur10e inferred from ..."]}}
 
-Times in s of robot time.
+Times in s of robot time. ``loop`` is there only for a program that loops forever (PolyScope's
+"Loop forever", a ``while True`` of the main thread still running when the check stopped):
+``cycle_time`` is then the mean time of one pass of that loop after the first (``first_pass``
+includes the way from where the arm started), ``passes`` the complete passes checked;
+otherwise ``cycle_time`` is the robot time from the start to the end of the program.
 """
 
 from __future__ import annotations
@@ -44,6 +50,36 @@ class Move:
                 "start": round(self.start, 6), "duration": round(self.duration, 6)}
 
 
+@dataclass(frozen=True)
+class Loop:
+    """The loop a program runs forever, as far as the check followed it: ``passes`` complete
+    passes, the first taking ``first_pass`` s (with the way from the start), the others
+    ``pass_time`` s on average, ``shortest`` to ``longest`` s (s of robot time)."""
+
+    span: Span
+    passes: int
+    first_pass: float
+    pass_time: float
+    shortest: float
+    longest: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"line": self.span.line, "column": self.span.column, "passes": self.passes,
+                "pass_time": round(self.pass_time, 6), "first_pass": round(self.first_pass, 6),
+                "shortest": round(self.shortest, 6), "longest": round(self.longest, 6)}
+
+    def describe(self) -> str:
+        """``one pass of the loop at line 2, which runs forever: 1505 passes checked, the
+        first 5.310 s``."""
+        extra = [f"{self.passes} pass{'es' if self.passes != 1 else ''} checked"]
+        if abs(self.first_pass - self.pass_time) > 5e-4:
+            extra.append(f"the first {self.first_pass:.3f} s")
+        if self.longest - self.shortest > 5e-4:
+            extra.append(f"from {self.shortest:.3f} to {self.longest:.3f} s")
+        return (f"one pass of the loop at line {self.span.line}, which runs forever: "
+                + ", ".join(extra))
+
+
 @dataclass
 class Report:
     """Everything ``urdsl check`` found out about one program."""
@@ -54,6 +90,7 @@ class Report:
     moves: list[Move] = field(default_factory=list)
     events: list = field(default_factory=list)
     cycle_time: float = 0.0
+    loop: Loop | None = None  # the loop the program runs forever: cycle_time is one pass
     trace: Any = field(default=None, repr=False)
     inferred: Any = None  # urdsl.verify.infer.Inference: robot, start, TCP the check used
     context: str | None = None  # the project context the program ran in, if any
@@ -97,6 +134,7 @@ class Report:
             "robot": self.robot,
             "ok": not self.has_errors,
             "cycle_time": round(self.cycle_time, 6),
+            **({"loop": self.loop.to_dict()} if self.loop is not None else {}),
             "context": self.context,
             "summary": {s: self.count(s) for s in ("error", "warning", "info")},
             "findings": [f.to_dict() for f in self.findings],
@@ -131,7 +169,8 @@ class Report:
         verdict = "FAILED" if self.has_errors else "ok"
         return (f"{self.file}: {verdict} on {self.robot}: {self.count('error')} error(s), "
                 f"{self.count('warning')} warning(s), {self.count('info')} info; "
-                f"{len(self.moves)} move(s), cycle time {self.cycle_time:.3f} s")
+                f"{len(self.moves)} move(s), cycle time {self.cycle_time:.3f} s"
+                + (f" ({self.loop.describe()})" if self.loop is not None else ""))
 
     def print_rich(self, console, moves: bool = True, max_moves: int = 20) -> None:
         """The report on a rich console: coloured findings, a table of moves."""

@@ -35,7 +35,7 @@ from ..script.nodes import NO_SPAN
 from ..script.parser import parse
 from . import checks
 from .findings import Finding, nothing_runs
-from .report import Move, Report
+from .report import Loop, Move, Report
 
 __all__ = ["CheckOptions", "Progress", "check_text", "check_tree", "check_file", "DEFAULT_START",
            "DEFAULT_TIMEOUT"]
@@ -126,6 +126,10 @@ class CheckOptions:
     ``start_joints`` or inferred from the program): then ``start_joints`` is only where the
     simulated arm stands, and what the program reads of the arm's position before its first
     move to a known target is unknown, as is that move's path."""
+    robot_assumed: bool = False
+    """Whether ``robot`` is only assumed (neither given nor inferred): a finding that must
+    hold on the real arm whatever it is (a relative move that drifts out of every start's
+    reach, :mod:`urdsl.motion.drift`) is then judged on the widest UR model."""
     unknown_globals: dict[str, str] = field(default_factory=dict)
     """Globals the program reads that something outside it defines (a URCap node's code):
     name → where the value comes from; each holds an unknown value."""
@@ -187,7 +191,9 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     planner.stoppable = stoppable_moves(module)  # Direction nodes: moves until a condition
     if options.start_unknown:
         planner.unknown_position("the program starts (where the arm was left: no start pose "
-                                 "given or inferred; --start-joints sets one)", module.span)
+                                 "given or inferred; --start-joints sets one)", module.span,
+                                 still="where the arm stood when the program started")
+    planner.model_assumed = options.robot_assumed
     if options.tcp is not None:
         planner.tcp = np.asarray(options.tcp, dtype=float)
     deadline = None if options.timeout is None else started + RUN_SHARE * options.timeout
@@ -263,6 +269,9 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
                    deadline=final, reserve=CHECK_RESERVE)
     report.trace = trace
     report.cycle_time = float(min(max(result.time, trace.duration), options.max_time))
+    report.loop = _forever(result)
+    if report.loop is not None:
+        report.cycle_time = report.loop.pass_time
     report.moves = [Move(s.kind, s.span, s.start, s.duration, s.params.get("lead"))
                     for s in planner.segments]
     _phase(options, "checking the motion")
@@ -270,6 +279,22 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
                                            module.span))
     report.sort()
     return report
+
+
+def _forever(result) -> Loop | None:
+    """The loop the program runs forever (:class:`~urdsl.verify.report.Loop`), when the run
+    stopped inside it only because the check stopped (``--max-time``, the wall-clock bound)
+    after at least one complete pass; otherwise None."""
+    passes = result.forever
+    stopped = result.stopped_at_max_time or result.stopped or (
+        result.stopped_early is not None and result.stopped_early.kind == "deadline")
+    if passes is None or not stopped or passes.pass_time is None:
+        return None
+    later = passes.count - 2  # complete passes after the first
+    shortest = passes.shortest if later > 0 else passes.first_pass
+    longest = passes.longest if later > 0 else passes.first_pass
+    return Loop(passes.span, passes.count - 1, passes.first_pass, passes.pass_time,
+                shortest, longest)
 
 
 def _stopped_finding(event, options: CheckOptions) -> Finding:
@@ -287,10 +312,18 @@ def _stopped_finding(event, options: CheckOptions) -> Finding:
 def _runtime_finding(error) -> Finding:
     diagnostic = error.diagnostic
     if error.kind == "ik":
+        # a target that drifted out of every start's reach holds for every start (and, when
+        # the model is only assumed, every model): the cause says so (see infer.qualify)
+        cause = DRIFT if getattr(error, "drift", False) else None
         return Finding.of("URS301", diagnostic.message, error.span, error.time,
-                          diagnostic.hint)
+                          diagnostic.hint, cause)
     return Finding(diagnostic.code, "error", diagnostic.message, error.span, error.time,
                    diagnostic.hint)
+
+
+DRIFT = "drift out of every start's reach"
+"""The cause of a URS301 for a move relative to an unknown start that no start makes
+reachable (:mod:`urdsl.motion.drift`): it was judged for every model the arm may be."""
 
 
 PATH_CODES = frozenset({"URS302", "URS304", "URS305", "URS306", "URS307", "URS308"})
