@@ -324,33 +324,41 @@ def _floats_or_none(text: str | None) -> tuple[float, ...] | None:
 
 
 def _blend_kept(move: Node, motion: Node) -> bool:
-    """Whether a process move (MoveP) keeps the blend of ``motion``: not at its last motion
-    unless the next node is another MoveP, into which it can blend (after the Robot
-    Program's last node comes its first one again when the program loops), or the move ends
-    a subprogram."""
+    """Whether a process move (MoveP) keeps the blend of ``motion``: always but at its last
+    motion, which keeps it only when what follows in the program tree is another MoveP, into
+    which it can blend. What follows is the next node beside the move; when the move is the
+    last one of its parent (a Loop, If, Folder, Force, a Move ...), the node after that
+    parent, and so on up. After the Robot Program's last node comes its first one again when
+    the program loops. When nothing follows (the end of a program run once, of a
+    subprogram, of a thread), the blend is kept: PolyScope drops it only for a node it finds
+    (seen: 5.9, a MoveP that ends a Loop followed by a MoveL writes r=0; 5.12, a MoveP ending
+    a MoveJ's children in a looping program whose first node is a MoveJ, r=0; 5.7, a MoveP
+    ending a Force that ends a program run once, and 5.8, a MoveP ending a subprogram, keep
+    theirs)."""
     if move.fields.get("motion_type") != "MoveP":
         return True
     motions = [child for child in move.children
                if child.kind in ("Waypoint", "CircleMove") and not child.suppressed]
     if not motions or motion is not motions[-1]:
         return True
-    parent = move.parent
-    if parent is None:
-        return False
-    siblings = [child for child in parent.children if not child.suppressed]
-    index = siblings.index(move) if move in siblings else -1
-    if 0 <= index < len(siblings) - 1:
-        following = siblings[index + 1]
-    elif index >= 0 and parent.kind == "MainProgram" and \
-            parent.attrs.get("runOnlyOnce") != "true":
-        following = siblings[0]
-    elif index >= 0 and parent.kind == "SubProgram":
-        # the last node of a subprogram: what follows is the caller's, which PolyScope does
-        # not look at; it keeps the blend (seen: PolyScope 5.8, four MoveP in subprograms,
-        # three followed by a MoveL write r=0, the last node of one r=0.025)
-        return True
-    else:
-        return False
+    node = move
+    while True:
+        parent = node.parent
+        if parent is None:
+            return True
+        siblings = [child for child in parent.children if not child.suppressed]
+        index = siblings.index(node) if node in siblings else -1
+        if 0 <= index < len(siblings) - 1:
+            following = siblings[index + 1]
+            break
+        if parent.kind == "MainProgram":
+            if parent.attrs.get("runOnlyOnce") != "true" and siblings:
+                following = siblings[0]
+                break
+            return True
+        if parent.kind == "SubProgram":
+            return True
+        node = parent
     return following.kind == "Move" and following.fields.get("motion_type") == "MoveP"
 
 
