@@ -198,7 +198,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
         planner.tcp = np.asarray(options.tcp, dtype=float)
     deadline = None if options.timeout is None else started + RUN_SHARE * options.timeout
     config = RuntimeConfig(step_time=step, max_time=options.max_time, deadline=deadline,
-                           go_on_after_undefined=True)
+                           go_on_after_undefined=True, stop_repeating=True)
     environment = options.environment
     if environment is None:
         environment = Environment(devices="unknown")
@@ -287,7 +287,8 @@ def _forever(result) -> Loop | None:
     after at least one complete pass; otherwise None."""
     passes = result.forever
     stopped = result.stopped_at_max_time or result.stopped or (
-        result.stopped_early is not None and result.stopped_early.kind == "deadline")
+        result.stopped_early is not None and result.stopped_early.kind in ("deadline",
+                                                                           "repeats"))
     if passes is None or not stopped or passes.pass_time is None:
         return None
     later = passes.count - 2  # complete passes after the first
@@ -298,7 +299,11 @@ def _forever(result) -> Loop | None:
 
 
 def _stopped_finding(event, options: CheckOptions) -> Finding:
-    """URS313 for a run that stopped early: it names the robot time and the statement."""
+    """URS313 for a run that stopped early: it names the robot time and the statement;
+    URS312 (info) for a loop that repeats itself (nothing is left unchecked)."""
+    if event.kind == "repeats":
+        return Finding.of("URS312", f"{event.message}; the check stops here at robot time "
+                          f"{event.time:.3f} s", event.span, event.time)
     if event.kind == "deadline":
         message = (f"the check reached its wall-clock bound of {options.timeout:g} s and "
                    f"{event.message}, here; what follows was not checked")
