@@ -199,6 +199,19 @@ class LoopPasses:
         return self.first_pass
 
 
+_ORDERINGS = frozenset({"<", ">", "<=", ">="})
+
+
+def _likely_operands(a: Any, b: Any) -> tuple[float, float] | None:
+    """The operands of a comparison with the :attr:`Unknown.likely` value of the unknown
+    one in its place, when one is such a value and the other a number; else None."""
+    if type(a) is Unknown and a.likely is not None and is_number(b):
+        return a.likely, b
+    if type(b) is Unknown and b.likely is not None and is_number(a):
+        return a, b.likely
+    return None
+
+
 class _StopRun(Exception):
     """Ends a run early without a program error (see :attr:`RunResult.stopped_early`)."""
 
@@ -1247,6 +1260,9 @@ class _Compiler:
                 b = right(frame)
                 found = has_unknown(a) or has_unknown(b)
                 if found is not None:
+                    likely = _likely_operands(a, b)
+                    if likely is not None:
+                        return found.leaning(operation(*likely))
                     if reply is not None:
                         # one device, one reply: the first constant a read is compared with
                         # is the reply taken; `JOB == 2` then `JOB == 7` is not both true
@@ -1265,6 +1281,9 @@ class _Compiler:
                 raise rt.error("arithmetic", "division by zero", node) from None
             except (TypeError, ValueError) as error:
                 found = has_unknown(a) or has_unknown(b)
+                likely = _likely_operands(a, b) if op in _ORDERINGS else None
+                if likely is not None:
+                    return found.leaning(operation(*likely))
                 # xor of an unknown needs the other side a bool or unknown too (two device
                 # reads, e.g. RTDE boolean registers, are a valid xor)
                 other = b if found is a else a

@@ -127,7 +127,8 @@ def freeze(value: Any) -> Any:
     if kind is StructValue:
         return ("s", *((k, freeze(v)) for k, v in value.members.items()))
     if kind is Unknown:
-        return ("?", value.source, value.span, value.lean, freeze(value.relative))
+        return ("?", value.source, value.span, value.lean, freeze(value.relative),
+                value.likely)
     if kind is Relative:
         return ("r", id(value.anchor), value.offset, value.moves, value.statements)
     if kind is ThreadHandle:  # a thread run anew each pass is the same thread
