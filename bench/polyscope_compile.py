@@ -56,7 +56,9 @@ projects found after those, two of every three in the order they were added, the
 same for the projects of the repositories fetched for the real-world benchmark, listed by
 ``bench/polyscope_pairs.py``; ``tune5``: the same for the projects found by their
 repositories' file lists (a folder holding ``default.installation``, a program's name),
-listed the same way),
+listed the same way; ``tune6``: the same for the projects of the next round (repositories
+found by their names and file lists, URSim volume folders, course templates, and those the
+real-world helpers fetched), listed the same way),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most; then each project's share of programs exact (program part, whole, whole among
 the programs with their installation) and the mean of these over the projects, each project
@@ -442,7 +444,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="folder of owner+name git dirs")
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
     parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "tune3", "tune4",
-                                                   "tune5", "all"),
+                                                   "tune5", "tune6", "all"),
                         default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
     parser.add_argument("--script-files", choices=("file", "cache"), default="file",

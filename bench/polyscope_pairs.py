@@ -15,7 +15,10 @@ every third project ``held`` and the others ``tune4``. Only pairs PolyScope 3.x-
 are rows (root ``<URProgram>``, a ``.script`` with markers: not PolyScope 1.x's serialised
 programs, a generator's files, a ``__MACOSX`` resource fork); a repository with none is not
 a project. ``--studied REPO`` (repeatable): a repository whose programs a helper has already
-compiled is not blind: it takes the first split and no position in the cycle.
+compiled is not blind: it takes the first split and no position in the cycle. ``--exclude
+REPO`` (repeatable): a repository that is not a project of its own, such as a fork whose pairs
+are another listed repository's blob for blob (students' forks of a course template): it is
+left out and takes no position.
 
 Usage: ``python bench/polyscope_pairs.py --repos /work/.mirror [--tsv tune4,tune4,held]``
 """
@@ -154,6 +157,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--tsv", help="comma-separated splits by position, repeated")
     parser.add_argument("--studied", action="append", default=[],
                         help="a repository already compiled by a helper (repeatable)")
+    parser.add_argument("--exclude", action="append", default=[],
+                        help="a repository that is not a project of its own (a fork; "
+                             "repeatable)")
     args = parser.parse_args(argv)
     have, authors = known(args.pairs)
     projects: list[tuple[str, list[Pair]]] = []
@@ -161,7 +167,8 @@ def main(argv: list[str] | None = None) -> int:
         if not entry.is_dir() or "+" not in entry.name:
             continue
         repo = entry.name.replace("+", "/", 1)
-        if repo in have or repo.split("/")[0].lower() in authors:
+        if (repo in have or repo.split("/")[0].lower() in authors
+                or repo in args.exclude):
             continue
         directory = git_dir(args.repos, entry.name)
         if directory is None:

@@ -35,8 +35,10 @@ def test_motion_examples_without_devices_check_clean(name):
     report = check_text(by_name(name), name, options=CheckOptions(
         start_joints=READY, max_time=1.0, self_collision=False))
     assert not report.has_errors, report.render_text()
-    # control loops run until stopped: the cycle time is one pass of the loop
-    assert report.loop is not None and report.loop.passes > 100
+    # control loops run until stopped (or until a pass begins as an earlier one did): the
+    # cycle time is one pass of the loop
+    assert report.loop is not None
+    assert report.loop.passes > 100 or "begins in the same state" in report.render_text()
     assert report.cycle_time == pytest.approx(report.loop.pass_time)
     assert report.cycle_time < 0.1
 

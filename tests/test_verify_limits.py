@@ -31,7 +31,9 @@ def only(report, code: str):
 
 def test_an_endless_program_stops_at_the_wall_clock_bound_and_says_where(tmp_path, capsys):
     path = tmp_path / "endless.script"
-    path.write_text("i = 0\nwhile True:\n  i = i + 1\n  sync()\nend\n")
+    # i decides a branch: no pass begins as an earlier one did (that would end the check)
+    path.write_text("i = 0\nwhile True:\n  i = i + 1\n  if i < 0:\n    halt\n  end\n"
+                    "  sync()\nend\n")
     status = main(["check", str(path), "--max-time", "1e9", "--timeout", "3"])
     out = capsys.readouterr().out
     assert status == 0  # a warning: the program has no error that was found
@@ -158,7 +160,8 @@ def test_exponential_recursion_meets_the_wall_clock_bound():
 def test_a_message_at_every_pass_does_not_fill_memory():
     from urdsl.runtime.interpreter import EVENT_LIMIT
 
-    report = check('while True:\n  textmsg("tick")\n  sync()\nend\n', max_time=30)
+    report = check('i = 0\nwhile True:\n  textmsg("tick")\n  i = i + 1\n  if i < 0:\n'
+                   '    halt\n  end\n  sync()\nend\n', max_time=30)
     assert len(report.events) == EVENT_LIMIT + 1  # 15,000 passes; the rest are counted
     assert report.events[-1].message.startswith("5,0")
     assert len(report.trace.times) <= 1  # the arm never moved: nothing to sample

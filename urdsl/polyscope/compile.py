@@ -142,10 +142,21 @@ class Compiled:
 # ---- waypoint poses ------------------------------------------------------------------------
 
 
-def _dh(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
+def _dh(theta: float, d: float, a: float, alpha: float) -> list[list[float]]:
     ct, st, ca, sa = math.cos(theta), math.sin(theta), math.cos(alpha), math.sin(alpha)
-    return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
-                     [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]])
+    return [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
+            [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]]
+
+
+def _matmul4(a: list[list[float]], b: list[list[float]]) -> list[list[float]]:
+    """The product of two 4×4 matrices, each element summed over k = 0..3 in turn in plain
+    double arithmetic (no fused multiply-add, no vector reordering). Near a half turn the
+    rotation vector's angle depends on the last bit of the trace (π - 1.5e-8 for a trace one
+    rounding step above -1), so the rounding of these sums decides what PolyScope writes:
+    this order reproduces 44 of 48 such waypoints PolyScope wrote (eggsu, inaki1111,
+    CA-Giken, orlandingabriel, manelpuig), numpy's product 38."""
+    return [[a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j] + a[i][3] * b[3][j]
+             for j in range(4)] for i in range(4)]
 
 
 def _rotvec_to_matrix(rv) -> np.ndarray:
@@ -270,16 +281,16 @@ def waypoint_pose(q, tcp, kinematics: Kinematics) -> tuple[float, ...]:
     """The TCP pose (x, y, z in m, rotation vector in rad, in the base frame) of joint angles
     ``q`` (rad) with TCP offset ``tcp`` on the arm described by ``kinematics`` (standard DH;
     ``delta_theta`` added to each joint angle)."""
-    transform = np.eye(4)
-    for i in range(6):
-        transform = transform @ _dh(q[i] + kinematics.delta_theta[i], kinematics.d[i],
-                                    kinematics.a[i], kinematics.alpha[i])
-    tool = np.eye(4)
-    tool[:3, :3] = _rotvec_to_matrix(tcp[3:])
-    tool[:3, 3] = tcp[:3]
-    transform = transform @ tool
-    rv = _matrix_to_rotvec(transform[:3, :3])
-    return tuple(float(x) for x in transform[:3, 3]) + tuple(float(x) for x in rv)
+    transform = _dh(q[0] + kinematics.delta_theta[0], kinematics.d[0], kinematics.a[0],
+                    kinematics.alpha[0])
+    for i in range(1, 6):
+        transform = _matmul4(transform, _dh(q[i] + kinematics.delta_theta[i], kinematics.d[i],
+                                            kinematics.a[i], kinematics.alpha[i]))
+    rotation = _rotvec_to_matrix(tcp[3:]).tolist()
+    tool = [[*rotation[i], float(tcp[i])] for i in range(3)] + [[0.0, 0.0, 0.0, 1.0]]
+    transform = _matmul4(transform, tool)
+    rv = _matrix_to_rotvec(np.array([row[:3] for row in transform[:3]]))
+    return tuple(float(transform[i][3]) for i in range(3)) + tuple(float(x) for x in rv)
 
 
 # ---- the compiler --------------------------------------------------------------------------
@@ -1010,6 +1021,13 @@ class _Compiler:
             return self.set_pulse(node)
         if kind == "NoAction":
             return [self.marker(node, "Set")]
+        if kind == "IncrementVariable" and node.fields.get("variable"):
+            # adds one to a variable: marker "Set i_count=i_count+1", then
+            # ``i_count = i_count + 1`` (seen: an installation variable, PolyScope 5.9.1,
+            # manelpuig/Project_Assistive_Robotics 06_var_global_01)
+            name = str(node.fields["variable"])
+            return [self.marker(node, f"Set {name}={name}+1"),
+                    Assign(Name(name), BinOp("+", Name(name), Number(1)))]
         return self.n_unknown(node)
 
     def n_SetPayload(self, node: Node) -> list[Item]:

@@ -593,6 +593,12 @@ def _set(reader: _Reader, node: Node, element: ElementTree.Element) -> None:
     tcp = element.find("tcp")
     if tcp is not None:
         node.fields["tcp"] = reader.resolve(tcp).get("referencedName")
+    # the variable an IncrementVariable Set adds one to: an installation variable (seen:
+    # ``<installationVariable name="i_count"/>``, 5.9.1) or a program variable [U]
+    for tag in ("installationVariable", "variable"):
+        if element.find(tag) is not None:
+            node.fields["variable"] = reader.variable_name(element.find(tag))
+            break
     node.fields["expression"] = reader.expression(element.find("expression"))
 
 

@@ -30,6 +30,7 @@ from ..script import nodes as n
 from ..script.binder import Binding, Signature
 from ..script.nodes import NO_SPAN, Span
 from .errors import ScriptRuntimeError
+from .repeat import inert_names, pass_state
 from .unknown import (
     IDLE_AFTER_PASSES,
     UNKNOWN_LOOP_PASSES,
@@ -94,6 +95,10 @@ class RuntimeConfig:
     deadline: float | None = None
     max_threads: int = MAX_THREADS
     go_on_after_undefined: bool = False
+    stop_repeating: bool = False
+    """Stop the run when a pass of a ``while True`` loop of the main thread begins in a state
+    an earlier pass began in (:mod:`urdsl.runtime.repeat`): every later pass repeats those
+    (the verifier; the virtual controller runs on, as the robot does)."""
     pace: Callable[[float], None] | None = None
     """Called with the robot time (s) the program is about to advance to, before it does:
     the virtual controller sleeps there to run in real time. ``None`` (the verifier): robot
@@ -140,15 +145,27 @@ class RunResult:
     ``"deadline"`` (the wall-clock bound); its time and span say how far it got."""
 
 
+REPEAT_EVERY_PASS = 256
+"""Passes of a ``while True`` loop whose begin state is compared, each; after them, every
+:data:`REPEAT_STRIDE`-th (see :meth:`Interpreter.stop_if_repeating`)."""
+REPEAT_STRIDE = 64
+REPEAT_STATES = 512
+"""Begin states of one loop kept for comparison (a loop of a longer period runs on)."""
+
+
 class LoopPasses:
     """The passes of a ``while True`` loop of the main thread: how many began, and when (robot
     time, s). A pass runs from one start of the loop's body to the next."""
 
-    __slots__ = ("span", "count", "first", "second", "last", "shortest", "longest")
+    __slots__ = ("span", "count", "first", "second", "last", "shortest", "longest", "states",
+                 "repeats")
 
     def __init__(self, span: Span) -> None:
         self.span = span
         self.count = 0
+        # the state passes began in -> the first such pass (1-based) and its robot time (s)
+        self.states: dict = {}
+        self.repeats: int | None = None  # the earlier pass the last one began as, if any
         self.first = self.second = self.last = 0.0
         self.shortest = math.inf
         self.longest = 0.0
@@ -180,6 +197,19 @@ class LoopPasses:
         if self.count >= 3:
             return (self.last - self.second) / (self.count - 2)
         return self.first_pass
+
+
+_ORDERINGS = frozenset({"<", ">", "<=", ">="})
+
+
+def _likely_operands(a: Any, b: Any) -> tuple[float, float] | None:
+    """The operands of a comparison with the :attr:`Unknown.likely` value of the unknown
+    one in its place, when one is such a value and the other a number; else None."""
+    if type(a) is Unknown and a.likely is not None and is_number(b):
+        return a.likely, b
+    if type(b) is Unknown and b.likely is not None and is_number(a):
+        return a, b.likely
+    return None
 
 
 class _StopRun(Exception):
@@ -278,6 +308,7 @@ class Interpreter:
         self.halted = False
         self.stop_requested = False
         self._once: set = set()
+        self._inert: frozenset[str] | None = None  # see stop_if_repeating
         self._threads: list[Thread] = []
         self._order = 0
         self._scheduler: greenlet.greenlet | None = None
@@ -454,6 +485,44 @@ class Interpreter:
         self.current.blocked = event
         self.event("blocked", message, node.span)
         self.wait_until(math.inf)
+
+    def stop_if_repeating(self, passes: LoopPasses, frame: Frame, node: n.Node,
+                          loop_state: Any = None) -> None:
+        """Stop the run (``"repeats"``) when the pass of ``passes`` now beginning begins in the
+        state an earlier one began in (:func:`urdsl.runtime.repeat.pass_state`): the passes
+        from that one on repeat for ever, and all of them have been run. The state is taken
+        at every pass up to :data:`REPEAT_EVERY_PASS`, then at every
+        :data:`REPEAT_STRIDE`-th, and at most :data:`REPEAT_STATES` are kept: a loop of very
+        short passes (a poll each controller frame) costs little more than before.
+        ``loop_state``: what else of the loop decides what its next pass does."""
+        count = passes.count
+        if count > REPEAT_EVERY_PASS and count % REPEAT_STRIDE:
+            return
+        if self._inert is None:
+            self._inert = inert_names(self.module)
+        state = pass_state(self, frame, self._inert)
+        if state is None:
+            return
+        state = (state, loop_state, len(self.device_replies))
+        seen = passes.states.get(state)
+        if seen is None:
+            if len(passes.states) < REPEAT_STATES:
+                passes.states[state] = (count, self.time)
+            return
+        earlier, then = seen
+        if self.time <= then:
+            return  # passes that take no robot time: the controller stops the program as
+            # runaway (URS207), which the run must go on to find
+        passes.repeats = earlier
+        if earlier == count - 1:
+            same, repeated = "the one before", f"pass {earlier}, which was checked"
+        else:
+            same = f"pass {earlier}"
+            repeated = f"passes {earlier} to {count - 1}, which were checked"
+        raise _StopRun(Event(self.time, "repeats",
+                             f"pass {count} of this loop begins in the same state as {same} "
+                             f"(variables, arm, I/O, threads): every later pass repeats "
+                             f"{repeated}", node.span))
 
     def check_deadline(self, node: n.Node | None) -> None:
         """Stop the run if the wall-clock bound (``config.deadline``) has passed."""
@@ -890,6 +959,11 @@ class _Compiler:
             while True:
                 if passes is not None:
                     passes.begin(rt.time)
+                    if rt.config.stop_repeating:
+                        # the polling loop's pass count decides its device branches until
+                        # the device is taken as idle
+                        rt.stop_if_repeating(passes, frame, node, None if polling is None
+                                             else min(polling[0], IDLE_AFTER_PASSES + 1))
                 if polling is not None:
                     polling[0] += 1
                 value = test(frame)
@@ -1186,6 +1260,9 @@ class _Compiler:
                 b = right(frame)
                 found = has_unknown(a) or has_unknown(b)
                 if found is not None:
+                    likely = _likely_operands(a, b)
+                    if likely is not None:
+                        return found.leaning(operation(*likely))
                     if reply is not None:
                         # one device, one reply: the first constant a read is compared with
                         # is the reply taken; `JOB == 2` then `JOB == 7` is not both true
@@ -1204,6 +1281,9 @@ class _Compiler:
                 raise rt.error("arithmetic", "division by zero", node) from None
             except (TypeError, ValueError) as error:
                 found = has_unknown(a) or has_unknown(b)
+                likely = _likely_operands(a, b) if op in _ORDERINGS else None
+                if likely is not None:
+                    return found.leaning(operation(*likely))
                 # xor of an unknown needs the other side a bool or unknown too (two device
                 # reads, e.g. RTDE boolean registers, are a valid xor)
                 other = b if found is a else a

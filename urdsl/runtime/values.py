@@ -156,6 +156,10 @@ class Unknown:
     reply compared with ``==`` to what the program expects is taken as equal (True), with
     ``!=`` as not different (False); ``not`` flips it; None: no lean.
 
+    ``likely``: for a number, what a working device gives (the count of values a socket
+    read asked for): a comparison of it with a number leans the way that value compares;
+    a loop on it still ends after a few passes (a device's buffer runs dry).
+
     ``relative``: for a pose read of the arm while its position is unknown, what is known of
     it (a :class:`Relative`: an unknown start plus a known displacement), else None. Only
     ``pose_add``/``pose_sub`` and the moves read it; every other operation gives
@@ -163,24 +167,29 @@ class Unknown:
     unknown).
     """
 
-    __slots__ = ("source", "span", "lean", "relative")
+    __slots__ = ("source", "span", "lean", "relative", "likely")
 
     def __init__(self, source: str, span: Any = None, lean: bool | None = None,
-                 relative: Relative | None = None) -> None:
+                 relative: Relative | None = None, likely: float | None = None) -> None:
         self.source = source
         self.span = span
         self.lean = lean
         self.relative = relative
+        self.likely = likely
 
     def leaning(self, lean: bool | None) -> Unknown:
-        """The same unknown value with another lean (and no :attr:`relative`)."""
-        if lean is self.lean and self.relative is None:
+        """The same unknown value with another lean (and no :attr:`relative`, no
+        :attr:`likely`)."""
+        if lean is self.lean and self.relative is None and self.likely is None:
             return self
         return Unknown(self.source, self.span, lean)
 
     def plain(self) -> Unknown:
-        """This value without :attr:`relative`: what an operation on it gives."""
-        return self if self.relative is None else Unknown(self.source, self.span, self.lean)
+        """This value without :attr:`relative` and :attr:`likely`: what an operation on it
+        gives."""
+        if self.relative is None and self.likely is None:
+            return self
+        return Unknown(self.source, self.span, self.lean)
 
     def __repr__(self) -> str:
         return f"<unknown: {self.source}>"

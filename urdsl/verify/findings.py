@@ -133,10 +133,13 @@ moment of your choosing, before the end.""",
       f"thread beat():\n  while True:\n    sleep(0.5)\n  end\nend\n{_READY}\nt = run beat()\n"
       "sleep(1)\nkill t")
 _rule("URS312", "time-limit", "info",
-      "The program was stopped at the time limit (it loops forever).",
+      "The program was stopped at the time limit, or where its forever loop repeats itself.",
       """
-Cell programs often loop forever. urdsl runs a program for at most --max-time seconds of
-robot time (3600 by default), checks what ran until then and says that it stopped it.""",
+Cell programs often loop forever. When a pass of the main program's forever loop begins in
+the state an earlier pass began in (the variables that can change what it does, the arm,
+I/O, threads), every later pass repeats those passes: the check has seen them all and stops
+there. Otherwise urdsl runs a program for at most --max-time seconds of robot time (3600 by
+default), checks what ran until then and says that it stopped it.""",
       "# urdsl check --max-time 20\nwhile True:\n  sleep(1)\nend",
       "# urdsl check --max-time 20\ni = 0\nwhile i < 10:\n  sleep(1)\n  i = i + 1\nend")
 _rule("URS313", "check-stopped-early", "warning",

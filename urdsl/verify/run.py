@@ -30,6 +30,7 @@ from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
 from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
 from ..runtime.values import Unknown
+from ..script import nodes as n
 from ..script.diagnostics import ScriptSyntaxError
 from ..script.nodes import NO_SPAN
 from ..script.parser import parse
@@ -198,7 +199,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
         planner.tcp = np.asarray(options.tcp, dtype=float)
     deadline = None if options.timeout is None else started + RUN_SHARE * options.timeout
     config = RuntimeConfig(step_time=step, max_time=options.max_time, deadline=deadline,
-                           go_on_after_undefined=True)
+                           go_on_after_undefined=True, stop_repeating=True)
     environment = options.environment
     if environment is None:
         environment = Environment(devices="unknown")
@@ -232,8 +233,10 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     for warning in planner.warnings:  # Overlapping Blends, or a stoppable move's far target
         code = "URS210" if warning.code == "condition" else "URS309"
         report.findings.append(Finding.of(code, warning.message, warning.span, warning.time))
-    if result.threads_left_running:
-        names = ", ".join(result.threads_left_running)
+    generated = generated_threads(module) if result.threads_left_running else set()
+    left = [name for name in result.threads_left_running if name not in generated]
+    if left:
+        names = ", ".join(left)
         report.findings.append(Finding.of(
             "URS311", f"the program ended while thread(s) {names} still ran; the controller "
             "stops them", module.span, result.time, "join or kill threads before the end"))
@@ -277,8 +280,73 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     _phase(options, "checking the motion")
     report.findings.extend(_trace_findings(trace, planner, robot, options, final,
                                            module.span))
+    report.findings = group_urcap_notes(module, report.findings)
     report.sort()
     return report
+
+
+def urcap_blocks(module) -> list[tuple[str, int, int]]:
+    """The code a URCap wrote into the program (PolyScope's ``# begin: URCap Installation
+    Node`` / ``Program Node`` … ``# end: …`` comments): (the URCap's name from its
+    ``#   Source:`` line, first line, last line) for each block."""
+    comments = sorted((c for c in n.walk(module) if type(c) is n.Comment),
+                      key=lambda c: c.span.line)
+    blocks: list[tuple[str, int, int]] = []
+    begun: tuple[str, int] | None = None
+    for comment in comments:
+        text = comment.text.strip()
+        if text.startswith("begin: URCap"):
+            begun = ("a URCap", comment.span.line)
+        elif begun is not None and text.startswith("Source:"):
+            name = text[len("Source:"):].split(",")[0].strip()
+            begun = (name or begun[0], begun[1])
+        elif begun is not None and text.startswith("end: URCap"):
+            blocks.append((begun[0], begun[1], comment.span.line))
+            begun = None
+    return blocks
+
+
+def generated_threads(module) -> set[str]:
+    """Threads PolyScope or a URCap wrote into a program (a step counter, a gripper's
+    communication thread): the program may end while they run, the controller stops them,
+    and the user has nothing to change."""
+    blocks = urcap_blocks(module)
+    return {t.name for t in n.walk(module) if type(t) is n.ThreadDef and (
+        t.name.startswith("Step_Counter_Thread_")
+        or any(first <= t.span.line <= last for _name, first, last in blocks))}
+
+
+def group_urcap_notes(module, findings: list[Finding]) -> list[Finding]:
+    """The URS210 notes (what depends on a value unknown offline) at statements of one
+    URCap's code, when there are several, as one: the user did not write that code, and a
+    Robotiq preamble alone holds some fifty device conditions."""
+    blocks = urcap_blocks(module)
+    if not blocks:
+        return findings
+    grouped: dict[tuple[str, int, int], list[Finding]] = {}
+    kept: list[Finding] = []
+    for finding in findings:
+        line = finding.span.line
+        block = next((b for b in blocks if b[1] <= line <= b[2]), None) \
+            if finding.code == "URS210" else None
+        if block is None:
+            kept.append(finding)
+        else:
+            grouped.setdefault(block, []).append(finding)
+    for (name, first, last), notes in grouped.items():
+        if len(notes) == 1:
+            kept.extend(notes)
+            continue
+        notes.sort(key=lambda f: (f.span.line, f.span.column))
+        lines = sorted({f.span.line for f in notes})
+        shown = ", ".join(str(line) for line in lines[:8]) + (", …" if len(lines) > 8 else "")
+        kept.append(Finding.of(
+            "URS210", f"{len(notes)} statements of the URCap code of {name} (lines {first}-{last}) "
+            f"depend on values unknown offline, the device's replies; the check follows a "
+            f"working device through them (lines {shown}; the first: {notes[0].message})",
+            notes[0].span, notes[0].time, "the URCap wrote this code: these notes are about "
+            "the device, not about your program"))
+    return kept
 
 
 def _forever(result) -> Loop | None:
@@ -287,7 +355,8 @@ def _forever(result) -> Loop | None:
     after at least one complete pass; otherwise None."""
     passes = result.forever
     stopped = result.stopped_at_max_time or result.stopped or (
-        result.stopped_early is not None and result.stopped_early.kind == "deadline")
+        result.stopped_early is not None and result.stopped_early.kind in ("deadline",
+                                                                           "repeats"))
     if passes is None or not stopped or passes.pass_time is None:
         return None
     later = passes.count - 2  # complete passes after the first
@@ -298,7 +367,11 @@ def _forever(result) -> Loop | None:
 
 
 def _stopped_finding(event, options: CheckOptions) -> Finding:
-    """URS313 for a run that stopped early: it names the robot time and the statement."""
+    """URS313 for a run that stopped early: it names the robot time and the statement;
+    URS312 (info) for a loop that repeats itself (nothing is left unchecked)."""
+    if event.kind == "repeats":
+        return Finding.of("URS312", f"{event.message}; the check stops here at robot time "
+                          f"{event.time:.3f} s", event.span, event.time)
     if event.kind == "deadline":
         message = (f"the check reached its wall-clock bound of {options.timeout:g} s and "
                    f"{event.message}, here; what follows was not checked")

@@ -1,0 +1,206 @@
+"""When a ``while True`` loop repeats itself: the state a pass begins in.
+
+A cell program loops forever. The checker used to run such a loop until ``--max-time``
+(3600 s of robot time) or its wall-clock bound, checking the same passes over and over. A
+program is deterministic offline (a device read is an unknown value followed as a working
+device answers, always the same way), so when a pass of the main thread's forever loop
+begins in exactly the state the pass before it began in, every later pass does what that
+pass did: the check has seen them all and may stop (:attr:`RuntimeConfig.stop_repeating`).
+
+The state compared (:func:`pass_state`): the variables that can change what the program
+does (those of the loop's frame and the globals, less the *inert* ones, see
+:func:`inert_names`), the arm (where everything planned so far ends, the move still
+blending, the TCP and payload, what is unknown of its position), the I/O and registers, and
+the threads that run with their wake times relative to now. Numbers compare exactly: a
+value that creeps by rounding keeps the loop running as before, never the reverse.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+from ..script import nodes as n
+from .values import (
+    Anchor,
+    ListValue,
+    PoseValue,
+    Relative,
+    StructValue,
+    ThreadHandle,
+    Unknown,
+)
+
+__all__ = ["LOGGING_CALLS", "freeze", "inert_names", "pass_state"]
+
+LOGGING_CALLS = frozenset({"textmsg", "varmsg"})
+"""Builtins whose arguments only end up in the log: a variable read there alone does not
+change what the program does."""
+
+_FLOWS = frozenset({n.Paren, n.UnaryOp, n.List, n.Pose, n.Number, n.Bool, n.String,
+                    n.NoneLit})
+_FLOW_OPS = frozenset({"+", "-", "*", "and", "or", "xor", "==", "!=", "<", ">", "<=", ">="})
+"""Expressions through which a value flows into an assignment without a way to fail that a
+later value could open (a division by what becomes zero, an index past the end, a builtin's
+domain): only through these is the assigned name's inertness passed on to what it reads."""
+
+_TIME_DIGITS = 6
+"""Times relative to now (s) are compared rounded to a microsecond: the same pass begun at a
+later robot time gives the same differences up to rounding."""
+
+
+def inert_names(module: n.Module) -> frozenset[str]:
+    """Names whose value cannot change what the program does: every read of them is in the
+    value assigned to an inert name, through arithmetic that cannot fail (``count = count +
+    1``, see :data:`_FLOWS`), or in a logging call (:data:`LOGGING_CALLS`). A name read in
+    any other call, a division or an index matters. Names are taken by spelling, whatever
+    their scope, which errs towards reading a name as one that matters."""
+    flows: dict[str, set[str]] = {}  # target name -> names its assigned values read
+    matters: set[str] = set()
+    assigned: set[str] = set()
+    stack: list[tuple[n.Node, str | None]] = [(module, None)]
+    while stack:
+        node, into = stack.pop()  # into: the name a value being read flows into, if any
+        kind = type(node)
+        if kind is n.Name:
+            if into is None:
+                matters.add(node.id)
+            elif into != "":
+                flows.setdefault(into, set()).add(node.id)
+            continue
+        if kind is n.Assign:
+            target = node.target
+            if type(target) is n.Name:
+                assigned.add(target.id)
+                stack.append((node.value, target.id))
+            else:  # a[i] = v, s.m = v: everything read there matters
+                stack.append((target, None))
+                stack.append((node.value, None))
+            continue
+        if kind is n.Declare:
+            assigned.add(node.name)
+            if node.value is not None:
+                stack.append((node.value, node.name))
+            continue
+        if kind is n.Call:
+            func = node.func
+            if type(func) is n.Name:  # a function's name is not a variable's
+                # a logging call's arguments change nothing; any other call may fail on
+                # what it is given (a square root, an index) or act on it
+                into_args = "" if func.id in LOGGING_CALLS else None
+                stack.extend((child, into_args) for child in (*node.args, *node.keywords))
+                continue
+            into = None
+        elif into and not (kind in _FLOWS or (kind is n.BinOp and node.op in _FLOW_OPS)):
+            into = None  # a division, an index...: it may fail on a later value
+        for name in node.__dataclass_fields__:  # type: ignore[attr-defined]
+            if name == "span":
+                continue
+            value = getattr(node, name)
+            if isinstance(value, n.Node):
+                stack.append((value, into))
+            elif isinstance(value, tuple):
+                stack.extend((v, into) for v in value if isinstance(v, n.Node))
+    # a name matters when it is read where it matters, or flows into one that does
+    todo = list(matters)
+    while todo:
+        for source in flows.get(todo.pop(), ()):
+            if source not in matters:
+                matters.add(source)
+                todo.append(source)
+    return frozenset(assigned - matters)
+
+
+def freeze(value: Any) -> Any:
+    """``value`` as a hashable key that two values the program cannot tell apart share."""
+    kind = type(value)
+    if kind in (float, int, bool, str) or value is None:
+        return (kind.__name__, value)
+    if kind is PoseValue:
+        return ("p", *value)
+    if kind is ListValue or kind is list or kind is tuple:
+        return ("l", getattr(value, "capacity", None), *(freeze(v) for v in value))
+    if kind is dict:
+        return ("d", *sorted((str(k), freeze(v)) for k, v in value.items()))
+    if kind is StructValue:
+        return ("s", *((k, freeze(v)) for k, v in value.members.items()))
+    if kind is Unknown:
+        return ("?", value.source, value.span, value.lean, freeze(value.relative),
+                value.likely)
+    if kind is Relative:
+        return ("r", id(value.anchor), value.offset, value.moves, value.statements)
+    if kind is ThreadHandle:  # a thread run anew each pass is the same thread
+        return ("t", value.thread.name, value.thread.done)
+    if kind is Anchor:
+        return ("o", id(value))
+    if isinstance(value, np.ndarray):
+        return ("a", value.shape, value.tobytes())
+    if isinstance(value, (np.floating, np.integer, np.bool_)):
+        return (kind.__name__, value.item())
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return (kind.__name__, *(freeze(getattr(value, f.name))
+                                 for f in dataclasses.fields(value)))
+    return ("o", id(value))
+
+
+def _ahead(when: float, now: float) -> float:
+    """How far ``when`` (s of robot time) lies ahead of ``now``, rounded; 0 when past (an
+    arm at rest since then is at rest, however long)."""
+    return max(0.0, round(when - now, _TIME_DIGITS))
+
+
+def _arm(robot: Any, now: float) -> Any:
+    """What the planner will do from now on: where everything planned ends, the move still
+    running or blending, TCP, payload, what is unknown of the position. None without a
+    planner (nothing to compare: no stop)."""
+    segments = getattr(robot, "segments", None)
+    if segments is None:
+        return None
+    pending = getattr(robot, "_pending", None)
+    unresolved = getattr(robot, "_unresolved", [])
+    last = unresolved[-1] if unresolved else (pending if pending is not None else (
+        segments[-1] if segments else None))
+    end = None if last is None else (
+        last.kind, last.pose_end.tobytes(), None if unresolved else last.q_end.tobytes(),
+        _ahead(last.end, now), last.radius, freeze(last.params))
+    unknown_at = getattr(robot, "unknown_at", None)
+    return (end, freeze(robot.q_start) if last is None else None, freeze(robot.tcp),
+            robot.payload_mass, freeze(robot.payload_cog),
+            None if unknown_at is None else unknown_at[0], repr(getattr(robot, "drift", None)),
+            _ahead(getattr(robot, "_free_at", 0.0), now))
+
+
+_ENVIRONMENT_SKIPPED = frozenset({"messages"})
+
+
+def _environment(env: Any) -> Any:
+    if not dataclasses.is_dataclass(env):
+        return ("o", id(env))
+    return tuple(freeze(getattr(env, f.name)) for f in dataclasses.fields(env)
+                 if f.name not in _ENVIRONMENT_SKIPPED)
+
+
+def _compared(name: str, value: Any, inert: frozenset[str]) -> bool:
+    """Whether a variable is part of the state: it is not inert, or its value is not a
+    number (a list or string that grows by ``+`` fails when it outgrows its limit)."""
+    return name not in inert or type(value) not in (int, float, bool)
+
+
+def pass_state(rt: Any, frame: Any, inert: frozenset[str]) -> Any:
+    """The state a pass of a loop run in ``frame`` of the interpreter ``rt`` begins in, as a
+    hashable key (see the module's docstring); variables named in ``inert`` are left out."""
+    arm = _arm(rt.robot, rt.time) if rt.robot is not None else ()
+    if arm is None:
+        return None
+    variables = [] if frame.vars is rt.globals else [
+        (k, freeze(v)) for k, v in frame.vars.items() if _compared(k, v, inert)]
+    variables.extend((k, freeze(v)) for k, v in rt.globals.items() if _compared(k, v, inert))
+    # in the order they were started (which decides ties), not by the count of threads
+    # ever started: a thread run anew each pass is the same thread
+    threads = tuple((t.name, _ahead(t.wake, rt.time)) for t in
+                    sorted(rt._threads, key=lambda t: t.order)
+                    if not t.done and t is not rt.current)
+    return (tuple(sorted(variables, key=lambda item: item[0])), arm,
+            _environment(rt.env), threads)
