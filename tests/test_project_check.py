@@ -348,3 +348,20 @@ def test_a_program_does_not_take_names_from_its_repository(tmp_path, capsys):
 def test_a_repository_top_far_above_is_not_searched(tmp_path, capsys):
     piece = _repository(tmp_path, depth=4)  # four folders down: more than HOST_LEVELS
     assert check(capsys, str(piece))[0] == 1
+
+
+def test_a_fragment_sees_the_installation_variables_its_repository_keeps_apart(tmp_path,
+                                                                              capsys):
+    # PolyScope programs in folders of their own, the installation's variables in another
+    # (the robot's /programs holds both; a repository often splits them)
+    (tmp_path / "UR_installation").mkdir()
+    (tmp_path / "UR_installation" / "cell.variables").write_text(
+        "contact_pose=p[0.4, -0.2, 0.2, 0.0, 3.1416, 0.0]\n")
+    program = tmp_path / "path_1" / "init_par.script"
+    program.parent.mkdir()
+    program.write_text("approach = pose_trans(contact_pose, p[0, 0, -0.05, 0, 0, 0])\n"
+                       "textmsg(approach)\n")
+    status, report = check(capsys, str(program))
+    assert status == 0 and not [f for f in report["findings"] if f["severity"] == "error"]
+    program.write_text("textmsg(retract_pose)\n")  # defined nowhere: still an error
+    assert check(capsys, str(program))[0] == 1

@@ -405,10 +405,11 @@ def _neighbours(path: Path, root: Path, known: set[str]) -> list[Path]:
     includes, inside a repository whose top (a folder holding ``.git``) is at most
     :data:`HOST_LEVELS` folders above its own: the project files of that repository, as
     ``urdsl lint`` of it sees them (a generator's pieces kept in one folder, the programs
-    whose definitions they use in another: names found there are not "defined nowhere"):
-    its script files only (another folder's installation is not this file's). Nothing for
-    a program, outside a repository (a download or temporary folder holds
-    unrelated files), or when the repository is too large for a project."""
+    whose definitions they use in another, the installation variables in a folder of
+    their own: names found there are not "defined nowhere"): its script files and
+    ``.variables``, as `urdsl lint` of the repository reads them. Nothing for a program,
+    outside a repository (a download or temporary folder holds unrelated files), or when the
+    repository is too large for a project."""
     script = load_script(path)
     if script is None or script.module is None or script.is_host:
         return []
@@ -422,7 +423,8 @@ def _neighbours(path: Path, root: Path, known: set[str]) -> list[Path]:
         folder = folder.parent
         if (folder / ".git").exists():
             tree = _bounded_tree(folder, MAX_TREE_FILES)
-            return [p for p in tree or () if p.suffix in SCRIPT_SUFFIXES
+            return [p for p in tree or () if (p.suffix in SCRIPT_SUFFIXES
+                                               or p.suffix == VARIABLES_SUFFIX)
                     and _key(p) not in known]
     return []
 
