@@ -278,3 +278,11 @@ def test_a_builtin_the_version_lacks_is_still_an_error():
 def test_an_unknown_function_is_still_urs102():
     assert "varmsg" in finding("varmesg(\"x\", 1)\n", "URS102").hint
     assert _codes("tool_poses()\n", version="3.15") == ["URS102"]
+
+
+@pytest.mark.parametrize("call", ['modbus_set_output_register("payload", 3)',
+                                  'modbus_set_output_signal("BRUSH", True)'])
+def test_modbus_outputs_set_from_the_main_program_need_not_say_so(call):
+    # is_secondary_program left out: programs that ran on e-Series robots do it
+    assert _codes(call + "\n") == []
+    assert _codes(call.replace(")", ", False)") + "\n") == []

@@ -348,3 +348,53 @@ def test_a_program_does_not_take_names_from_its_repository(tmp_path, capsys):
 def test_a_repository_top_far_above_is_not_searched(tmp_path, capsys):
     piece = _repository(tmp_path, depth=4)  # four folders down: more than HOST_LEVELS
     assert check(capsys, str(piece))[0] == 1
+
+
+def test_a_fragment_sees_the_installation_variables_its_repository_keeps_apart(tmp_path,
+                                                                              capsys):
+    # PolyScope programs in folders of their own, the installation's variables in another
+    # (the robot's /programs holds both; a repository often splits them)
+    (tmp_path / "UR_installation").mkdir()
+    (tmp_path / "UR_installation" / "cell.variables").write_text(
+        "contact_pose=p[0.4, -0.2, 0.2, 0.0, 3.1416, 0.0]\n")
+    program = tmp_path / "path_1" / "init_par.script"
+    program.parent.mkdir()
+    program.write_text("approach = pose_trans(contact_pose, p[0, 0, -0.05, 0, 0, 0])\n"
+                       "textmsg(approach)\n")
+    status, report = check(capsys, str(program))
+    assert status == 0 and not [f for f in report["findings"] if f["severity"] == "error"]
+    program.write_text("textmsg(retract_pose)\n")  # defined nowhere: still an error
+    assert check(capsys, str(program))[0] == 1
+
+
+def _urp_including(*files: str) -> bytes:
+    """A PolyScope 5 program whose Robot Program runs the script ``files`` in order."""
+    nodes = "".join(f'<Script type="File"><cachedContents></cachedContents>'
+                    f"<file>/programs/cell/{name}</file></Script>" for name in files)
+    return (f'<URProgram name="cell" installation="default" directory="/programs/cell" '
+            f'createdIn="5.11.0" lastSavedIn="5.11.0"><children><MainProgram '
+            f'runOnlyOnce="true"><children>{nodes}</children></MainProgram></children>'
+            f"</URProgram>").encode()
+
+
+INIT = ("def cell_init():\n  global angle = 0\n  global last = read_input_integer_register(43)\n"
+        "end\n\ncell_init()\n")
+WAIT = ("def cell_wait():\n  command = read_input_integer_register(43)\n"
+        "  while command == last:\n    sync()\n    command = read_input_integer_register(43)\n"
+        "  end\n  global angle = angle + 5\n  global last = command\nend\n\ncell_wait()\n")
+
+
+def test_a_polyscope_program_hosts_the_script_files_its_script_nodes_run(tmp_path, capsys):
+    # each file a complete program of its own (def + call), run by the .urp one after another:
+    # what the first sets, the next reads
+    (tmp_path / "cell_init.script").write_text(INIT)
+    (tmp_path / "cell_wait.script").write_text(WAIT)
+    (tmp_path / "cell.urp").write_bytes(_urp_including("cell_init.script", "cell_wait.script"))
+    status, report = check(capsys, str(tmp_path / "cell_wait.script"))
+    assert status == 0, report["findings"]
+    assert "cell.urp" in report["context"]
+    assert main(["lint", str(tmp_path)]) == 0
+    capsys.readouterr()
+    # without the program, the names the file reads before it sets them are not defined
+    (tmp_path / "cell.urp").unlink()
+    assert check(capsys, str(tmp_path / "cell_wait.script"))[0] == 1

@@ -132,3 +132,34 @@ def test_the_virtual_controller_runs_a_repeating_loop_on():
 ])
 def test_inert_names_are_those_that_change_nothing_the_program_does(program, inert):
     assert set(inert_names(parse(program, "x.script"))) == inert
+
+
+def test_a_thread_asleep_past_the_next_pass_keeps_the_loop_running_until_it_wakes():
+    report = check(f"""
+        stop = False
+        thread watchdog():
+          sleep(60)
+          stop = True
+        end
+        run watchdog()
+        while True:
+          if stop:
+            movel(p[3.0, 0, 0.2, 0, 3.1416, 0])
+          end
+          movej({A}, a=1.4, v=1.05)
+          movej({B}, a=1.4, v=1.05)
+        end
+        """)
+    assert "URS301" in report.codes()  # the move after 60 s is checked
+
+
+def test_what_a_loop_sends_is_a_log_not_a_state():
+    report = check(f"""
+        socket_open("127.0.0.1", 30000, "plc")
+        while True:
+          movej({A}, a=1.4, v=1.05)
+          socket_send_string("at A", "plc")
+          movej({B}, a=1.4, v=1.05)
+        end
+        """)
+    assert repeats(report) and len(report.moves) == 4

@@ -62,3 +62,10 @@ def test_a_users_thread_left_running_is_still_reported():
                    "  run mine()\n  sleep(1)")
     (left,) = [f for f in report.findings if f.code == "URS311"]
     assert "mine" in left.message and "rq_gripper" not in left.message
+
+
+def test_threads_running_when_the_check_stops_the_program_are_not_left_running():
+    report = check("thread mine():\n    while True:\n      sync()\n    end\n  end\n"
+                   "  run mine()\n  n = 0\n  while True:\n    n = n + 1\n    if n < 0:\n"
+                   "      halt\n    end\n    sleep(1)\n  end")
+    assert "URS312" in report.codes() and "URS311" not in report.codes()

@@ -53,15 +53,17 @@ def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
     threads: set[str] = set()
     for scope in analysis.scopes:
         first_write = _first_writes(scope) if scope.kind == "top" else {}
+        early = _read_before_declared(scope)
         for name in scope.reads:
             # a name the controller may define itself (``pi``, [U]) is still looked up in the
             # project: a project that assigns it gives it the value the file reads
             if not analysis.defined(name.id, scope) or (
                     name.id in BUILTIN_VARIABLES and not _bound_in_file(analysis, name.id, scope)):
                 reads.add(name.id)
-            elif name.span.start < first_write.get(name.id, -1):
+            elif name.span.start < first_write.get(name.id, -1) or name.id in early:
                 # read at the first level before the file's first write of it (``if
-                # run_program:`` ... ``run_program = False``): the value comes from the host
+                # run_program:`` ... ``run_program = False``), or in a function before it
+                # declares the global it sets: the value comes from the host
                 reads.add(name.id)
         for call in scope.calls:
             name = call.func.id  # type: ignore[union-attr]
@@ -85,6 +87,30 @@ def _first_writes(scope) -> dict[str, int]:
             continue
         found[name] = min(node.span.start for node in nodes)
     return found
+
+
+def _read_before_declared(scope) -> set[str]:
+    """Globals a scope reads in a statement before (or in) the one that declares them with a
+    value (``while command == last:`` ... ``global last = command``): there the name holds
+    what the program gave it before (the Init script a PolyScope program runs first, say).
+    By statement order, not by offset: a file's context puts other files' definitions first."""
+    declared = {name for name, d in scope.declared_global.items()
+                if name not in scope.params and name not in scope.declared_local}
+    if not declared:
+        return set()
+    seen: set[str] = set()
+    early: set[str] = set()
+    for statement in scope.body:
+        if isinstance(statement, (n.FunctionDef, n.ThreadDef)):
+            continue
+        nodes = list(n.walk(statement))
+        targets = {id(x.target) for x in nodes if type(x) is n.Assign}
+        reads = {x.id for x in nodes
+                 if type(x) is n.Name and x.id in declared and id(x) not in targets}
+        early |= reads - seen
+        seen |= {x.name for x in nodes if type(x) is n.Declare and x.value is not None
+                 and x.scope == "global"}
+    return early
 
 
 def _bound_in_file(analysis, name: str, scope) -> bool:

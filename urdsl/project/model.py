@@ -24,6 +24,7 @@ fragment's file, or when the fragment's code lines are found inlined in the host
 from __future__ import annotations
 
 import contextlib
+import io
 import os
 import re
 import tomllib
@@ -42,6 +43,9 @@ __all__ = [
 
 SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
 VARIABLES_SUFFIX = ".variables"
+URP_SUFFIX = ".urp"
+"""A PolyScope program: a host of the script files its Script nodes name, read as the
+URScript :mod:`urdsl.polyscope` compiles it to (see :func:`load_urp`)."""
 MAX_FILE_BYTES = 5_000_000
 """Larger files are not read as part of a project (they are not hand-written programs)."""
 
@@ -297,6 +301,9 @@ class Project:
                     known.add(key)
                     found.append(candidate)
         scripts = [load_script(p) for p in found if p.suffix in SCRIPT_SUFFIXES]
+        exported = {_key(p.with_suffix("")) for p in found if p.suffix in SCRIPT_SUFFIXES}
+        scripts += [load_urp(p) for p in found if p.suffix == URP_SUFFIX
+                    and _key(p.with_suffix("")) not in exported]  # else its .script is it
         variables = [read_variables(p) for p in found if p.suffix == VARIABLES_SUFFIX]
         return cls(root, [s for s in scripts if s is not None], variables, frozenset(explicit))
 
@@ -368,7 +375,8 @@ class Project:
 # ---- files -----------------------------------------------------------------------------------
 
 def _wanted(path: Path) -> bool:
-    return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix == VARIABLES_SUFFIX)
+    return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix == VARIABLES_SUFFIX
+                               or path.suffix == URP_SUFFIX)
 
 
 MAX_TREE_VISITS = 50_000
@@ -405,10 +413,11 @@ def _neighbours(path: Path, root: Path, known: set[str]) -> list[Path]:
     includes, inside a repository whose top (a folder holding ``.git``) is at most
     :data:`HOST_LEVELS` folders above its own: the project files of that repository, as
     ``urdsl lint`` of it sees them (a generator's pieces kept in one folder, the programs
-    whose definitions they use in another: names found there are not "defined nowhere"):
-    its script files only (another folder's installation is not this file's). Nothing for
-    a program, outside a repository (a download or temporary folder holds
-    unrelated files), or when the repository is too large for a project."""
+    whose definitions they use in another, the installation variables in a folder of
+    their own: names found there are not "defined nowhere"): its script files and
+    ``.variables``, as `urdsl lint` of the repository reads them. Nothing for a program,
+    outside a repository (a download or temporary folder holds unrelated files), or when the
+    repository is too large for a project."""
     script = load_script(path)
     if script is None or script.module is None or script.is_host:
         return []
@@ -422,7 +431,8 @@ def _neighbours(path: Path, root: Path, known: set[str]) -> list[Path]:
         folder = folder.parent
         if (folder / ".git").exists():
             tree = _bounded_tree(folder, MAX_TREE_FILES)
-            return [p for p in tree or () if p.suffix in SCRIPT_SUFFIXES
+            return [p for p in tree or () if (p.suffix in SCRIPT_SUFFIXES
+                                               or p.suffix == VARIABLES_SUFFIX)
                     and _key(p) not in known]
     return []
 
@@ -497,7 +507,7 @@ def _key(path: Path) -> str:
         return str(path)
 
 
-_CACHE: dict[tuple[str, str, int, int, str], ScriptFile] = {}
+_CACHE: dict[tuple, ScriptFile | None] = {}
 
 
 def load_script(path: Path) -> ScriptFile | None:
@@ -520,6 +530,37 @@ def load_script(path: Path) -> ScriptFile | None:
     except OSError:
         return None
     script = script_file(path, _display(path), text)
+    if len(_CACHE) > 512:
+        _CACHE.clear()
+    _CACHE[key] = script
+    return script
+
+
+def load_urp(path: Path) -> ScriptFile | None:
+    """The PolyScope program at ``path`` as the URScript it compiles to (with the script
+    files its Script nodes name, its installation and variables, as ``urdsl compile``
+    writes it), as a host of those files; None when it cannot be read or compiled (that is
+    said by ``urdsl lint``/``check`` of the ``.urp`` itself). Cached as :func:`load_script`."""
+    try:
+        stat = path.stat()
+    except OSError:
+        return None
+    if stat.st_size > MAX_FILE_BYTES:
+        return None
+    key = ("urp", str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns,
+           os.getcwd() if path.is_absolute() else "")
+    if key in _CACHE:
+        return _CACHE[key]
+    from ..polyscope.command import load
+
+    try:
+        with contextlib.redirect_stderr(io.StringIO()):  # its installation's warnings: said
+            _program, compiled = load(path)              # by a lint or check of the .urp
+        text = compiled.text
+    except Exception:  # noqa: BLE001 - any unreadable program is simply not a host here
+        script = None
+    else:
+        script = script_file(path, _display(path), text)
     if len(_CACHE) > 512:
         _CACHE.clear()
     _CACHE[key] = script

@@ -18,11 +18,13 @@ value that creeps by rounding keeps the loop running as before, never the revers
 from __future__ import annotations
 
 import dataclasses
+from collections import deque
 from typing import Any
 
 import numpy as np
 
 from ..script import nodes as n
+from .environment import SocketModel
 from .values import (
     Anchor,
     ListValue,
@@ -131,6 +133,11 @@ def freeze(value: Any) -> Any:
                 value.likely)
     if kind is Relative:
         return ("r", id(value.anchor), value.offset, value.moves, value.statements)
+    if kind is SocketModel:  # what it sent is a log: only what reads will return counts
+        return ("socket", value.host, value.port, value.connected,
+                tuple(freeze(v) for v in value.incoming))
+    if kind is deque:
+        return ("l", None, *(freeze(v) for v in value))
     if kind is ThreadHandle:  # a thread run anew each pass is the same thread
         return ("t", value.thread.name, value.thread.done)
     if kind is Anchor:

@@ -233,8 +233,12 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     for warning in planner.warnings:  # Overlapping Blends, or a stoppable move's far target
         code = "URS210" if warning.code == "condition" else "URS309"
         report.findings.append(Finding.of(code, warning.message, warning.span, warning.time))
-    generated = generated_threads(module) if result.threads_left_running else set()
-    left = [name for name in result.threads_left_running if name not in generated]
+    # threads still running when the check stopped the program (--max-time) are not left
+    # running by the program
+    running = [] if result.stopped_at_max_time or result.stopped else \
+        result.threads_left_running
+    generated = generated_threads(module) if running else set()
+    left = [name for name in running if name not in generated]
     if left:
         names = ", ".join(left)
         report.findings.append(Finding.of(
