@@ -398,3 +398,12 @@ def test_a_polyscope_program_hosts_the_script_files_its_script_nodes_run(tmp_pat
     # without the program, the names the file reads before it sets them are not defined
     (tmp_path / "cell.urp").unlink()
     assert check(capsys, str(tmp_path / "cell_wait.script"))[0] == 1
+
+
+def test_only_the_first_level_reading_a_global_before_setting_it_asks_the_program():
+    wrapped = parse("def step():\n  if busy:\n    sync()\n  end\n  global busy = False\nend\n"
+                    "step()\n")
+    assert needed_names(wrapped)[0] == {"busy"}  # the program def a file wraps itself in
+    library = parse("def weave():\n  a = gap[0]\n  global gap = [1, 2]\nend\n"
+                    "def start():\n  global gap = [0, 0]\nend\n")
+    assert needed_names(library)[0] == set()  # start() may run first: the file has it

@@ -53,7 +53,7 @@ def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
     threads: set[str] = set()
     for scope in analysis.scopes:
         first_write = _first_writes(scope) if scope.kind == "top" else {}
-        early = _read_before_declared(scope)
+        early = _read_before_declared(scope) if scope.kind == "top" else set()
         for name in scope.reads:
             # a name the controller may define itself (``pi``, [U]) is still looked up in the
             # project: a project that assigns it gives it the value the file reads
@@ -90,10 +90,12 @@ def _first_writes(scope) -> dict[str, int]:
 
 
 def _read_before_declared(scope) -> set[str]:
-    """Globals a scope reads in a statement before (or in) the one that declares them with a
-    value (``while command == last:`` ... ``global last = command``): there the name holds
-    what the program gave it before (the Init script a PolyScope program runs first, say).
-    By statement order, not by offset: a file's context puts other files' definitions first."""
+    """Globals the first level of a file (or of the program ``def`` a file wraps itself in)
+    reads in a statement before (or in) the one that declares them with a value (``while
+    command == last:`` ... ``global last = command``): there the name holds what the program
+    gave it before (the Init script a PolyScope program runs first, say). By statement
+    order, not by offset: a file's context puts other files' definitions first. A function's
+    own order says nothing (another function may set the global before it is called)."""
     declared = {name for name, d in scope.declared_global.items()
                 if name not in scope.params and name not in scope.declared_local}
     if not declared:

@@ -510,18 +510,27 @@ def _key(path: Path) -> str:
 _CACHE: dict[tuple, ScriptFile | None] = {}
 
 
-def load_script(path: Path) -> ScriptFile | None:
-    """The parsed script file at ``path`` (None when it cannot be read or is too large).
-    Parsed files are cached by path, size and modification time (and, for an absolute path,
-    the working folder its shown name is relative to)."""
+def _cache_key(path: Path, kind: str) -> tuple | None:
+    """What a file read as ``kind`` is cached by: its path, size and modification time (and,
+    for an absolute path, the working folder its shown name is relative to); None when it
+    cannot be read or is larger than :data:`MAX_FILE_BYTES`."""
     try:
         stat = path.stat()
     except OSError:
         return None
     if stat.st_size > MAX_FILE_BYTES:
         return None
-    key = (str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns,
-           os.getcwd() if path.is_absolute() else "")  # the name shown depends on it
+    return (kind, str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns,
+            os.getcwd() if path.is_absolute() else "")  # the name shown depends on it
+
+
+def load_script(path: Path) -> ScriptFile | None:
+    """The parsed script file at ``path`` (None when it cannot be read or is too large).
+    Parsed files are cached by path, size and modification time (and, for an absolute path,
+    the working folder its shown name is relative to)."""
+    key = _cache_key(path, "script")
+    if key is None:
+        return None
     cached = _CACHE.get(key)
     if cached is not None:
         return cached
@@ -541,14 +550,9 @@ def load_urp(path: Path) -> ScriptFile | None:
     files its Script nodes name, its installation and variables, as ``urdsl compile``
     writes it), as a host of those files; None when it cannot be read or compiled (that is
     said by ``urdsl lint``/``check`` of the ``.urp`` itself). Cached as :func:`load_script`."""
-    try:
-        stat = path.stat()
-    except OSError:
+    key = _cache_key(path, "urp")
+    if key is None:
         return None
-    if stat.st_size > MAX_FILE_BYTES:
-        return None
-    key = ("urp", str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns,
-           os.getcwd() if path.is_absolute() else "")
     if key in _CACHE:
         return _CACHE[key]
     from ..polyscope.command import load
