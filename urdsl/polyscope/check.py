@@ -397,8 +397,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     urcaps = {number for number, _node in generated.urcap_nodes()}
     report = check_tree(with_urcap_time(module, urcaps), generated.filename, file_options)
     report.inferred = inference
-    report.findings = node_findings(generated, [
-        f for f in report.findings if not _polyscope_threads_only(f)])
+    report.findings = node_findings(generated, report.findings)
     source = module.span.source
     for diagnostic in urcap_diagnostics(generated):
         span = n.Span(source, _offset(generated.text, diagnostic.line), _offset(
@@ -455,19 +454,6 @@ def installation_defaults(options, installation: Installation, cell_given: bool)
     if not taken:
         return []
     return [f"from {Path(installation.path).name}: " + ", ".join(taken)]
-
-
-_THREADS_LEFT = re.compile(r"thread\(s\) (.+?) still ran")
-
-
-def _polyscope_threads_only(finding) -> bool:
-    """A URS311 finding about PolyScope's own step-counter thread only (the controller stops
-    it at the program's end, as it is meant to)."""
-    if finding.code != "URS311":
-        return False
-    names = _THREADS_LEFT.search(finding.message)
-    return names is not None and all(name.startswith("Step_Counter_Thread_")
-                                     for name in names.group(1).split(", "))
 
 
 def _offset(text: str, line: int) -> int:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from .compile import Compiled, CompileError, compile_program, parse_variables
@@ -76,11 +77,16 @@ def expand_folders(names: list[str], verb: str) -> list[tuple[str, str | None]]:
     return files
 
 
-def _installation_for(program: Program, path: str | Path) -> Installation | None:
+def _warn(message: str) -> None:
+    print(f"warning: {message}", file=sys.stderr)
+
+
+def _installation_for(program: Program, path: str | Path,
+                      warn: Callable[[str], None] = _warn) -> Installation | None:
     """The installation the program names (``installationRelativePath``, e.g.
     ``../default.installation``, else ``NAME.installation`` in its folder), else the only
-    installation there; ``None`` when there is none. A broken installation is reported on
-    standard error and left out."""
+    installation there; ``None`` when there is none. A missing or broken installation is
+    said through ``warn`` (standard error) and left out."""
     folder = Path(path).parent
     candidate: Path | None = None
     for name in (program.installation_path, program.installation):
@@ -92,29 +98,29 @@ def _installation_for(program: Program, path: str | Path) -> Installation | None
         candidate = find_installation(path)
     if candidate is None:
         if program.installation:
-            print(f"warning: {folder / (program.installation + '.installation')}: the "
-                  "installation the program names is not there; compiled without its "
-                  "preamble", file=sys.stderr)
+            warn(f"{folder / (program.installation + '.installation')}: the installation "
+                 "the program names is not there; compiled without its preamble")
         return None
     try:
         return read_installation(candidate)
     except InstallationError as error:
-        print(f"warning: {error}; compiled without it", file=sys.stderr)
+        warn(f"{error}; compiled without it")
         return None
 
 
-def load(path: str | Path) -> tuple[Program, Compiled]:
+def load(path: str | Path, warn: Callable[[str], None] = _warn) -> tuple[Program, Compiled]:
     """Read and compile the ``.urp`` at ``path`` with its installation and the
     installation's variables. Raises :class:`UrpError` or :class:`CompileError` (messages
-    name the file and node)."""
-    program, _installation, compiled = load_all(path)
+    name the file and node); a missing or broken installation is said through ``warn``."""
+    program, _installation, compiled = load_all(path, warn)
     return program, compiled
 
 
-def load_all(path: str | Path) -> tuple[Program, Installation | None, Compiled]:
+def load_all(path: str | Path, warn: Callable[[str], None] = _warn
+             ) -> tuple[Program, Installation | None, Compiled]:
     """:func:`load`, also giving the installation read (None when there is none)."""
     program = read_urp(path)
-    installation = _installation_for(program, path)
+    installation = _installation_for(program, path, warn)
     variables: list[tuple[str, str]] = []
     if installation is not None:
         file = Path(installation.path).with_suffix(".variables")

@@ -62,8 +62,8 @@ def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
                 reads.add(name.id)
             elif name.span.start < first_write.get(name.id, -1) or name.id in early:
                 # read at the first level before the file's first write of it (``if
-                # run_program:`` ... ``run_program = False``), or in a function before it
-                # declares the global it sets: the value comes from the host
+                # run_program:`` ... ``run_program = False``), or before the statement
+                # that declares it global with a value: the value comes from the host
                 reads.add(name.id)
         for call in scope.calls:
             name = call.func.id  # type: ignore[union-attr]

@@ -24,7 +24,6 @@ fragment's file, or when the fragment's code lines are found inlined in the host
 from __future__ import annotations
 
 import contextlib
-import io
 import os
 import re
 import tomllib
@@ -558,8 +557,8 @@ def load_urp(path: Path) -> ScriptFile | None:
     from ..polyscope.command import load
 
     try:
-        with contextlib.redirect_stderr(io.StringIO()):  # its installation's warnings: said
-            _program, compiled = load(path)              # by a lint or check of the .urp
+        # a missing installation is said by a lint or check of the .urp itself, not here
+        _program, compiled = load(path, warn=lambda _message: None)
         text = compiled.text
     except Exception:  # noqa: BLE001 - any unreadable program is simply not a host here
         script = None

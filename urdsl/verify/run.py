@@ -237,7 +237,8 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     # running by the program
     running = [] if result.stopped_at_max_time or result.stopped else \
         result.threads_left_running
-    generated = generated_threads(module) if running else set()
+    blocks = urcap_blocks(module)
+    generated = generated_threads(module, blocks) if running else set()
     left = [name for name in running if name not in generated]
     if left:
         names = ", ".join(left)
@@ -284,7 +285,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     _phase(options, "checking the motion")
     report.findings.extend(_trace_findings(trace, planner, robot, options, final,
                                            module.span))
-    report.findings = group_urcap_notes(module, report.findings)
+    report.findings = group_urcap_notes(blocks, report.findings)
     report.sort()
     return report
 
@@ -310,21 +311,21 @@ def urcap_blocks(module) -> list[tuple[str, int, int]]:
     return blocks
 
 
-def generated_threads(module) -> set[str]:
-    """Threads PolyScope or a URCap wrote into a program (a step counter, a gripper's
-    communication thread): the program may end while they run, the controller stops them,
-    and the user has nothing to change."""
-    blocks = urcap_blocks(module)
+def generated_threads(module, blocks: list[tuple[str, int, int]]) -> set[str]:
+    """Threads PolyScope or a URCap (its code in ``blocks``, see :func:`urcap_blocks`) wrote
+    into a program (a step counter, a gripper's communication thread): the program may end
+    while they run, the controller stops them, and the user has nothing to change."""
     return {t.name for t in n.walk(module) if type(t) is n.ThreadDef and (
         t.name.startswith("Step_Counter_Thread_")
         or any(first <= t.span.line <= last for _name, first, last in blocks))}
 
 
-def group_urcap_notes(module, findings: list[Finding]) -> list[Finding]:
+def group_urcap_notes(blocks: list[tuple[str, int, int]],
+                      findings: list[Finding]) -> list[Finding]:
     """The URS210 notes (what depends on a value unknown offline) at statements of one
-    URCap's code, when there are several, as one: the user did not write that code, and a
-    Robotiq preamble alone holds some fifty device conditions."""
-    blocks = urcap_blocks(module)
+    URCap's code (``blocks``, see :func:`urcap_blocks`), when there are several, as one: the
+    user did not write that code, and a Robotiq preamble alone holds some fifty device
+    conditions."""
     if not blocks:
         return findings
     grouped: dict[tuple[str, int, int], list[Finding]] = {}
