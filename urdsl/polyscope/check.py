@@ -192,14 +192,16 @@ def undefined_globals(module: n.Module) -> list[str]:
 
 
 def missing_features(generated: Generated) -> dict[str, str]:
-    """Installation features the program reads as variables while its installation is not
-    there (the preamble that defines them is not written): each with where its value
-    would come from."""
+    """Installation variables and features the program refers to while its installation is
+    not there (the preamble and ``.variables`` that define them are not read): each with
+    where its value would come from."""
     if generated.installation is not None:
         return {}
-    named = generated.program.installation or "(none named)"
-    return {name: f"a feature of the installation {named}, which is not beside the program"
-            for name in sorted(generated.program.feature_variables)}
+    program = generated.program
+    named = f"{program.installation}.installation" if program.installation else "(none named)"
+    return {name: f"a {'feature' if name in program.feature_variables else 'name'} of the "
+                  f"installation {named} (not beside the program)"
+            for name in sorted(program.feature_variables | program.installation_names)}
 
 
 def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
@@ -211,9 +213,9 @@ def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
     if urcaps:
         names = ", ".join(dict.fromkeys(node.title for _number, node in urcaps))
         values = {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
-    features = missing_features(generated)
-    return values | {name: why for name, why in features.items()
-                     if name in undefined_globals(module)}
+    # the missing installation's preamble would define each of its names before the program
+    # runs, also one the program assigns itself (``i_count = i_count + 1``)
+    return values | missing_features(generated)
 
 
 def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Module, list[str]]:
@@ -388,7 +390,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
                                            cell_given=bool(cell_path)))
     file_options.unknown_globals = urcap_values(generated, module)
     if file_options.unknown_globals:
-        notes.append("unknown values (URCap nodes' results, features of a missing "
+        notes.append("unknown values (URCap nodes' results, names of a missing "
                      "installation): " + ", ".join(sorted(file_options.unknown_globals)))
     module, stand_ins = with_urcap_functions(generated, module)
     if stand_ins:
