@@ -366,9 +366,15 @@ class Project:
                     and script in self.hosts_of(s)]
         return FileContext(self, script, hosts, included)
 
-    def diagnostics(self) -> list[Diagnostic]:
-        """Problems in the installation variables files (bad lines)."""
-        return [d for variables in self.variables for d in variables.diagnostics]
+    def diagnostics(self, near: str | Path | None = None) -> list[Diagnostic]:
+        """Problems in the installation variables files (bad lines); with ``near`` (a file
+        linted on its own), only those of the files in its folder or a folder above it: the
+        installations of other programs of the tree are not its business."""
+        chosen = self.variables
+        if near is not None:
+            folders = {Path(near).resolve().parent, *Path(near).resolve().parents}
+            chosen = [v for v in chosen if Path(v.filename).resolve().parent in folders]
+        return [d for variables in chosen for d in variables.diagnostics]
 
 
 # ---- files -----------------------------------------------------------------------------------
