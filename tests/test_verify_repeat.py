@@ -163,3 +163,27 @@ def test_what_a_loop_sends_is_a_log_not_a_state():
         end
         """)
     assert repeats(report) and len(report.moves) == 4
+
+
+def test_a_sync_thread_whose_offset_inside_a_frame_drifts_still_repeats():
+    # PolyScope's step-counter thread syncs every 2 ms frame; a pass that takes a time that
+    # is no whole number of frames (a move of 1.0713 s) leaves the thread's offset inside its
+    # frame different each pass. The controller runs threads on frames: the passes repeat.
+    report = check(f"""
+        def cell():
+          steps = 0.0
+          thread Step_Counter_Thread_1():
+            while (True):
+              steps = steps + 1.0
+              sync()
+            end
+          end
+          run Step_Counter_Thread_1()
+          while True:
+            movej({A}, a=1.4, v=1.05)
+            sleep(0.0007)
+            movej({B}, a=1.4, v=1.05)
+          end
+        end
+        """)
+    assert repeats(report) and report.loop.passes <= 3

@@ -213,9 +213,11 @@ def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
     if urcaps:
         names = ", ".join(dict.fromkeys(node.title for _number, node in urcaps))
         values = {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
-    # the missing installation's preamble would define each of its names before the program
-    # runs, also one the program assigns itself (``i_count = i_count + 1``)
-    return values | missing_features(generated)
+    # the missing installation's preamble would define each of its names the program uses
+    # before the program runs, also one the program assigns itself (``i_count = i_count + 1``)
+    used = {node.id for node in n.walk(module) if isinstance(node, n.Name)}
+    return values | {name: why for name, why in missing_features(generated).items()
+                     if name in used}
 
 
 def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Module, list[str]]:

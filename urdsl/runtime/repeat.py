@@ -18,6 +18,7 @@ value that creeps by rounding keeps the loop running as before, never the revers
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections import deque
 from typing import Any
 
@@ -51,6 +52,9 @@ domain): only through these is the assigned name's inertness passed on to what i
 _TIME_DIGITS = 6
 """Times relative to now (s) are compared rounded to a microsecond: the same pass begun at a
 later robot time gives the same differences up to rounding."""
+
+FRAME = 0.002
+"""The controller's frame in s (500 Hz)."""
 
 
 def inert_names(module: n.Module) -> frozenset[str]:
@@ -158,6 +162,13 @@ def _ahead(when: float, now: float) -> float:
     return max(0.0, round(when - now, _TIME_DIGITS))
 
 
+def _frames_ahead(when: float, now: float) -> int:
+    """How many controller frames (:data:`FRAME`, 2 ms) ahead of ``now`` a thread wakes: the
+    controller runs its threads on frames, so two passes whose threads wake within the same
+    frame are the same to it (a ``sync()`` loop's offset inside a frame is urdsl's own)."""
+    return max(0, math.ceil(round((when - now) / FRAME, _TIME_DIGITS)))
+
+
 def _arm(robot: Any, now: float) -> Any:
     """What the planner will do from now on: where everything planned ends, the move still
     running or blending, TCP, payload, what is unknown of the position. None without a
@@ -206,7 +217,7 @@ def pass_state(rt: Any, frame: Any, inert: frozenset[str]) -> Any:
     variables.extend((k, freeze(v)) for k, v in rt.globals.items() if _compared(k, v, inert))
     # in the order they were started (which decides ties), not by the count of threads
     # ever started: a thread run anew each pass is the same thread
-    threads = tuple((t.name, _ahead(t.wake, rt.time)) for t in
+    threads = tuple((t.name, _frames_ahead(t.wake, rt.time)) for t in
                     sorted(rt._threads, key=lambda t: t.order)
                     if not t.done and t is not rt.current)
     return (tuple(sorted(variables, key=lambda item: item[0])), arm,
