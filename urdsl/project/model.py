@@ -30,7 +30,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..polyscope.variables import VariablesFile, read_variables
+from ..polyscope.variables import VariablesFile, parse_variables, read_variables
 from ..script import nodes as n
 from ..script.diagnostics import Diagnostic, ScriptError
 from ..script.parser import parse
@@ -42,6 +42,9 @@ __all__ = [
 
 SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
 VARIABLES_SUFFIX = ".variables"
+INSTALLATION_SUFFIX = ".installation"
+"""A PolyScope installation: its point and plane features are globals of every program run
+with it (see :func:`installation_features`)."""
 URP_SUFFIX = ".urp"
 """A PolyScope program: a host of the script files its Script nodes name, read as the
 URScript :mod:`urdsl.polyscope` compiles it to (see :func:`load_urp`)."""
@@ -304,6 +307,8 @@ class Project:
         scripts += [load_urp(p) for p in found if p.suffix == URP_SUFFIX
                     and _key(p.with_suffix("")) not in exported]  # else its .script is it
         variables = [read_variables(p) for p in found if p.suffix == VARIABLES_SUFFIX]
+        variables += [features for p in found if p.suffix == INSTALLATION_SUFFIX
+                      and (features := installation_features(p)) is not None]
         return cls(root, [s for s in scripts if s is not None], variables, frozenset(explicit))
 
     # -- questions ---------------------------------------------------------------------------
@@ -380,8 +385,29 @@ class Project:
 # ---- files -----------------------------------------------------------------------------------
 
 def _wanted(path: Path) -> bool:
-    return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix == VARIABLES_SUFFIX
-                               or path.suffix == URP_SUFFIX)
+    return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix in (
+        VARIABLES_SUFFIX, URP_SUFFIX, INSTALLATION_SUFFIX))
+
+
+def installation_features(path: Path) -> VariablesFile | None:
+    """The features of the installation at ``path`` that programs see as variables (point
+    and plane features: ``pose_trans(Plane_1, p)``), as installation variables
+    ``Plane_1=p[...]`` of a file named ``PATH (features)``; None when it has none or cannot be
+    read (a ``.urp`` that names it says so). PolyScope writes them into the preamble of every
+    program run with that installation, so a script file a program includes may use them."""
+    from ..polyscope.installation import InstallationError, read_installation
+
+    try:
+        if path.stat().st_size > MAX_FILE_BYTES:
+            return None
+        installation = read_installation(path)
+    except (InstallationError, OSError):
+        return None
+    if not installation.features:
+        return None
+    text = "".join(f"{name}=p[{', '.join(repr(float(v)) for v in pose)}]\n"
+                   for name, pose in installation.features)
+    return parse_variables(text, f"{path} (features)")
 
 
 MAX_TREE_VISITS = 50_000
@@ -436,9 +462,8 @@ def _neighbours(path: Path, root: Path, known: set[str]) -> list[Path]:
         folder = folder.parent
         if (folder / ".git").exists():
             tree = _bounded_tree(folder, MAX_TREE_FILES)
-            return [p for p in tree or () if (p.suffix in SCRIPT_SUFFIXES
-                                               or p.suffix == VARIABLES_SUFFIX)
-                    and _key(p) not in known]
+            return [p for p in tree or () if (p.suffix in SCRIPT_SUFFIXES or p.suffix in (
+                VARIABLES_SUFFIX, INSTALLATION_SUFFIX)) and _key(p) not in known]
     return []
 
 
