@@ -306,6 +306,6 @@ def test_warnings_in_code_a_urcap_wrote_are_counted_in_one_note_errors_stay():
     assert [(d.code, d.severity, d.line) for d in found] == [
         ("URS122", "info", 2), ("URS102", "error", 6), ("URS112", "warning", 8)]
     assert found[0].column == 3
-    assert "2 warning(s) (URS112) in the code Gripper wrote" in found[0].message
+    assert "2 finding(s) (URS112) in the code Gripper wrote" in found[0].message
     quiet = lint_text(text, "export.script", build_settings(ignore=["URS122"]))
     assert [d.code for d in quiet] == ["URS102", "URS112"]

@@ -117,23 +117,12 @@ def _folded_in_urcap_code(found: list[Diagnostic], tree: n.Module,
     source = tree.span.source or n.Source("", "<generated>")
     for (urcap, first, last), inside in folded.items():
         codes = ", ".join(sorted({d.code for d in inside}))
-        start = _offset(source.text, first)
-        start += len(source.text[start:].split("\n", 1)[0]) - len(
-            source.text[start:].split("\n", 1)[0].lstrip())  # at the begin comment itself
-        span = n.Span(source, start, start)
+        text = source.line_text(first)
+        start = source.line_start(first) + len(text) - len(text.lstrip())  # at the comment
         kept.append(Diagnostic.at(
-            span, f"{len(inside)} warning(s) ({codes}) in the code {urcap} wrote into the "
+            n.Span(source, start, start),
+            f"{len(inside)} finding(s) ({codes}) in the code {urcap} wrote into the "
             f"program (lines {first}-{last}) not shown: the URCap writes that code anew at "
             "every save", code=URCAP_CODE_RULE.code, severity=URCAP_CODE_RULE.severity))
     return kept
 
-
-def _offset(text: str, line: int) -> int:
-    """The character offset of the start of 1-based ``line`` in ``text``."""
-    offset = 0
-    for _ in range(line - 1):
-        found = text.find("\n", offset)
-        if found < 0:
-            return len(text)
-        offset = found + 1
-    return offset

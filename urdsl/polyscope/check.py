@@ -404,8 +404,8 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     report.findings = node_findings(generated, report.findings)
     source = module.span.source
     for diagnostic in urcap_diagnostics(generated):
-        span = n.Span(source, _offset(generated.text, diagnostic.line), _offset(
-            generated.text, diagnostic.line) + len(diagnostic.source_line or "")) \
+        start = source.line_start(diagnostic.line)
+        span = n.Span(source, start, start + len(diagnostic.source_line or "")) \
             if diagnostic.line else n.NO_SPAN
         report.findings.append(Finding(URCAP_CODE, "info", diagnostic.message, span))
     report.findings.sort(key=lambda f: (f.span.line, f.span.column, f.time or 0.0, f.code))
@@ -458,14 +458,6 @@ def installation_defaults(options, installation: Installation, cell_given: bool)
     if not taken:
         return []
     return [f"from {Path(installation.path).name}: " + ", ".join(taken)]
-
-
-def _offset(text: str, line: int) -> int:
-    """Character offset of the start of 1-based ``line`` in ``text``."""
-    offset = 0
-    for _ in range(line - 1):
-        offset = text.index("\n", offset) + 1
-    return offset
 
 
 def send_check(path: str, robot: str, check: bool):
