@@ -242,6 +242,10 @@ def test_which_threads_are_detached():
               sleep(0.5)
             end
           end
+          thread watchdog():
+            sleep(100)
+            halt
+          end
           run counter()
           while True:
             if get_standard_digital_out(1):

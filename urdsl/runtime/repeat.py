@@ -122,6 +122,9 @@ def inert_names(module: n.Module) -> frozenset[str]:
 
 _IO_PREFIXES = ("set_", "write_", "get_", "read_")
 
+_STOPPING_CALLS = frozenset({"popup", "protective_stop", "powerdown", "halt"})
+"""Builtins that stop or pause the whole program: a thread that calls one steers it."""
+
 
 def _uses(nodes: Any, unknown_reads: frozenset[str] = frozenset()
           ) -> tuple[set[str], set[str], set, set, bool]:
@@ -129,9 +132,9 @@ def _uses(nodes: Any, unknown_reads: frozenset[str] = frozenset()
     the names they assign, the I/O they write and read, as (family, address) pairs
     (``("port_register", "128")`` for ``write_port_register(128, v)`` and
     ``read_port_register(128)``, ``("standard_digital_out", "*")`` for an address that is not
-    a number), and whether they move the arm, call a function of the program or start or stop
-    a thread. A read named in ``unknown_reads`` (a device read whose value the run does not
-    know, whatever was written) reads nothing the program wrote."""
+    a number), and whether they move the arm, stop the program, call a function of the
+    program or start or stop a thread. A read named in ``unknown_reads`` (a device read whose
+    value the run does not know, whatever was written) reads nothing the program wrote."""
     reads: set[str] = set()
     writes: set[str] = set()
     io_out: set[tuple[str, str]] = set()
@@ -151,7 +154,7 @@ def _uses(nodes: Any, unknown_reads: frozenset[str] = frozenset()
             writes.add(node.name)
         elif kind is n.Call and type(node.func) is n.Name:
             name = node.func.id
-            if name in MOTION_CALLS:
+            if name in MOTION_CALLS or name in _STOPPING_CALLS:
                 steers = True
             elif lookup(name) is None:
                 steers = True  # a function of the program: it may do anything
@@ -164,7 +167,7 @@ def _uses(nodes: Any, unknown_reads: frozenset[str] = frozenset()
             stack.extend(node.args)
             stack.extend(k.value for k in node.keywords)
             continue
-        elif kind in (n.Run, n.Kill, n.FunctionDef, n.ThreadDef):
+        elif kind in (n.Run, n.Kill, n.FunctionDef, n.ThreadDef, n.Halt):
             steers = True
         for name in getattr(node, "__dataclass_fields__", ()):
             if name == "span":
@@ -180,12 +183,13 @@ def _uses(nodes: Any, unknown_reads: frozenset[str] = frozenset()
 def detached_threads(module: n.Module,
                      unknown_reads: frozenset[str] = frozenset()) -> frozenset[str]:
     """Threads whose timing cannot change what the rest of the program does, nor the other
-    way round: they neither move the arm nor call the program's functions nor start or stop
-    threads; no other code reads a variable they assign or an I/O family they write, and
-    they read no variable other code assigns (a heartbeat that counts to 499 and writes a
-    register each second). When such a thread wakes relative to a pass of the main loop
-    does not enter the pass's state; its variables do. ``unknown_reads``: device reads whose
-    value the run takes as unknown, whatever the program wrote (see :func:`_uses`)."""
+    way round: they neither move the arm nor stop the program nor call the program's
+    functions nor start or stop threads; no other code reads a variable they assign or an
+    I/O family they write, and they read no variable other code assigns (a heartbeat that
+    counts to 499 and writes a register each second). When such a thread wakes relative to
+    a pass of the main loop does not enter the pass's state; its variables do.
+    ``unknown_reads``: device reads whose value the run takes as unknown, whatever the program
+    wrote (see :func:`_uses`)."""
     threads = [node for node in n.walk(module) if type(node) is n.ThreadDef]
     if not threads:
         return frozenset()
