@@ -423,6 +423,12 @@ def test_a_fragment_sees_the_features_of_the_installation_beside_it(tmp_path, ca
     assert status == 0 and not [f for f in report["findings"] if f["severity"] == "error"]
     assert main(["lint", "--format", "json", str(fragment)]) == 0
     assert json.loads(capsys.readouterr().out) == []
+    # a feature named in PolyScope's own language is written as PolyScope writes it
+    (tmp_path / "default.installation").write_bytes(_installation5().replace(
+        b'name="pick"', 'name="点_1"'.encode()))
+    fragment.write_text("textmsg(u28857_1)\n")
+    assert main(["lint", "--format", "json", str(tmp_path)]) == 0
+    assert json.loads(capsys.readouterr().out) == []
     fragment.write_text("textmsg(hidden)\n")  # a feature that is not variable: not there
     assert main(["lint", "--format", "json", str(fragment)]) == 1
     assert "'hidden'" in json.loads(capsys.readouterr().out)[0]["message"]

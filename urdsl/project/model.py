@@ -24,6 +24,7 @@ fragment's file, or when the fragment's code lines are found inlined in the host
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import re
 import tomllib
@@ -56,6 +57,7 @@ MAX_TREE_FILES = 2000
 HOST_LEVELS = 3
 """How many folders above a file urdsl looks for the program that includes it."""
 
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _INLINE_SHARE = 0.8
 _SUBPROGRAM_SHARE = 0.5
 
@@ -395,6 +397,7 @@ def installation_features(path: Path) -> VariablesFile | None:
     ``Plane_1=p[...]`` of a file named ``PATH (features)``; None when it has none or cannot be
     read (a ``.urp`` that names it says so). PolyScope writes them into the preamble of every
     program run with that installation, so a script file a program includes may use them."""
+    from ..polyscope.compile import ascii_name
     from ..polyscope.installation import InstallationError, read_installation
 
     try:
@@ -403,11 +406,16 @@ def installation_features(path: Path) -> VariablesFile | None:
         installation = read_installation(path)
     except (InstallationError, OSError):
         return None
-    if not installation.features:
+    # named as PolyScope writes them in a script ("点_1" is u28857_1); a name or pose that
+    # still is no URScript (a damaged file) is left out, never reported as the user's line
+    lines = [f"{ascii_name(name)}=p[{', '.join(repr(float(v)) for v in pose)}]\n"
+             for name, pose in installation.features
+             if _IDENTIFIER.fullmatch(ascii_name(name)) and all(map(math.isfinite, pose))]
+    if not lines:
         return None
-    text = "".join(f"{name}=p[{', '.join(repr(float(v)) for v in pose)}]\n"
-                   for name, pose in installation.features)
-    return parse_variables(text, f"{path} (features)")
+    features = parse_variables("".join(lines), f"{path} (features)")
+    features.diagnostics = []
+    return features
 
 
 MAX_TREE_VISITS = 50_000
