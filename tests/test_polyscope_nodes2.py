@@ -176,7 +176,8 @@ def test_relative_waypoint_moves_by_the_taught_difference():
 
 def test_polyscope3_relative_waypoint_writes_its_poses_in_place():
     # PolyScope 3 writes no waypoint globals; a relative waypoint's two poses stand in the
-    # motion as a fixed waypoint's pose does [U]
+    # motion as a fixed waypoint's pose does, from the forward kinematics (seen: 3.15.6
+    # ati-ia/ft-urcap, 3.15.8 ic-sw1821/UR_RTDE_2; test_polyscope_nodes8)
     lines = compiled(RELATIVE.format(
         start='<relativeFromPosition joints="0, -1.5, 1.5, -1.5, -1.5, 0" '
               'pose="0.1, 0.2, 0.3, 0.0, 3.14, 0.0"/>',
@@ -184,7 +185,7 @@ def test_polyscope3_relative_waypoint_writes_its_poses_in_place():
             'pose="0.1, 0.25, 0.3, 0.0, 3.14, 0.0"/>'),
         version="3.15.4.106291")
     assert not any("Slide_" in line for line in lines)
-    assert "movel(pose_add(get_target_tcp_pose(), pose_sub(p[0.1, 0.25, 0.3, 0.0, 3.14, 0.0], " \
+    assert "movel(pose_add(get_forward_kin(), pose_sub(p[0.1, 0.25, 0.3, 0.0, 3.14, 0.0], " \
            "p[0.1, 0.2, 0.3, 0.0, 3.14, 0.0])), a=1.2, v=0.25)" in lines
 
 

@@ -519,14 +519,24 @@ class _Compiler:
         # for the nodes in a Thread node, which it numbers all the same; 3.8.0 (not 3.5.0,
         # 3.10.1, 3.12.1, 3.14.1 or 3.15) writes no marker for the Robot Program node
         # [U: 3.9 and 3.11; Case and Thread markers before 3.10]
-        self.flags = not (saved[0] == 3 and saved < (3, 12))
-        self.inner_markers = self.flags
+        # PolyScope 5 before 5.6 writes no flags either (seen: 5.4.2 and 5.5.1, waypoint
+        # markers without "breakAfter"; 5.7.0 on with them); the flags came with breakpoints
+        # and single step, 3.12 and 5.6 [U: 5.6, 5.0-5.3]
+        early = (saved[0] == 3 and saved < (3, 12)) or (saved[0] == 5 and saved < (5, 6))
+        self.flags = not early
+        self.inner_markers = not (saved[0] == 3 and saved < (3, 12))
         self.main_marker = not ((3, 6) <= saved < (3, 10))
+        # before breakpoints a suppressed node is numbered as one, whatever it holds (seen:
+        # 3.5.4, jmtc7 7_4_pruebas_modbus: a suppressed MoveJ with its waypoint is one
+        # number; 3.15, 5.x number every node in it) [U: 3.6-3.11, 5.0-5.5]
+        self.suppressed_as_one = early
         # PolyScope 3.2 (seen: nedlecky/UR KeyenceRobotVisionSample, 3.2.20175) writes no
-        # marker for a Script node of a file and titles every Popup "Message" (an Error
-        # popup too: ``popup("…", "Message", False, True, blocking=True)``); 3.5 on as now
-        # [U: between 3.2 and 3.5]
+        # marker for a Script node of a file (3.4.0 does: ryanpennings/RTDE_UR rtde_2,
+        # ``$ 8 "Script: int"``) and titles every Popup "Message" (an Error popup too:
+        # ``popup("…", "Message", False, True, blocking=True)``); 3.5 on as now
+        # [U: 3.3 for the marker, 3.3-3.4 for the title]
         self.old_polyscope3 = saved[0] == 3 and saved < (3, 5)
+        self.script_file_marker = not (saved[0] == 3 and saved < (3, 4))
 
     # -- numbering
     def _number_tree(self, node: Node) -> None:
@@ -537,6 +547,8 @@ class _Compiler:
             self.number_of[id(current)] = self.counter
             self.numbers[self.counter] = current
             if current.kind == "CallSubProgram":
+                continue
+            if current.suppressed and self.suppressed_as_one:
                 continue
             stack.extend(reversed(current.children))
 
@@ -1142,7 +1154,7 @@ class _Compiler:
             path = str(node.fields.get("file", ""))
             contents = self.script_file(path) or contents
             label = f"Script: {path.rsplit('/', 1)[-1]}"
-            if self.old_polyscope3:
+            if not self.script_file_marker:
                 return self.code(contents, node)
         else:
             label = "Script"
@@ -1532,7 +1544,10 @@ class _Compiler:
             return []  # PolyScope writes nothing for a Force node with an empty body
         # in force mode the program may not stop at a node: every marker inside is noBreak
         body = [_no_break(item) if self.flags else item for item in self.block(node.children)]
-        return [self.marker(node, "Force"), _stmt("sleep", _num(0.02)), _stmt("zero_ftsensor"),
+        # PolyScope 5 zeroes the e-Series' own force/torque sensor first; PolyScope 3 (a CB3
+        # has none) does not (seen: 3.15.6 ati-ia/ft-urcap, 3.15.8 ic-sw1821/UR_RTDE_2)
+        zero = [_stmt("zero_ftsensor")] if self.version >= 5 else []
+        return [self.marker(node, "Force"), _stmt("sleep", _num(0.02)), *zero,
                 _stmt("force_mode", frame, List(tuple(Number(int(v)) for v in selection)),
                       List(tuple(_num(v) for v in wrench)), Number(kind),
                       List(tuple(_num(v) for v in limits))),
@@ -1590,14 +1605,16 @@ class _Compiler:
             start: Expr = Name(f"{name}_from_p")
             if self.version < 5:
                 # PolyScope 3 writes no waypoint globals: the two poses in place, as for a
-                # fixed waypoint [U: no PolyScope 3 script with a relative waypoint seen]
+                # fixed waypoint (seen: 3.15.6, 3.15.8)
                 to_pose, from_pose = self.pose_of(node), self.pose_of(node, "from_")
                 if to_pose is None or from_pose is None:
                     raise self.error(node, "a relative waypoint without its two positions")
                 to = Pose(tuple(_num(v) for v in to_pose))
                 start = Pose(tuple(_num(v) for v in from_pose))
-            target = _call("pose_add", _call("get_target_tcp_pose"),
-                           _call("pose_sub", to, start))
+            # from where the robot is: PolyScope 3 its forward kinematics, 5 its target
+            # pose (seen: 3.15.6 ati-ia/ft-urcap, 3.15.8 ic-sw1821/UR_RTDE_2; 5.7 on)
+            here = _call("get_forward_kin" if self.version < 5 else "get_target_tcp_pose")
+            target = _call("pose_add", here, _call("pose_sub", to, start))
         else:
             return [self.marker(node, name, "breakAfter")]
         keywords = self.motion_keywords(move, node)
