@@ -83,6 +83,8 @@ TRIGGERS = [
     ("URS120", "def main():\n  local count = 0\n  textmsg(count)\nend\n", [(2, 3)], {}),
     ("URS121", "def home():\n  textmsg(1)\nend\ndef home():\n  textmsg(2)\nend\n", [(4, 5)],
      {}),
+    ("URS122", "def prog():\n  # begin: URCap Installation Node\n  unused = 1\n"
+     "  # end: URCap Installation Node\nend\n", [(2, 3)], {}),
 ]
 
 # (code, snippet that must not trigger it, settings)
@@ -130,6 +132,8 @@ CLEAN = [
     ("URS120", "def main():\n  def f():\n    local c = 0\n    textmsg(c)\n  end\n  f()\nend\n",
      {}),
     ("URS121", "def home():\n  textmsg(1)\nend\ndef park():\n  textmsg(2)\nend\n", {}),
+    ("URS122", "def prog():\n  # begin: URCap Installation Node\n  used = 1\n  textmsg(used)\n"
+     "  # end: URCap Installation Node\nend\n", {}),
 ]
 
 
@@ -286,3 +290,22 @@ def test_modbus_outputs_set_from_the_main_program_need_not_say_so(call):
     # is_secondary_program left out: programs that ran on e-Series robots do it
     assert _codes(call + "\n") == []
     assert _codes(call.replace(")", ", False)") + "\n") == []
+
+
+def test_warnings_in_code_a_urcap_wrote_are_counted_in_one_note_errors_stay():
+    text = ("def prog():\n"
+            "  # begin: URCap Installation Node\n"
+            "  #   Source: Gripper, 1.0, Maker\n"
+            "  grip_state = 0\n"
+            "  grip_force = 0\n"
+            "  undefined_call_here()\n"
+            "  # end: URCap Installation Node\n"
+            "  unused = 1\n"
+            "end\n")
+    found = lint_text(text, "export.script")
+    assert [(d.code, d.severity, d.line) for d in found] == [
+        ("URS122", "info", 2), ("URS102", "error", 6), ("URS112", "warning", 8)]
+    assert found[0].column == 3
+    assert "2 finding(s) (URS112) in the code Gripper wrote" in found[0].message
+    quiet = lint_text(text, "export.script", build_settings(ignore=["URS122"]))
+    assert [d.code for d in quiet] == ["URS102", "URS112"]

@@ -265,7 +265,7 @@ def test_a_feature_of_a_missing_installation_is_not_a_mistake_of_the_program(tmp
     assert main(["lint", str(program), "--format", "json"]) == 0
     (found,) = json.loads(capsys.readouterr().out)
     assert found["severity"] == "warning" and "'Plane_3'" in found["message"]
-    assert "a feature of the installation default, which is not beside the program" \
+    assert "a feature of the installation default.installation (not beside the program)" \
         in found["message"]
     assert main(["check", str(program), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
@@ -274,3 +274,33 @@ def test_a_feature_of_a_missing_installation_is_not_a_mistake_of_the_program(tmp
                                 + _chars("textmsg(Plane_3)") + "</expression></Script>"))
     assert main(["lint", str(program)]) == 1
     assert "URS101 name 'Plane_3' is not defined [node" in capsys.readouterr().out
+
+
+def test_installation_variables_and_move_features_of_a_missing_installation(tmp_path, capsys):
+    # an IncrementVariable Set of an installation variable and a MoveL in a feature both take
+    # names from the installation; without it beside the program they are unknown values
+    # (check) and warnings that say so (lint), not "not defined" errors
+    increment = ('<Set type="IncrementVariable"><installationVariable name="i_count"/></Set>')
+    test = ('<If type="If"><expression>' + _chars("i_count == 3") + '</expression>'
+            '<children><Wait type="Sleep"><waitTime>0.1</waitTime></Wait></children></If>')
+    program = tmp_path / "counter.urp"
+    program.write_text(_program(increment + test))
+    assert main(["check", str(program), "--json"]) == 0
+    captured = capsys.readouterr()
+    report = json.loads(captured.out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    assert "names of a missing installation): i_count" in report["context"]
+    assert f"{program}: the installation it names, " in captured.err
+    move = ('<Move motionType="MoveL" speed="0.25" acceleration="1.2" useActiveTCP="true" '
+            'positionType="CartesianPose">'
+            '<feature class="GeomFeatureReference" referencedName="Joint_6_name"/>'
+            '<children><Waypoint type="Variable" name="Variable">'
+            '<variable name="offset"/></Waypoint></children></Move>')
+    offset = ('<Script type="Line"><expression>' + _chars("global offset = p[0, 0, 0.01, 0, 0, 0]")
+              + "</expression></Script>")
+    program.write_text(_program(offset + move))
+    assert main(["lint", str(program), "--format", "json"]) == 0
+    found = [f for f in json.loads(capsys.readouterr().out) if "Joint_6_name" in f["message"]]
+    assert found and found[0]["severity"] == "warning"
+    assert "a name of the installation default.installation (not beside the program)" in \
+        found[0]["message"]

@@ -288,7 +288,7 @@ def test_compile_names_a_missing_or_corrupt_installation(tmp_path, capsys):
     out = tmp_path / "pre.script"
     assert main(["compile", str(program), "-o", str(out)]) == 0
     err = capsys.readouterr().err
-    assert f"{tmp_path / 'cell.installation'}: the installation the program names is not " \
+    assert f"{program}: the installation it names, {tmp_path / 'cell.installation'}, is not " \
            "there" in err and "Traceback" not in err
     assert "set_tcp" not in out.read_text()
     (tmp_path / "cell.installation").write_bytes(gzip.compress(_installation5())[:60])

@@ -407,3 +407,28 @@ def test_only_the_first_level_reading_a_global_before_setting_it_asks_the_progra
     library = parse("def weave():\n  a = gap[0]\n  global gap = [1, 2]\nend\n"
                     "def start():\n  global gap = [0, 0]\nend\n")
     assert needed_names(library)[0] == set()  # start() may run first: the file has it
+
+
+def test_a_fragment_sees_the_features_of_the_installation_beside_it(tmp_path, capsys):
+    # a script file a Script node includes may use the installation's features as
+    # variables (PolyScope writes them into every program's preamble): with no program
+    # beside it, the installation itself defines them, for lint and check
+    from test_polyscope_preamble import _installation5
+
+    (tmp_path / "default.installation").write_bytes(_installation5())
+    fragment = tmp_path / "approach.script"
+    fragment.write_text("above = pose_trans(pick, p[0, 0, -0.05, 0, 0, 0])\n"
+                        "textmsg(above)\ntextmsg(Table)\n")
+    status, report = check(capsys, str(fragment))
+    assert status == 0 and not [f for f in report["findings"] if f["severity"] == "error"]
+    assert main(["lint", "--format", "json", str(fragment)]) == 0
+    assert json.loads(capsys.readouterr().out) == []
+    # a feature named in PolyScope's own language is written as PolyScope writes it
+    (tmp_path / "default.installation").write_bytes(_installation5().replace(
+        b'name="pick"', 'name="点_1"'.encode()))
+    fragment.write_text("textmsg(u28857_1)\n")
+    assert main(["lint", "--format", "json", str(tmp_path)]) == 0
+    assert json.loads(capsys.readouterr().out) == []
+    fragment.write_text("textmsg(hidden)\n")  # a feature that is not variable: not there
+    assert main(["lint", "--format", "json", str(fragment)]) == 1
+    assert "'hidden'" in json.loads(capsys.readouterr().out)[0]["message"]

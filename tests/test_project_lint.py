@@ -93,6 +93,21 @@ def test_bad_installation_variables_are_reported_once_with_their_line(tmp_path, 
         ("default.variables", 2, "URS001")]
 
 
+def test_a_file_linted_alone_reports_only_its_own_installations_problems(tmp_path, capsys):
+    # another program's broken installation variables in a sibling folder are not the
+    # business of a file named on its own; its own folder's (or one above) are
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "default.variables").write_text("broken line\n")
+    (tmp_path / "cell").mkdir()
+    (tmp_path / "cell" / "a.script").write_text("textmsg(1)\n")
+    status, found = lint(capsys, str(tmp_path / "cell" / "a.script"))
+    assert (status, found) == (0, [])
+    (tmp_path / "default.variables").write_text("speed=0.3\nbroken line\n")
+    status, found = lint(capsys, str(tmp_path / "cell" / "a.script"))
+    assert status == 1 and [(Path(f["file"]).name, f["line"]) for f in found] == [
+        ("default.variables", 2)]
+
+
 def test_stdin_with_a_filename_uses_the_project(monkeypatch, capsys):
     import io
     import sys

@@ -56,6 +56,25 @@ def test_poses_lists_structs_matrices():
     assert value("x = make_list(2, 0, 5)\nx.append(7)\nx.append(8)\n") == ListValue([0, 0, 7, 8])
 
 
+def test_the_manuals_list_struct_and_matrix_methods():
+    # "Methods in URScript" (5.15 and later): the manual's own examples
+    fill = ("l1 = make_list(5, 9, 10)\nl2 = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\nidx = 0\n"
+            "while (idx < l2.length()):\n  if (l1.excess_capacity() > 0):\n"
+            "    l1.append(l2[idx])\n  end\n  idx = idx + 1\nend\nx = l1\n")
+    assert value(fill) == ListValue([9, 9, 9, 9, 9, 1, 2, 3, 4, 5])
+    assert value("x = make_list(2, 0, 100)\nx.extend([1, 2, 3])\nx.remove(0)\n") == \
+        ListValue([0, 1, 2, 3])
+    assert value("l = [1, 2, 3, 4, 5]\nx = l.slice(1, 4)\n") == ListValue([2, 3, 4])
+    assert value("x = [1, 2].to_string()") == "[1, 2]"
+    assert value("s = struct(a=1, b=2)\nx = s.length()") == 2
+    assert value("m = [[1, 2, 3], [4, 5, 6]]\nx = m.shape()") == ListValue([2, 3])
+    assert value("m = [[1, 2, 3], [4, 5, 6]]\nx = m.get_column(1)") == ListValue([2, 5])
+    assert value("m = [[1, 2, 3], [4, 5, 6]]\nx = m.get_row(1)") == ListValue([4, 5, 6])
+    assert "full" in error("x = [1, 2]\nx.extend([3])\n").message
+    assert "outside" in error("x = [1, 2]\nx.remove(2)\n").message
+    assert "has no method 'shape'" in error("x = [1, 2]\ny = x.shape()\n").message
+
+
 # ---- scoping and calls ---------------------------------------------------------------------
 
 

@@ -4,14 +4,19 @@ from __future__ import annotations
 
 import pytest
 
-from urdsl.script.builtins import catalog, lookup, methods, parse_version
+from urdsl.script.builtins import catalog, lookup, method, methods, parse_version
 
 
 def test_every_row_is_there():
     # 299 rows of the reference catalog + get_joint_positions, eip_reader_factory and
     # eip_writer_factory (added from UR's own scripts, see their remarks) + 7 CB-era builtins
-    # (varmsg, tool_pose, set_runstate_outputs and four set_runstate_*_outputs)
-    assert len(catalog()) + len(methods()) == 309
+    # (varmsg, tool_pose, set_runstate_outputs and four set_runstate_*_outputs) + 5 list
+    # methods of the manual's "Methods on List" (excess_capacity, extend, remove, slice,
+    # to_string); its struct and matrix methods are found by receiver
+    assert len(catalog()) + len(methods()) == 314
+    assert method("struct", "length").returns == ("Int",)
+    assert method("matrix", "get_column").params[0].name == "index"
+    assert method("list", "shape") is None
     assert sum(b.deprecated for b in catalog().values()) == 16
     # 3 more signature rows of older generations: speedj, speedl (t_min), set_payload (CoG)
     assert sum(len(b.variants) for b in catalog().values()) == 3

@@ -8,7 +8,7 @@ import textwrap
 import pytest
 
 from urdsl.runtime.interpreter import Interpreter, RuntimeConfig
-from urdsl.runtime.repeat import inert_names
+from urdsl.runtime.repeat import detached_threads, inert_names
 from urdsl.script import parse
 from urdsl.verify.run import CheckOptions, check_text
 
@@ -163,3 +163,95 @@ def test_what_a_loop_sends_is_a_log_not_a_state():
         end
         """)
     assert repeats(report) and len(report.moves) == 4
+
+
+def test_a_sync_thread_whose_offset_inside_a_frame_drifts_still_repeats():
+    # PolyScope's step-counter thread syncs every 2 ms frame; a pass that takes a time that
+    # is no whole number of frames (a move of 1.0713 s) leaves the thread's offset inside its
+    # frame different each pass. The controller runs threads on frames: the passes repeat.
+    report = check(f"""
+        def cell():
+          steps = 0.0
+          thread Step_Counter_Thread_1():
+            while (True):
+              steps = steps + 1.0
+              sync()
+            end
+          end
+          run Step_Counter_Thread_1()
+          while True:
+            movej({A}, a=1.4, v=1.05)
+            sleep(0.0007)
+            movej({B}, a=1.4, v=1.05)
+          end
+        end
+        """)
+    assert repeats(report) and report.loop.passes <= 3
+
+
+def test_a_heartbeat_thread_that_nothing_reads_does_not_keep_the_loop_from_repeating():
+    # the heartbeat counts and writes a register once a second; the cell loop's pass takes
+    # no whole number of seconds, so the heartbeat's wake time inside a pass drifts. Nothing
+    # else reads what it writes, so when it wakes does not change what the program does.
+    body = f"""
+        def cell():
+          heartbeat = 0
+          thread beat():
+            while (True):
+              heartbeat = heartbeat + 1
+              if (heartbeat > 9):
+                heartbeat = 0
+              end
+              write_port_register(128, heartbeat)
+              sleep(1.0)
+            end
+          end
+          run beat()
+          while True:
+            movej({A}, a=1.4, v=1.05)
+            movej({B}, a=1.4, v=1.05)
+          end
+        end
+        """
+    report = check(body)
+    assert repeats(report) and report.loop.passes <= 12
+    assert not report.has_errors
+    # the same heartbeat read by the cell loop: its timing matters, it is not detached
+    coupled = textwrap.dedent(body).replace("run beat()", "run beat()\n  x = heartbeat")
+    assert detached_threads(parse(coupled, "cell.script")) == frozenset()
+
+
+def test_which_threads_are_detached():
+    text = textwrap.dedent("""
+        def prog():
+          n = 0
+          thread counter():
+            while True:
+              n = n + 1
+              sync()
+            end
+          end
+          thread mover():
+            while True:
+              movej([0, -1.57, 0, -1.57, 0, 0])
+            end
+          end
+          thread lamp():
+            while True:
+              set_standard_digital_out(1, True)
+              sleep(0.5)
+            end
+          end
+          thread watchdog():
+            sleep(100)
+            halt
+          end
+          run counter()
+          while True:
+            if get_standard_digital_out(1):
+              sleep(1)
+            end
+          end
+        end
+        """)
+    assert detached_threads(parse(text, "t.script")) == frozenset({"counter"})

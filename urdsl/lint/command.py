@@ -164,7 +164,8 @@ class _Projects:
         extra = []
         if id(project) not in self.reported:
             self.reported.add(id(project))
-            extra = project.diagnostics()  # type: ignore[attr-defined]
+            extra = project.diagnostics(  # type: ignore[attr-defined]
+                file if root is None else None)
         return project.context(file), extra  # type: ignore[attr-defined]
 
 

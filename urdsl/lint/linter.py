@@ -11,10 +11,11 @@ import re
 from ..script import nodes as n
 from ..script.diagnostics import Diagnostic, ScriptError
 from ..script.parser import parse
+from ..script.urcaps import urcap_blocks
 from . import calls, flow, motion, names  # noqa: F401 - importing registers the rules
 from .config import LintSettings, build_settings
 from .context import LintContext
-from .registry import DEPTH_RULE, RULES
+from .registry import DEPTH_RULE, RULES, URCAP_CODE_RULE
 from .scope import analyse
 
 __all__ = ["lint_text", "lint_tree"]
@@ -65,7 +66,8 @@ def lint_tree(tree: n.Module, settings: LintSettings | None = None,
             n.Span(source, 0, 0), f"blocks nest too deeply to lint; skipped: "
             f"{', '.join(skipped)}", code=DEPTH_RULE.code, severity=DEPTH_RULE.severity,
             hint="split the deep nesting into functions"))
-    found = _without_noqa(found, tree)
+    found = _folded_in_urcap_code(_without_noqa(found, tree), tree,
+                                  URCAP_CODE_RULE.code in settings.codes)
     unique = {(d.line, d.column, d.code, d.message): d for d in found}
     return sorted(unique.values(), key=lambda d: (d.line, d.column, d.code))
 
@@ -91,3 +93,36 @@ def _without_noqa(found: list[Diagnostic], tree: n.Module) -> list[Diagnostic]:
             continue
         kept.append(diagnostic)
     return kept
+
+
+def _folded_in_urcap_code(found: list[Diagnostic], tree: n.Module,
+                          shown: bool) -> list[Diagnostic]:
+    """Warnings and infos inside code a URCap wrote into the program (``# begin: URCap ...``
+    to ``# end: ...``) folded into one URS122 info per block that counts them (none when
+    ``shown`` is False: the rule is not selected): the user cannot change that code, the URCap
+    writes it anew at every save. Errors stay as they are."""
+    blocks = urcap_blocks(tree)
+    if not blocks:
+        return found
+    kept: list[Diagnostic] = []
+    folded: dict[tuple[str, int, int], list[Diagnostic]] = {}
+    for diagnostic in found:
+        block = next((b for b in blocks if b[1] <= diagnostic.line <= b[2]), None)
+        if block is None or diagnostic.severity == "error":
+            kept.append(diagnostic)
+        else:
+            folded.setdefault(block, []).append(diagnostic)
+    if not shown:
+        return kept
+    source = tree.span.source or n.Source("", "<generated>")
+    for (urcap, first, last), inside in folded.items():
+        codes = ", ".join(sorted({d.code for d in inside}))
+        text = source.line_text(first)
+        start = source.line_start(first) + len(text) - len(text.lstrip())  # at the comment
+        kept.append(Diagnostic.at(
+            n.Span(source, start, start),
+            f"{len(inside)} finding(s) ({codes}) in the code {urcap} wrote into the "
+            f"program (lines {first}-{last}) not shown: the URCap writes that code anew at "
+            "every save", code=URCAP_CODE_RULE.code, severity=URCAP_CODE_RULE.severity))
+    return kept
+

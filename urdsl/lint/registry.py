@@ -18,7 +18,8 @@ from ..script.diagnostics import Diagnostic
 if TYPE_CHECKING:  # pragma: no cover
     from .context import LintContext
 
-__all__ = ["Rule", "RULES", "rule", "SYNTAX_RULE", "DEPTH_RULE", "expand_codes"]
+__all__ = ["Rule", "RULES", "rule", "SYNTAX_RULE", "DEPTH_RULE", "URCAP_CODE_RULE",
+           "expand_codes"]
 
 Check = Callable[["LintContext"], Iterator[Diagnostic]]
 
@@ -60,6 +61,22 @@ that file, and this note says which; every other rule still runs.""",
     fixed="split the deep nesting into functions",
 )
 _add(DEPTH_RULE)
+
+URCAP_CODE_RULE = Rule(
+    code="URS122", name="urcap-code", severity="info",
+    summary="Warnings inside code a URCap wrote into the program, counted and not shown.",
+    explanation="""
+A PolyScope export holds the code each URCap writes into the program (`# begin: URCap
+Installation Node` ... `# end: URCap Installation Node`): a gripper's functions and its
+state variables, often thousands of lines. The URCap writes that code anew every time the
+program is saved, so a warning there (a variable it never reads, say) is nothing the user
+can change: such warnings become one info per block that counts them. An error inside the
+block is reported as it is.""",
+    example="def prog():\n  # begin: URCap Installation Node\n  #   Source: Gripper, 1.0, Maker\n"
+            "  gripper_state = 0\n  # end: URCap Installation Node\nend",
+    fixed="# nothing to change: the URCap writes that code",
+)
+_add(URCAP_CODE_RULE)
 
 
 def rule(

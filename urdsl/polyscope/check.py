@@ -192,14 +192,16 @@ def undefined_globals(module: n.Module) -> list[str]:
 
 
 def missing_features(generated: Generated) -> dict[str, str]:
-    """Installation features the program reads as variables while its installation is not
-    there (the preamble that defines them is not written): each with where its value
-    would come from."""
+    """Installation variables and features the program refers to while its installation is
+    not there (the preamble and ``.variables`` that define them are not read): each with
+    where its value would come from."""
     if generated.installation is not None:
         return {}
-    named = generated.program.installation or "(none named)"
-    return {name: f"a feature of the installation {named}, which is not beside the program"
-            for name in sorted(generated.program.feature_variables)}
+    program = generated.program
+    named = f"{program.installation}.installation" if program.installation else "(none named)"
+    return {name: f"a {'feature' if name in program.feature_variables else 'name'} of the "
+                  f"installation {named} (not beside the program)"
+            for name in sorted(program.feature_variables | program.installation_names)}
 
 
 def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
@@ -211,9 +213,11 @@ def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
     if urcaps:
         names = ", ".join(dict.fromkeys(node.title for _number, node in urcaps))
         values = {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
-    features = missing_features(generated)
-    return values | {name: why for name, why in features.items()
-                     if name in undefined_globals(module)}
+    # the missing installation's preamble would define each of its names the program uses
+    # before the program runs, also one the program assigns itself (``i_count = i_count + 1``)
+    used = {node.id for node in n.walk(module) if isinstance(node, n.Name)}
+    return values | {name: why for name, why in missing_features(generated).items()
+                     if name in used}
 
 
 def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Module, list[str]]:
@@ -388,7 +392,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
                                            cell_given=bool(cell_path)))
     file_options.unknown_globals = urcap_values(generated, module)
     if file_options.unknown_globals:
-        notes.append("unknown values (URCap nodes' results, features of a missing "
+        notes.append("unknown values (URCap nodes' results, names of a missing "
                      "installation): " + ", ".join(sorted(file_options.unknown_globals)))
     module, stand_ins = with_urcap_functions(generated, module)
     if stand_ins:
@@ -400,8 +404,8 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     report.findings = node_findings(generated, report.findings)
     source = module.span.source
     for diagnostic in urcap_diagnostics(generated):
-        span = n.Span(source, _offset(generated.text, diagnostic.line), _offset(
-            generated.text, diagnostic.line) + len(diagnostic.source_line or "")) \
+        start = source.line_start(diagnostic.line)
+        span = n.Span(source, start, start + len(diagnostic.source_line or "")) \
             if diagnostic.line else n.NO_SPAN
         report.findings.append(Finding(URCAP_CODE, "info", diagnostic.message, span))
     report.findings.sort(key=lambda f: (f.span.line, f.span.column, f.time or 0.0, f.code))
@@ -454,14 +458,6 @@ def installation_defaults(options, installation: Installation, cell_given: bool)
     if not taken:
         return []
     return [f"from {Path(installation.path).name}: " + ", ".join(taken)]
-
-
-def _offset(text: str, line: int) -> int:
-    """Character offset of the start of 1-based ``line`` in ``text``."""
-    offset = 0
-    for _ in range(line - 1):
-        offset = text.index("\n", offset) + 1
-    return offset
 
 
 def send_check(path: str, robot: str, check: bool):

@@ -98,8 +98,9 @@ def _installation_for(program: Program, path: str | Path,
         candidate = find_installation(path)
     if candidate is None:
         if program.installation:
-            warn(f"{folder / (program.installation + '.installation')}: the installation "
-                 "the program names is not there; compiled without its preamble")
+            warn(f"{path}: the installation it names, "
+                 f"{folder / (program.installation + '.installation')}, is not there; "
+                 "compiled without its preamble")
         return None
     try:
         return read_installation(candidate)

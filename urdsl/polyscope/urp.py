@@ -177,6 +177,11 @@ class Program:
     feature_variables: frozenset[str] = frozenset()
     """Installation features the program's expressions read as variables (a feature made a
     variable in the installation: ``pose_trans(Plane_3, p)``); the preamble defines them."""
+    installation_names: frozenset[str] = frozenset()
+    """Every name the program takes from its installation: installation variables
+    (``<installationVariable name="i_count"/>``) and the features its moves and expressions
+    refer to (``referencedName``); the installation's preamble and ``.variables`` define
+    them."""
 
     @property
     def major_version(self) -> int | None:
@@ -309,6 +314,17 @@ class _Reader:
         self.positions: dict[ElementTree.Element, tuple[int, int]] = {}
         self.feature_variables: set[str] = set()
 
+    def installation_names(self) -> set[str]:
+        """The names of installation variables and features the program refers to."""
+        names = set(self.feature_variables)
+        for element in self.root.iter():
+            if element.tag == "installationVariable" and element.get("name"):
+                names.add(element.get("name", ""))
+            elif element.get("class", "").startswith("GeomFeature") and \
+                    element.get("referencedName"):
+                names.add(element.get("referencedName", ""))
+        return names
+
     # -- references
     def resolve(self, element: ElementTree.Element) -> ElementTree.Element:
         """The element an XStream ``reference`` attribute points to (or ``element``)."""
@@ -378,7 +394,8 @@ class _Reader:
                        root.get("installation"), root.get("createdIn"),
                        root.get("lastSavedIn"), kinematics, main, before, init, threads, subs,
                        others, top, root.get("installationRelativePath") or None,
-                       root.get("directory") or None, frozenset(self.feature_variables))
+                       root.get("directory") or None, frozenset(self.feature_variables),
+                       frozenset(self.installation_names()))
 
     def node(self, element: ElementTree.Element, parent: Node | None) -> Node:
         element = self.resolve(element)

@@ -24,13 +24,14 @@ fragment's file, or when the fragment's code lines are found inlined in the host
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..polyscope.variables import VariablesFile, read_variables
+from ..polyscope.variables import VariablesFile, parse_variables, read_variables
 from ..script import nodes as n
 from ..script.diagnostics import Diagnostic, ScriptError
 from ..script.parser import parse
@@ -42,6 +43,9 @@ __all__ = [
 
 SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
 VARIABLES_SUFFIX = ".variables"
+INSTALLATION_SUFFIX = ".installation"
+"""A PolyScope installation: its point and plane features are globals of every program run
+with it (see :func:`installation_features`)."""
 URP_SUFFIX = ".urp"
 """A PolyScope program: a host of the script files its Script nodes name, read as the
 URScript :mod:`urdsl.polyscope` compiles it to (see :func:`load_urp`)."""
@@ -53,6 +57,7 @@ MAX_TREE_FILES = 2000
 HOST_LEVELS = 3
 """How many folders above a file urdsl looks for the program that includes it."""
 
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _INLINE_SHARE = 0.8
 _SUBPROGRAM_SHARE = 0.5
 
@@ -304,6 +309,8 @@ class Project:
         scripts += [load_urp(p) for p in found if p.suffix == URP_SUFFIX
                     and _key(p.with_suffix("")) not in exported]  # else its .script is it
         variables = [read_variables(p) for p in found if p.suffix == VARIABLES_SUFFIX]
+        variables += [features for p in found if p.suffix == INSTALLATION_SUFFIX
+                      and (features := installation_features(p)) is not None]
         return cls(root, [s for s in scripts if s is not None], variables, frozenset(explicit))
 
     # -- questions ---------------------------------------------------------------------------
@@ -366,16 +373,49 @@ class Project:
                     and script in self.hosts_of(s)]
         return FileContext(self, script, hosts, included)
 
-    def diagnostics(self) -> list[Diagnostic]:
-        """Problems in the installation variables files (bad lines)."""
-        return [d for variables in self.variables for d in variables.diagnostics]
+    def diagnostics(self, near: str | Path | None = None) -> list[Diagnostic]:
+        """Problems in the installation variables files (bad lines); with ``near`` (a file
+        linted on its own), only those of the files in its folder or a folder above it: the
+        installations of other programs of the tree are not its business."""
+        chosen = self.variables
+        if near is not None:
+            folders = {Path(near).resolve().parent, *Path(near).resolve().parents}
+            chosen = [v for v in chosen if Path(v.filename).resolve().parent in folders]
+        return [d for variables in chosen for d in variables.diagnostics]
 
 
 # ---- files -----------------------------------------------------------------------------------
 
 def _wanted(path: Path) -> bool:
-    return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix == VARIABLES_SUFFIX
-                               or path.suffix == URP_SUFFIX)
+    return path.is_file() and (path.suffix in SCRIPT_SUFFIXES or path.suffix in (
+        VARIABLES_SUFFIX, URP_SUFFIX, INSTALLATION_SUFFIX))
+
+
+def installation_features(path: Path) -> VariablesFile | None:
+    """The features of the installation at ``path`` that programs see as variables (point
+    and plane features: ``pose_trans(Plane_1, p)``), as installation variables
+    ``Plane_1=p[...]`` of a file named ``PATH (features)``; None when it has none or cannot be
+    read (a ``.urp`` that names it says so). PolyScope writes them into the preamble of every
+    program run with that installation, so a script file a program includes may use them."""
+    from ..polyscope.compile import ascii_name
+    from ..polyscope.installation import InstallationError, read_installation
+
+    try:
+        if path.stat().st_size > MAX_FILE_BYTES:
+            return None
+        installation = read_installation(path)
+    except (InstallationError, OSError):
+        return None
+    # named as PolyScope writes them in a script ("点_1" is u28857_1); a name or pose that
+    # still is no URScript (a damaged file) is left out, never reported as the user's line
+    lines = [f"{ascii_name(name)}=p[{', '.join(repr(float(v)) for v in pose)}]\n"
+             for name, pose in installation.features
+             if _IDENTIFIER.fullmatch(ascii_name(name)) and all(map(math.isfinite, pose))]
+    if not lines:
+        return None
+    features = parse_variables("".join(lines), f"{path} (features)")
+    features.diagnostics = []
+    return features
 
 
 MAX_TREE_VISITS = 50_000
@@ -430,9 +470,8 @@ def _neighbours(path: Path, root: Path, known: set[str]) -> list[Path]:
         folder = folder.parent
         if (folder / ".git").exists():
             tree = _bounded_tree(folder, MAX_TREE_FILES)
-            return [p for p in tree or () if (p.suffix in SCRIPT_SUFFIXES
-                                               or p.suffix == VARIABLES_SUFFIX)
-                    and _key(p) not in known]
+            return [p for p in tree or () if (p.suffix in SCRIPT_SUFFIXES or p.suffix in (
+                VARIABLES_SUFFIX, INSTALLATION_SUFFIX)) and _key(p) not in known]
     return []
 
 

@@ -19,7 +19,8 @@ from collections.abc import Callable
 from typing import Any
 
 from ..script.binder import Problem
-from ..script.builtins import Builtin, lookup, methods
+from ..script.builtins import Builtin, lookup
+from ..script.builtins import method as lookup_method
 from ..script.nodes import Node
 from . import motion_builtins  # noqa: F401 - registers motion, robot state and pose maths
 from .registry import IMPLEMENTATIONS, implements
@@ -36,6 +37,7 @@ from .values import (
     PoseValue,
     StructValue,
     Unknown,
+    copy_value,
     exceeds,
     format_value,
     is_number,
@@ -154,12 +156,25 @@ class BuiltinTable:
                     node: Node) -> Any:
         rt = self.rt
         if type(receiver) is ListValue:
-            row = methods().get(method)
-            if row is None or not row.module.startswith("language-list"):
+            row = None
+            if receiver and all(type(item) is ListValue for item in receiver):
+                row = lookup_method("matrix", method)  # a matrix is a list of rows
+                if row is not None:
+                    bound = self.bind(row, args, named, node)
+                    return _matrix_method(rt, node, receiver, method, bound)
+            row = lookup_method("list", method)
+            if row is None:
                 raise rt.error("undefined", f"a list has no method '{method}'", node,
-                               "lists have append, insert, pop, clear, length, capacity")
+                               "lists have " + ", ".join(_LIST_METHODS))
             bound = self.bind(row, args, named, node)
             return _list_method(rt, node, receiver, method, bound)
+        if type(receiver) is StructValue:
+            row = lookup_method("struct", method)
+            if row is None:
+                raise rt.error("undefined", f"a struct has no method '{method}'", node,
+                               "structs have length and to_string")
+            self.bind(row, args, named, node)
+            return len(receiver.members) if method == "length" else format_value(receiver)
         if type(receiver) is _RemoteHandle:
             method = receiver.prefix + method
             if rt.unknown:  # a blocking call: the server's reply is unknown offline
@@ -230,7 +245,56 @@ def _builtin_hint(name: str) -> str | None:
     return f"did you mean '{close[0]}'?" if close else None
 
 
+_LIST_METHODS = ("append", "capacity", "clear", "excess_capacity", "extend", "insert",
+                 "length", "pop", "remove", "slice", "to_string")
+"""The list methods of the manual's "Methods on List" (5.15 and later)."""
+
+
+def _index(rt: Any, node: Node, value: Any, size: int, what: str) -> int:
+    """A whole-number ``value`` in ``0..size`` (a list position), else a program error."""
+    whole = type(value) is int or (type(value) is float and value.is_integer())
+    if not whole or not 0 <= value <= size:
+        raise rt.error("index", f"{what}: index {format_value(value)} is outside 0..{size}",
+                       node)
+    return int(value)
+
+
+def _matrix_method(rt: Any, node: Node, rows: ListValue, method: str, bound: dict) -> Any:
+    if method == "shape":
+        return ListValue([len(rows), len(rows[0])])
+    if method == "to_string":
+        return format_value(rows)
+    if method == "get_row":
+        return copy_value(rows[_index(rt, node, bound["index"], len(rows) - 1, "get_row")])
+    column = _index(rt, node, bound["index"], len(rows[0]) - 1, "get_column")
+    if any(len(row) <= column for row in rows):
+        raise rt.error("index", f"get_column: a row has no column {column}", node)
+    return ListValue([copy_value(row[column]) for row in rows])
+
+
 def _list_method(rt: Any, node: Node, items: ListValue, method: str, bound: dict) -> Any:
+    if method == "excess_capacity":
+        return items.capacity - len(items)
+    if method == "extend":
+        more = bound["elements"]
+        if type(more) is not ListValue:
+            raise rt.error("type", f"extend needs a list, not a {type_name(more)}", node)
+        if len(items) + len(more) > items.capacity:
+            raise rt.error("index", f"extend: the list is full (capacity {items.capacity})",
+                           node, "check l.excess_capacity() >= other.length() first")
+        items.extend(copy_value(v) for v in more)
+        return None
+    if method == "remove":
+        if not items:
+            raise rt.error("index", "remove from an empty list", node)
+        del items[_index(rt, node, bound["index"], len(items) - 1, "remove")]
+        return None
+    if method == "slice":
+        end = _index(rt, node, bound["end"], len(items), "slice")
+        begin = _index(rt, node, bound["begin"], end, "slice")
+        return ListValue([copy_value(v) for v in items[begin:end]])
+    if method == "to_string":
+        return format_value(items)
     if method == "append":
         if len(items) >= items.capacity:
             raise rt.error("index", f"append: the list is full (capacity {items.capacity})",

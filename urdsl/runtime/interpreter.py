@@ -30,8 +30,9 @@ from ..script import nodes as n
 from ..script.binder import Binding, Signature
 from ..script.nodes import NO_SPAN, Span
 from .errors import ScriptRuntimeError
-from .repeat import inert_names, pass_state
+from .repeat import detached_threads, inert_names, pass_state
 from .unknown import (
+    DEVICE_READS,
     IDLE_AFTER_PASSES,
     UNKNOWN_LOOP_PASSES,
     ends_program,
@@ -309,6 +310,7 @@ class Interpreter:
         self.stop_requested = False
         self._once: set = set()
         self._inert: frozenset[str] | None = None  # see stop_if_repeating
+        self._detached: frozenset[str] = frozenset()
         self._threads: list[Thread] = []
         self._order = 0
         self._scheduler: greenlet.greenlet | None = None
@@ -500,7 +502,9 @@ class Interpreter:
             return
         if self._inert is None:
             self._inert = inert_names(self.module)
-        state = pass_state(self, frame, self._inert)
+            self._detached = detached_threads(
+                self.module, DEVICE_READS if self.unknown else frozenset())
+        state = pass_state(self, frame, self._inert, self._detached)
         if state is None:
             return
         state = (state, loop_state, len(self.device_replies))

@@ -41,7 +41,7 @@ from ..versions import ControllerVersion, parse_version
 from .binder import Binding, Problem, Signature, problems
 
 __all__ = ["BLOCKING_CALLS", "MOTION_CALLS", "BuiltinParam", "Builtin", "catalog", "lookup",
-           "parse_version", "methods"]
+           "parse_version", "method", "methods"]
 
 Version = tuple[int, int]
 
@@ -356,7 +356,7 @@ def _load() -> tuple[dict[str, Builtin], dict[str, Builtin]]:
             raise ValueError(f"builtins.tsv:{number}: expected 8 columns, found {len(fields)}")
         builtin = _row(fields)
         if builtin.is_method:
-            method_rows[builtin.name.split(".", 1)[1]] = builtin
+            method_rows[builtin.name] = builtin
         elif builtin.name in functions:  # another signature row of the same builtin
             first = functions[builtin.name]
             functions[builtin.name] = replace(first, variants=(*first.variants, builtin))
@@ -371,8 +371,16 @@ def catalog() -> dict[str, Builtin]:
 
 
 def methods() -> dict[str, Builtin]:
-    """List and RPC-handle methods by method name (``append``, ``pop``, ...)."""
-    return _load()[1]
+    """List and RPC-handle methods by method name (``append``, ``pop``, ...); the struct and
+    matrix methods of the same names are found with :func:`method`."""
+    return {name.split(".", 1)[1]: row for name, row in _load()[1].items()
+            if not name.startswith(("struct.", "matrix."))}
+
+
+def method(receiver: str, name: str) -> Builtin | None:
+    """The method ``name`` of a ``receiver`` kind (``list``, ``struct``, ``matrix``: the
+    manual's "Methods in URScript", 5.15 and later), or None."""
+    return _load()[1].get(f"{receiver}.{name}")
 
 
 def lookup(name: str) -> Builtin | None:

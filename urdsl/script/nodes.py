@@ -70,6 +70,12 @@ class Source:
             column -= 1  # a byte-order mark is no column
         return index + 1, column
 
+    def line_start(self, line: int) -> int:
+        """The character offset where a 1-based line begins (the text's end past its last
+        line)."""
+        starts = self._starts()
+        return starts[line - 1] if 1 <= line <= len(starts) else len(self.text)
+
     def line_text(self, line: int) -> str:
         """The text of a 1-based line, without its line break."""
         starts = self._starts()

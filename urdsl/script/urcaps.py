@@ -24,7 +24,9 @@ from __future__ import annotations
 import functools
 from importlib import resources
 
-__all__ = ["urcap_hint", "urcap_of"]
+from . import nodes as n
+
+__all__ = ["urcap_blocks", "urcap_hint", "urcap_of"]
 
 
 @functools.cache
@@ -60,3 +62,24 @@ def urcap_hint(name: str) -> str | None:
     return (f"a function of {which}, which PolyScope adds to programs on a robot with the "
             "URCap installed; to check this file as it runs there, --include a .script "
             "PolyScope exported on that robot")
+
+
+def urcap_blocks(module) -> list[tuple[str, int, int]]:
+    """The code a URCap wrote into the program (PolyScope's ``# begin: URCap Installation
+    Node`` / ``Program Node`` … ``# end: …`` comments): (the URCap's name from its
+    ``#   Source:`` line, first line, last line) for each block."""
+    comments = sorted((c for c in n.walk(module) if type(c) is n.Comment),
+                      key=lambda c: c.span.line)
+    blocks: list[tuple[str, int, int]] = []
+    begun: tuple[str, int] | None = None
+    for comment in comments:
+        text = comment.text.strip()
+        if text.startswith("begin: URCap"):
+            begun = ("a URCap", comment.span.line)
+        elif begun is not None and text.startswith("Source:"):
+            name = text[len("Source:"):].split(",")[0].strip()
+            begun = (name or begun[0], begun[1])
+        elif begun is not None and text.startswith("end: URCap"):
+            blocks.append((begun[0], begun[1], comment.span.line))
+            begun = None
+    return blocks

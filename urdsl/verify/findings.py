@@ -123,6 +123,16 @@ that is skipped.""",
       f"{_READY}\nhome = get_actual_tcp_pose()\n"
       "movel(pose_add(home, p[0.1, 0, 0, 0, 0, 0]), r=0.02)\n"
       "movel(pose_add(home, p[0.1, 0.06, 0, 0, 0, 0]), r=0.02)\nmovel(home)")
+_rule("URS214", "urcap-node", "info",
+      "A URCap program node: only the URCap can generate its code.",
+      """
+A PolyScope program (.urp) may hold program nodes of URCaps (a gripper's Grip node, a
+vision system's Locate node). What such a node runs, only the URCap can write: urdsl
+compiles the program without it, says so once per node, and checks the rest with the node
+taken as a device (it takes a device's reply time, its results are unknown). In an export
+(.script) PolyScope wrote the URCap's code, and urdsl checks that.""",
+      "# a .urp with a Robotiq Grip node: urdsl check pick.urp",
+      "# export the program from PolyScope (it writes pick.script with the URCap's code)")
 _rule("URS311", "threads-still-running", "warning",
       "The program ended while threads were still running.",
       """

@@ -34,6 +34,7 @@ from ..script import nodes as n
 from ..script.diagnostics import ScriptSyntaxError
 from ..script.nodes import NO_SPAN
 from ..script.parser import parse
+from ..script.urcaps import urcap_blocks
 from . import checks
 from .findings import Finding, nothing_runs
 from .report import Loop, Move, Report
@@ -288,27 +289,6 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     report.findings = group_urcap_notes(blocks, report.findings)
     report.sort()
     return report
-
-
-def urcap_blocks(module) -> list[tuple[str, int, int]]:
-    """The code a URCap wrote into the program (PolyScope's ``# begin: URCap Installation
-    Node`` / ``Program Node`` … ``# end: …`` comments): (the URCap's name from its
-    ``#   Source:`` line, first line, last line) for each block."""
-    comments = sorted((c for c in n.walk(module) if type(c) is n.Comment),
-                      key=lambda c: c.span.line)
-    blocks: list[tuple[str, int, int]] = []
-    begun: tuple[str, int] | None = None
-    for comment in comments:
-        text = comment.text.strip()
-        if text.startswith("begin: URCap"):
-            begun = ("a URCap", comment.span.line)
-        elif begun is not None and text.startswith("Source:"):
-            name = text[len("Source:"):].split(",")[0].strip()
-            begun = (name or begun[0], begun[1])
-        elif begun is not None and text.startswith("end: URCap"):
-            blocks.append((begun[0], begun[1], comment.span.line))
-            begun = None
-    return blocks
 
 
 def generated_threads(module, blocks: list[tuple[str, int, int]]) -> set[str]:
