@@ -234,3 +234,24 @@ def test_a_move_without_a_condition_to_the_same_target_is_not_cut():
     arm = planner()
     with pytest.raises(OutOfReach):
         arm.movel(pose(100.0, 0, 0), 1.2, 0.25, 0, 0, NO_SPAN, 0.0)
+
+
+def test_movec_fixed_mode_turns_the_tool_with_the_arc():
+    # mode 1 keeps the tool's orientation relative to the arc's tangent: half a circle in
+    # the xy plane turns it by 180 degrees about z, whatever the target's orientation says;
+    # mode 0 goes from the start's orientation to the target's
+    start = (0.3, 0.0, 0.2, 0.0, 0.0, 0.0)
+    target = pose(-0.3, 0.0, 0.2)
+    target[:3, :3] = rotvec_to_matrix(np.array([0.0, 0.0, 1.0]))  # 57 degrees about z
+    fixed = planner(start=start)
+    fixed.movec(pose(0.0, 0.3, 0.2), target, a=1.2, v=0.25, r=0.0, mode=1, span=NO_SPAN,
+                now=0.0)
+    (segment,) = fixed.segments
+    halfway = segment.path_poses(np.array([0.5]))[0]
+    assert np.allclose(halfway[:3, 3], (0.0, 0.3, 0.2), atol=1e-9)
+    assert np.allclose(matrix_to_rotvec(halfway[:3, :3]), (0, 0, math.pi / 2), atol=1e-9)
+    assert abs(abs(matrix_to_rotvec(segment.pose_end[:3, :3])[2]) - math.pi) < 1e-9
+    free = planner(start=start)
+    free.movec(pose(0.0, 0.3, 0.2), target, a=1.2, v=0.25, r=0.0, mode=0, span=NO_SPAN,
+               now=0.0)
+    assert np.allclose(matrix_to_rotvec(free.segments[0].pose_end[:3, :3]), (0, 0, 1.0))

@@ -50,6 +50,21 @@ def arc_length(p0: np.ndarray, via: np.ndarray, p2: np.ndarray) -> float:
     return radius * end
 
 
+def arc_rotations(p0: np.ndarray, via: np.ndarray, p2: np.ndarray,
+                  fraction: np.ndarray) -> np.ndarray:
+    """Rotations (N, 3, 3) about the arc's axis by the angle the arc from ``p0`` through
+    ``via`` to ``p2`` has turned at each path fraction: what ``movec``'s fixed mode
+    (``mode=1``) turns the tool by, so that its orientation stays the same relative to the
+    arc's tangent. The identity for points on a line."""
+    fraction = np.asarray(fraction, dtype=float)
+    circle = _circle(p0, via, p2)
+    if circle is None:
+        return np.repeat(np.eye(3)[None], len(fraction), axis=0)
+    _centre, _radius, u, w, _, end = circle
+    axis = np.cross(u, w)
+    return rotvec_to_matrix(fraction[:, None] * end * axis[None, :])
+
+
 def arc_points(p0: np.ndarray, via: np.ndarray, p2: np.ndarray,
                fraction: np.ndarray) -> np.ndarray:
     """Points (N, 3) at path fractions along the arc from ``p0`` through ``via`` to ``p2``."""

@@ -136,12 +136,19 @@ class Segment:
 
     def path_poses(self, fraction: np.ndarray) -> np.ndarray:
         """TCP poses (N, 4, 4) at path fractions in [0, 1] (Cartesian moves)."""
-        from .geometry import arc_points, slerp_rotations
+        from .geometry import arc_points, arc_rotations, slerp_rotations
 
         fraction = np.asarray(fraction, dtype=float)
         poses = np.repeat(np.eye(4)[None], len(fraction), axis=0)
-        poses[:, :3, :3] = slerp_rotations(self.pose_start[:3, :3], self.pose_end[:3, :3],
-                                           fraction)
+        if self.kind == "movec" and self.via is not None and self.params.get("mode") == 1:
+            # fixed mode: the tool turns with the arc, its orientation constant relative to
+            # the arc's tangent (the manual's movec, mode 1)
+            poses[:, :3, :3] = arc_rotations(self.pose_start[:3, 3], self.via,
+                                             self.pose_end[:3, 3], fraction) \
+                @ self.pose_start[:3, :3]
+        else:
+            poses[:, :3, :3] = slerp_rotations(self.pose_start[:3, :3],
+                                               self.pose_end[:3, :3], fraction)
         if self.kind == "movec" and self.via is not None:
             poses[:, :3, 3] = arc_points(self.pose_start[:3, 3], self.via, self.pose_end[:3, 3],
                                          fraction)
@@ -552,11 +559,16 @@ class MotionPlanner:
     def movec(self, via: np.ndarray, pose: np.ndarray, a: float, v: float, r: float,
               mode: int, span: Span, now: float) -> float:
         """Circular arc from the current TCP through ``via``'s position to ``pose``."""
-        from .geometry import arc_length
+        from .geometry import arc_length, arc_rotations
 
         pose_from = self._end_matrix()
         length = arc_length(pose_from[:3, 3], via[:3, 3], pose[:3, 3])
         profile = Trapezoid.plan(length, v, a)
+        if mode == 1:  # fixed mode: the target's orientation is not used; the tool ends
+            # turned by the arc's angle from where it started (the manual's movec, mode 1)
+            pose = pose.copy()
+            pose[:3, :3] = arc_rotations(pose_from[:3, 3], via[:3, 3], pose[:3, 3],
+                                         np.array([1.0]))[0] @ pose_from[:3, :3]
         return self._add_cartesian("movec", profile, pose_from, pose, r, span,
                                    {"a": a, "v": v, "mode": mode}, now, via=via)
 
