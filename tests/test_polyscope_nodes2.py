@@ -177,7 +177,7 @@ def test_relative_waypoint_moves_by_the_taught_difference():
 def test_polyscope3_relative_waypoint_writes_its_poses_in_place():
     # PolyScope 3 writes no waypoint globals; a relative waypoint's two poses stand in the
     # motion as a fixed waypoint's pose does, from the forward kinematics (seen: 3.15.6
-    # ati-ia/ft-urcap, 3.15.8 ic-sw1821/UR_RTDE_2; test_polyscope_nodes8)
+    # ati-ia/ft-urcap, 3.15.8 ic-sw1821/UR_RTDE_2)
     lines = compiled(RELATIVE.format(
         start='<relativeFromPosition joints="0, -1.5, 1.5, -1.5, -1.5, 0" '
               'pose="0.1, 0.2, 0.3, 0.0, 3.14, 0.0"/>',

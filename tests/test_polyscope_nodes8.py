@@ -6,7 +6,6 @@ PolyScope wrote."""
 from __future__ import annotations
 
 import pytest
-from test_polyscope_nodes2 import RELATIVE
 from test_polyscope_nodes3 import OLD_NODES
 from test_polyscope_nodes6 import FORCE
 from test_polyscope_variants import WAYPOINT, WAYPOINT_MOVE, compiled
@@ -58,19 +57,6 @@ def test_polyscope_3_5_numbers_a_suppressed_node_as_one():
 def test_later_polyscope_numbers_every_node_in_a_suppressed_one(version):
     # 3.15 (Usaakm, PakBot) and 5.x number the suppressed MoveJ and its waypoint
     assert markers(compiled(SUPPRESSED, version=version))[-1].startswith('$ 4 "Wait: 0.01"')
-
-
-def test_polyscope_3_relative_waypoint_moves_from_the_forward_kinematics():
-    # ati-ia/ft-urcap ATI Demo Program (3.15.6), ic-sw1821/UR_RTDE_2 DMT08b_9 (3.15.8):
-    # movel(pose_add(get_forward_kin(), pose_sub(p[to], p[from])), …)
-    lines = compiled(RELATIVE.format(
-        start='<relativeFromPosition joints="0, -1.5, 1.5, -1.5, -1.5, 0" '
-              'pose="0.1, 0.2, 0.3, 0.0, 3.14, 0.0"/>',
-        end='<position joints="0, -1.4, 1.5, -1.5, -1.5, 0" '
-            'pose="0.1, 0.25, 0.3, 0.0, 3.14, 0.0"/>'),
-        version="3.15.6.106324")
-    assert "movel(pose_add(get_forward_kin(), pose_sub(p[0.1, 0.25, 0.3, 0.0, 3.14, 0.0], " \
-           "p[0.1, 0.2, 0.3, 0.0, 3.14, 0.0])), a=1.2, v=0.25)" in lines
 
 
 def test_polyscope_3_force_does_not_zero_a_force_sensor():
