@@ -11,7 +11,7 @@ import re
 from ..script import nodes as n
 from ..script.diagnostics import Diagnostic, ScriptError
 from ..script.parser import parse
-from ..script.urcaps import urcap_blocks
+from ..script.urcaps import by_urcap_block, urcap_blocks
 from . import calls, flow, motion, names  # noqa: F401 - importing registers the rules
 from .config import LintSettings, build_settings
 from .context import LintContext
@@ -104,14 +104,8 @@ def _folded_in_urcap_code(found: list[Diagnostic], tree: n.Module,
     blocks = urcap_blocks(tree)
     if not blocks:
         return found
-    kept: list[Diagnostic] = []
-    folded: dict[tuple[str, int, int], list[Diagnostic]] = {}
-    for diagnostic in found:
-        block = next((b for b in blocks if b[1] <= diagnostic.line <= b[2]), None)
-        if block is None or diagnostic.severity == "error":
-            kept.append(diagnostic)
-        else:
-            folded.setdefault(block, []).append(diagnostic)
+    kept, folded = by_urcap_block(blocks, found, lambda d: d.line,
+                                  lambda d: d.severity != "error")
     if not shown:
         return kept
     source = tree.span.source or n.Source("", "<generated>")

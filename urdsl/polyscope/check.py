@@ -201,7 +201,7 @@ def missing_features(generated: Generated) -> dict[str, str]:
     named = f"{program.installation}.installation" if program.installation else "(none named)"
     return {name: f"a {'feature' if name in program.feature_variables else 'name'} of the "
                   f"installation {named} (not beside the program)"
-            for name in sorted(program.feature_variables | program.installation_names)}
+            for name in sorted(program.installation_names)}  # feature variables too
 
 
 def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:

@@ -396,16 +396,33 @@ def installation_features(path: Path) -> VariablesFile | None:
     and plane features: ``pose_trans(Plane_1, p)``), as installation variables
     ``Plane_1=p[...]`` of a file named ``PATH (features)``; None when it has none or cannot be
     read (a ``.urp`` that names it says so). PolyScope writes them into the preamble of every
-    program run with that installation, so a script file a program includes may use them."""
-    from ..polyscope.compile import ascii_name
+    program run with that installation, so a script file a program includes may use them.
+    Cached as :func:`load_script`."""
     from ..polyscope.installation import InstallationError, read_installation
 
+    key = _cache_key(path, "features")
+    if key is None:
+        return None
+    if key in _FEATURES:
+        return _FEATURES[key]
     try:
-        if path.stat().st_size > MAX_FILE_BYTES:
-            return None
         installation = read_installation(path)
     except (InstallationError, OSError):
-        return None
+        installation = None
+    if len(_FEATURES) > 512:
+        _FEATURES.clear()
+    _FEATURES[key] = features = None if installation is None else _features_file(
+        installation, path)
+    return features
+
+
+_FEATURES: dict[tuple, VariablesFile | None] = {}
+
+
+def _features_file(installation, path: Path) -> VariablesFile | None:
+    """:func:`installation_features` of an installation read."""
+    from ..polyscope.compile import ascii_name
+
     # named as PolyScope writes them in a script ("点_1" is u28857_1); a name or pose that
     # still is no URScript (a damaged file) is left out, never reported as the user's line
     lines = [f"{ascii_name(name)}=p[{', '.join(repr(float(v)) for v in pose)}]\n"

@@ -370,6 +370,7 @@ def catalog() -> dict[str, Builtin]:
     return _load()[0]
 
 
+@functools.cache
 def methods() -> dict[str, Builtin]:
     """List and RPC-handle methods by method name (``append``, ``pop``, ...); the struct and
     matrix methods of the same names are found with :func:`method`."""

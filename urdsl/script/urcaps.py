@@ -22,11 +22,13 @@ exports of ``bench/realworld``; a URCap none of them uses is not in it::
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable, Iterable
 from importlib import resources
+from typing import TypeVar
 
 from . import nodes as n
 
-__all__ = ["urcap_blocks", "urcap_hint", "urcap_of"]
+__all__ = ["by_urcap_block", "urcap_blocks", "urcap_hint", "urcap_of"]
 
 
 @functools.cache
@@ -83,3 +85,26 @@ def urcap_blocks(module) -> list[tuple[str, int, int]]:
             blocks.append((begun[0], begun[1], comment.span.line))
             begun = None
     return blocks
+
+
+Item = TypeVar("Item")
+Block = tuple[str, int, int]
+
+
+def by_urcap_block(blocks: list[Block], items: Iterable[Item], line: Callable[[Item], int],
+                   wanted: Callable[[Item], bool] = lambda item: True
+                   ) -> tuple[list[Item], dict[Block, list[Item]]]:
+    """``items`` (findings) split into those outside URCap code and those inside, by the
+    block (:func:`urcap_blocks`) that holds their ``line``; an item ``wanted`` rejects stays
+    outside wherever it is."""
+    outside: list[Item] = []
+    inside: dict[Block, list[Item]] = {}
+    for item in items:
+        at = line(item)
+        block = next((b for b in blocks if b[1] <= at <= b[2]), None) if wanted(item) \
+            else None
+        if block is None:
+            outside.append(item)
+        else:
+            inside.setdefault(block, []).append(item)
+    return outside, inside

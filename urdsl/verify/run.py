@@ -34,7 +34,7 @@ from ..script import nodes as n
 from ..script.diagnostics import ScriptSyntaxError
 from ..script.nodes import NO_SPAN
 from ..script.parser import parse
-from ..script.urcaps import urcap_blocks
+from ..script.urcaps import by_urcap_block, urcap_blocks
 from . import checks
 from .findings import Finding, nothing_runs
 from .report import Loop, Move, Report
@@ -308,16 +308,8 @@ def group_urcap_notes(blocks: list[tuple[str, int, int]],
     conditions."""
     if not blocks:
         return findings
-    grouped: dict[tuple[str, int, int], list[Finding]] = {}
-    kept: list[Finding] = []
-    for finding in findings:
-        line = finding.span.line
-        block = next((b for b in blocks if b[1] <= line <= b[2]), None) \
-            if finding.code == "URS210" else None
-        if block is None:
-            kept.append(finding)
-        else:
-            grouped.setdefault(block, []).append(finding)
+    kept, grouped = by_urcap_block(blocks, findings, lambda f: f.span.line,
+                                   lambda f: f.code == "URS210")
     for (name, first, last), notes in grouped.items():
         if len(notes) == 1:
             kept.extend(notes)
