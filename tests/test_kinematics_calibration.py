@@ -207,3 +207,23 @@ def test_a_move_after_a_wide_arc_starts_where_the_arc_ended(deltas):
     # the next move starts right there
     assert report.trace.q[arc_rows[-1], 4] > 0
     assert np.abs(report.trace.q[after_rows[0]] - report.trace.q[arc_rows[-1]]).max() < 0.05
+
+
+@pytest.mark.parametrize("elbow", [-0.0129, 0.0103, -0.004])
+def test_a_pose_taught_stretched_out_keeps_its_elbow_on_a_longer_arm(elbow):
+    # an arm whose forearm is 0.9 mm longer than nominal, taught with the elbow a few
+    # hundredths of a radian from straight: the pose lies beyond the nominal reach, where
+    # both nominal elbow solutions are clamped to the same point; the arm's own solution
+    # (its taught joints) must still be found, on its side of the straight elbow
+    deltas = dict(DELTAS, delta_a=[2.3e-5, 1.2e-4, -8.9e-4, 1.1e-5, 4.0e-5, 0.0])
+    arm = Robot.model("ur5e", Calibration(**deltas))
+    taught = np.array([-2.1973, 0.0307, elbow, -0.5452, -1.4095, -2.6655])
+    pose = arm.fk(taught)
+    nominal, _ = Robot.model("ur5e").ik_all_many(pose[None])
+    assert np.nanmin(np.abs(nominal[0] - taught).max(axis=1)) > 0.1  # beyond its reach there
+    solutions = arm.ik_all(pose)
+    assert np.min(np.abs(solutions - taught).max(axis=1)) < 1e-9
+    assert np.allclose(arm.ik(pose, taught), taught, atol=1e-9)
+    assert np.allclose(arm.ik_many(pose[None], taught)[0], taught, atol=1e-9)
+    every, _ = arm.ik_all_many(pose[None])
+    assert np.nanmin(np.abs(every[0] - taught).max(axis=1)) < 1e-9

@@ -40,6 +40,30 @@ __all__ = ["Robot"]
 REFINE_TOLERANCE = 1e-12
 #: Nominal branches out of reach by less than this [m] are still refined for a calibrated arm.
 CALIBRATED_REACH_SLACK = 0.01
+#: Elbow angle [rad] from which a calibrated arm's solution is refined when the nominal one
+#: lies closer to the stretched elbow (θ3 = 0): see :func:`_elbow_seeds`.
+ELBOW_SEED = 0.02
+
+
+def _elbow_seeds(guesses: np.ndarray, side: np.ndarray) -> np.ndarray:
+    """Nominal solutions ``guesses`` (..., 6) as starting points for a calibrated arm's
+    Newton steps, each on its elbow side ``side`` (+1: θ3 ≥ 0, −1: θ3 ≤ 0; one per guess,
+    shape ``guesses.shape[:-1]`` or broadcast to it).
+
+    Near the stretched elbow the two elbow solutions of a pose lie a few hundredths of a
+    radian either side of θ3 = 0 on the calibrated arm, and the nominal ones may coincide at
+    0 (a pose the calibrated arm reaches lies just beyond the nominal reach, where both are
+    clamped to the boundary): refined from there, both converge to the same solution and
+    the arm's own solution is missed — the taught joints of a pose taught stretched out. A
+    guess within :data:`ELBOW_SEED` of 0 therefore starts at ±ELBOW_SEED on its side."""
+    seeds = np.array(guesses, dtype=float)
+    theta3 = seeds[..., 2]
+    seeds[..., 2] = np.where(np.abs(theta3) < ELBOW_SEED, side * ELBOW_SEED, theta3)
+    return seeds
+
+
+#: The elbow side of each analytic branch (k % 2 = 0: θ3 = +acos(…), 1: −acos(…)).
+_BRANCH_SIDE = np.where(np.arange(8) % 2 == 0, 1.0, -1.0)
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
@@ -287,7 +311,8 @@ class Robot:
         solutions, miss = _ik.solve_ur(flange, *self._nominal, q6_hint=q6_hint,
                                        reach_tolerance=CALIBRATED_REACH_SLACK)
         valid = ~np.isnan(solutions[..., 0])
-        refined, error = _ik.refine(solutions[valid], flange[np.nonzero(valid)[0]], *self._dh)
+        seeds = _elbow_seeds(solutions, _BRANCH_SIDE)
+        refined, error = _ik.refine(seeds[valid], flange[np.nonzero(valid)[0]], *self._dh)
         good = error < REFINE_TOLERANCE
         out = np.full_like(solutions, np.nan)
         index_n, index_k = np.nonzero(valid)
@@ -329,7 +354,8 @@ class Robot:
             return _dedupe(candidates)
         solutions, _ = _ik.solve_ur(flange, *self._nominal, q6_hint=hint,
                                     reach_tolerance=CALIBRATED_REACH_SLACK)
-        guesses = solutions[0][~np.isnan(solutions[0, :, 0])]
+        present = ~np.isnan(solutions[0, :, 0])
+        guesses = _elbow_seeds(solutions[0][present], _BRANCH_SIDE[present])
         # the batched solvers' damped Newton steps; where they do not converge (near a
         # singularity of the nominal guess), Pinocchio's least-squares steps
         refined, errors = _ik.refine(guesses, np.repeat(flange, len(guesses), axis=0),
@@ -395,7 +421,8 @@ class Robot:
         guess, found = _ik.choose_nearest(solutions, near, self.q_min, self.q_max)
         chosen = np.full((n, 6), np.nan)
         rows = np.flatnonzero(found)
-        refined, error = _ik.refine(guess[rows], flange[rows], *self._dh)
+        side = np.where(near[rows, 2] < 0.0, -1.0, 1.0)  # the side q_near is on
+        refined, error = _ik.refine(_elbow_seeds(guess[rows], side), flange[rows], *self._dh)
         good = error < REFINE_TOLERANCE
         chosen[rows[good]], _ = _ik.choose_nearest(refined[good][:, None, :],
                                                    near[rows[good]], self.q_min, self.q_max)
