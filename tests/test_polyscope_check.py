@@ -304,3 +304,33 @@ def test_installation_variables_and_move_features_of_a_missing_installation(tmp_
     assert found and found[0]["severity"] == "warning"
     assert "a name of the installation default.installation (not beside the program)" in \
         found[0]["message"]
+
+
+def test_an_export_is_checked_on_the_arm_of_the_program_beside_it(tmp_path, capsys):
+    # PolyScope saves X.script beside X.urp, whose <kinematics> is the arm's calibration: a
+    # pose taught with the arm stretched up lies beyond the nominal model's reach (here its
+    # upper arm is 1.5 mm longer) and is reached by the very arm
+    import numpy as np
+
+    from urdsl.kinematics import Robot
+    from urdsl.kinematics.pose import matrix_to_rotvec
+
+    kinematics = ('<kinematics><deltaTheta value="0, 0, 0, 0, 0, 0"/>'
+                  '<a value="0.0, -0.4265, -0.3922, 0.0, 0.0, 0.0"/>'
+                  '<d value="0.1625, 0.0, 0.0, 0.1333, 0.0997, 0.0996"/>'
+                  '<alpha value="1.5707963267948966, 0, 0, 1.5707963267948966, '
+                  '-1.5707963267948966, 0"/></kinematics>')
+    (tmp_path / "arm.urp").write_text(_program(
+        '<Wait type="Sleep"><waitTime>0.1</waitTime></Wait>', kinematics))
+    calibration, _ = calibration_of(read_urp(tmp_path / "arm.urp"))
+    up = [0.0, -1.5707963267948966, 0.0, -1.5707963267948966, 0.0, 0.0]
+    pose = Robot.model("ur5e", calibration=calibration).fk(np.array(up))
+    target = [float(v) for v in (*pose[:3, 3], *matrix_to_rotvec(pose[:3, :3]))]
+    export = tmp_path / "arm.script"
+    export.write_text("def arm():\n  movej(get_inverse_kin(p[" + ", ".join(map(repr, target))
+                      + "]))\nend\n")
+    assert main(["check", str(export), "--robot", "ur5e", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert "calibration of arm.urp's <kinematics>" in report["context"]
+    assert main(["check", str(export), "--robot", "ur5e", "--json", "--nominal"]) == 1
+    assert any(f["code"] == "URS301" for f in json.loads(capsys.readouterr().out)["findings"])

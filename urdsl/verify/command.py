@@ -127,8 +127,9 @@ def add_commands(commands) -> None:
                    help="check the file alone, not in the context of its project (host "
                    "program, sibling script files, installation variables)")
     p.add_argument("--nominal", action="store_true",
-                   help="a PolyScope program (.urp): check on the model's nominal kinematics, "
-                   "not the arm's calibration stored in the program")
+                   help="a PolyScope program (.urp), or its export with the .urp beside "
+                   "it: check on the model's nominal kinematics, not the arm's calibration "
+                   "stored in the program")
     p.set_defaults(run=cmd_check)
 
 
@@ -296,12 +297,43 @@ def _check_script(source, args: argparse.Namespace, options):
         file_options.cell = load_cell(file_options.robot, args.cell)
     if context is not None and context.hosts:
         inference.polyscope = True  # a fragment of a program PolyScope runs: taught on an arm
+    calibrated = None if args.nominal else _export_calibration(source.path, file_options)
     report = check_tree(module, source.name, file_options, started=started)
     report.inferred = inference
     qualify(report, inference)
-    if context is not None:
-        report.context = context.note
+    notes = [context.note] if context is not None and context.note else []
+    if calibrated:
+        notes.append(calibrated)
+    if notes:
+        report.context = "; ".join(notes)
     return report
+
+
+def _export_calibration(path: str | None, options) -> str | None:
+    """For an export (``X.script`` with PolyScope's ``X.urp`` beside it, whose ``<kinematics>``
+    is the arm's factory calibration): check on that very arm, as ``urdsl check X.urp`` does
+    (``options.calibration`` set when the calibration is of the model checked). A note
+    saying so, or None (no such program, no such block, another model)."""
+    from pathlib import Path
+
+    from ..polyscope.check import calibration_of
+    from ..polyscope.urp import UrpError, read_urp
+
+    if path is None:
+        return None
+    program_path = Path(path).with_suffix(".urp")
+    if not program_path.is_file():
+        return None
+    try:
+        program = read_urp(program_path)
+    except (UrpError, OSError):
+        return None
+    calibration, model = calibration_of(program, options.robot)
+    if calibration is None or model != options.robot:
+        return None
+    options.calibration = calibration
+    return (f"on this very arm: the {model} calibration of {program_path.name}'s "
+            "<kinematics>")
 
 
 def _check_urp(name: str, args: argparse.Namespace, options):
