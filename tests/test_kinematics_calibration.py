@@ -227,3 +227,14 @@ def test_a_pose_taught_stretched_out_keeps_its_elbow_on_a_longer_arm(elbow):
     assert np.allclose(arm.ik_many(pose[None], taught)[0], taught, atol=1e-9)
     every, _ = arm.ik_all_many(pose[None])
     assert np.nanmin(np.abs(every[0] - taught).max(axis=1)) < 1e-9
+
+
+@pytest.mark.parametrize("wrist", [0.005, -0.001, 1e-4])
+def test_near_the_wrist_singularity_the_arm_keeps_its_own_solution(calibrated, wrist):
+    # a few milliradians from wrist 2 = 0 the nominal solution's split between wrists 1 and 3
+    # is far from the calibrated arm's, and refined from there it may end on another of the
+    # calibrated chain's solutions: the joints the arm is at must still be the answer
+    here = np.array([-2.0, -0.8, -1.9, 0.3, wrist, 2.0])
+    pose = calibrated.fk(here)
+    assert np.allclose(calibrated.ik(pose, here), here, atol=1e-9)
+    assert np.allclose(calibrated.ik_many(pose[None], here)[0], here, atol=1e-9)

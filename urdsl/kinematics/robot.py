@@ -62,6 +62,11 @@ def _elbow_seeds(guesses: np.ndarray, side: np.ndarray) -> np.ndarray:
     return seeds
 
 
+#: A calibrated arm's solution more than this [rad] (largest joint) from ``q_near`` is solved
+#: again from ``q_near`` itself (:meth:`Robot.ik_many`): a joint moves at most 0.1 rad
+#: between two trace samples, a branch change about π.
+RESEED_STEP = 0.1
+
 #: The elbow side of each analytic branch (k % 2 = 0: θ3 = +acos(…), 1: −acos(…)).
 _BRANCH_SIDE = np.where(np.arange(8) % 2 == 0, 1.0, -1.0)
 
@@ -339,6 +344,13 @@ class Robot:
             q = q + np.linalg.lstsq(jacobian, twist, rcond=None)[0]
         return q, error
 
+    def _refine_from(self, q: np.ndarray, flange: np.ndarray) -> np.ndarray:
+        """A calibrated arm's solutions (M, 6) for flange poses (M, 4, 4) found by Newton
+        steps from the joints ``q`` (M, 6) themselves; NaN rows where they do not converge."""
+        refined, error = _ik.refine(q, flange, *self._dh)
+        refined[~(error < REFINE_TOLERANCE)] = np.nan
+        return refined
+
     def ik_all(self, T, tcp=None, q6_hint: float = 0.0) -> np.ndarray:
         """All inverse kinematics solutions (k, 6), k ≤ 8, joints wrapped to (−π, π].
 
@@ -385,6 +397,10 @@ class Robot:
         q_near = _joints(q_near, "q_near")
         T = _transform(T)
         solutions = self.ik_all(T, tcp, q6_hint=float(q_near[5]))
+        if self.calibration is not None:
+            nearby = self._refine_from(q_near[None], self._flange_targets(T[None], tcp))
+            if not np.isnan(nearby[0, 0]):
+                solutions = _dedupe(np.concatenate([solutions.reshape(-1, 6), nearby]))
         if len(solutions) == 0:
             distance = float(self.out_of_reach(T[None], tcp)[0])
             position = np.round(T[:3, 3], 4).tolist()
@@ -426,6 +442,15 @@ class Robot:
         good = error < REFINE_TOLERANCE
         chosen[rows[good]], _ = _ik.choose_nearest(refined[good][:, None, :],
                                                    near[rows[good]], self.q_min, self.q_max)
+        # near a singularity the nominal guess may refine to another of the calibrated
+        # arm's solutions (a general 6R chain has up to 16); the one nearest q_near is then
+        # found from q_near itself, as the arm continues from where it is
+        far = np.flatnonzero(~(np.abs(chosen - near).max(axis=1) <= RESEED_STEP))
+        if len(far):
+            nearby = self._refine_from(near[far], flange[far])
+            candidates = np.stack([chosen[far], nearby], axis=1)
+            chosen[far], _ = _ik.choose_nearest(candidates, near[far], self.q_min,
+                                                self.q_max)
         retry = np.flatnonzero(np.isnan(chosen[:, 0]))
         if len(retry):
             every, _ = self._solve(flange[retry], near[retry, 5])
