@@ -60,7 +60,9 @@ listed the same way; ``tune6``: the same for the projects of the next round (rep
 found by their names and file lists, URSim volume folders, course templates, and those the
 real-world helpers fetched), listed the same way; ``tune7``: the same for the projects of
 the round after (repositories found by their names: URCap, RTDE, socket and controller
-repositories, vendors' example programs), listed the same way),
+repositories, vendors' example programs), listed the same way; ``tune8``: the same for the
+projects of the round after that (repositories found by names of courses, tasks and arm
+models), listed the same way),
 the share of programs exact, the mean share of matching lines and the node types whose lines
 differ most; then each project's share of programs exact (program part, whole, whole among
 the programs with their installation) and the mean of these over the projects, each project
@@ -446,7 +448,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="folder of owner+name git dirs")
     parser.add_argument("--pairs", type=Path, default=ROOT / "bench/polyscope/pairs.tsv")
     parser.add_argument("--split", choices=("tune", "held", "extra", "tune2", "tune3", "tune4",
-                                                   "tune5", "tune6", "tune7", "all"),
+                                                   "tune5", "tune6", "tune7", "tune8", "all"),
                         default="all")
     parser.add_argument("--show", type=int, default=0, help="show the diffs of N programs")
     parser.add_argument("--script-files", choices=("file", "cache"), default="file",

@@ -513,18 +513,19 @@ class _Compiler:
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
         saved = _version(program.saved_in or program.created_in)
-        # PolyScope before 3.12 (seen: 3.5.0, 3.8.0 and 3.10.1; 3.12.1, 3.14.1, 3.15 on
-        # write them) writes its markers without the breakAfter/noBreak flags, and (seen:
-        # 3.10.1, alan1982br/gs1_carnaval_Photobooth_robot_arm_UR) none for a Case node nor
-        # for the nodes in a Thread node, which it numbers all the same; 3.8.0 (not 3.5.0,
-        # 3.10.1, 3.12.1, 3.14.1 or 3.15) writes no marker for the Robot Program node
-        # [U: 3.9 and 3.11; Case and Thread markers before 3.10]
+        # PolyScope before 3.12 (seen: 3.5.0, 3.8.0, 3.10.1 and 3.11.0; 3.12.1, 3.14.1,
+        # 3.15 on write them) writes its markers without the breakAfter/noBreak flags, and
+        # before 3.11 (seen: 3.10.1, alan1982br/gs1_carnaval_Photobooth_robot_arm_UR) none
+        # for a Case node nor for the nodes in a Thread node, which it numbers all the same;
+        # 3.11.0 (Grzegorr/Paper-Potato-UR5 kg_client) writes both, as 3.12 on do; 3.8.0
+        # (not 3.5.0, 3.10.1, 3.11.0, 3.12.1, 3.14.1 or 3.15) writes no marker for the
+        # Robot Program node [U: 3.9; Case and Thread markers before 3.10]
         # PolyScope 5 before 5.6 writes no flags either (seen: 5.4.2 and 5.5.1, waypoint
         # markers without "breakAfter"; 5.7.0 on with them); the flags came with breakpoints
         # and single step, 3.12 and 5.6 [U: 5.6, 5.0-5.3]
         early = (saved[0] == 3 and saved < (3, 12)) or (saved[0] == 5 and saved < (5, 6))
         self.flags = not early
-        self.inner_markers = not (saved[0] == 3 and saved < (3, 12))
+        self.inner_markers = not (saved[0] == 3 and saved < (3, 11))
         self.main_marker = not ((3, 6) <= saved < (3, 10))
         # before breakpoints a suppressed node is numbered as one, whatever it holds (seen:
         # 3.5.4, jmtc7 7_4_pruebas_modbus: a suppressed MoveJ with its waypoint is one

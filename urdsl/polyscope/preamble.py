@@ -170,7 +170,7 @@ def preamble_blocks(program: Program, installation: Installation | None,
                                                 Number(0))]))
     movable: dict[str, list[Item]] = {"steps": step_counter(program)}
     if installation is not None:
-        movable.update(_installation_blocks(installation, major))
+        movable.update(_installation_blocks(installation, major, saved))
     for kind in BLOCKS:
         if movable.get(kind):
             blocks.append((kind, movable[kind]))
@@ -273,11 +273,18 @@ def preamble(program: Program, installation: Installation | None,
             for item in items]
 
 
-def _installation_blocks(installation: Installation, major: int) -> dict[str, list[Item]]:
+def _installation_blocks(installation: Installation, major: int,
+                        saved: tuple[int, int] = (0, 0)) -> dict[str, list[Item]]:
     settings = installation.settings or {}
     blocks: dict[str, list[Item]] = {}
     safety: list[Item] = []
     hardness = settings.get("SmoothTransitionSettings", {}).get("transitionHardness")
+    if hardness is None and (3, 10) <= saved < (4, 0):
+        # an installation saved before the setting existed (3.4.5) compiled by a PolyScope
+        # that has it (3.11.0, Grzegorr/Paper-Potato-UR5 kg_client): the hard transition,
+        # ``set_safety_mode_transition_hardness(0)``; 3.5.0 writes nothing (Sander-ONeil)
+        # [U: 3.6-3.9, and 5.x with such an installation]
+        hardness = "HARD"
     if hardness:
         safety.append(_stmt("set_safety_mode_transition_hardness",
                             Number(1 if hardness == "SOFT" else 0)))
@@ -300,11 +307,30 @@ def _installation_blocks(installation: Installation, major: int) -> dict[str, li
     blocks["modbus"] = _modbus(installation)
     payload = installation.payload
     if payload is not None:
-        blocks["payload"] = payload_statements(installation, payload)
+        blocks["payload"] = payload_statements(installation, _tcp_as_cog(installation, payload,
+                                                                         saved))
     tcp = installation.tcp
     if tcp is not None:
         blocks["tcp"] = [_stmt("set_tcp", Pose(tuple(_num(v) for v in tcp.offset)))]
     return blocks
+
+
+def _tcp_as_cog(installation: Installation, payload: Payload,
+                saved: tuple[int, int]) -> Payload:
+    """The payload a later PolyScope reads from an installation last saved before 3.5: one
+    without a centre of gravity has it at the active TCP's position (seen: 3.11.0
+    compiling an installation saved in 3.4.5, Grzegorr/Paper-Potato-UR5 kg_client:
+    ``set_payload(0.0,[0.0,0.0,0.11])``, its active TCP at ``0, 0, 0.11``). PolyScope 3.2
+    with its own installation writes the mass alone (nedlecky/UR KeyenceRobotVisionSample
+    at c48f8df), and so does any PolyScope with an installation saved in 3.5 or later
+    (3.5.0, 3.15.8, 5.7.0 seen) [U: 3.5-3.10 and 3.12 on with a 3.4 installation]."""
+    old = _version(installation.version)
+    if payload.cog is not None or old[0] != 3 or old >= (3, 5) or not (3, 5) <= saved < (4, 0):
+        return payload
+    tcp = installation.tcp
+    if tcp is None or len(tcp.offset) < 3:
+        return payload
+    return Payload(payload.name, payload.mass, (tcp.offset[0], tcp.offset[1], tcp.offset[2]))
 
 
 def _io(settings: dict[str, dict[str, str]], major: int = 5) -> list[Item]:
