@@ -113,6 +113,16 @@ def test_the_same_move_with_pose_add_is_followed(tmp_path, capsys):
                                             "--robot", "ur5e"))] == [9]
 
 
+def test_the_target_waypoint_at_an_unknown_start_is_as_unknown_as_the_tcp_pose(tmp_path,
+                                                                              capsys):
+    # get_target_waypoint() (what PolyScope's Direction node aims from) is where the arm
+    # stands when it stands still: relative to the unknown start, not urdsl's default pose
+    move = "    x = get_target_waypoint()\n    movej(pose_add(x, p[0, -0.1, 0, 0, 0, 0]))"
+    found = errors(check(tmp_path, capsys, export(move), "--robot", "ur5e"))
+    assert [f["line"] for f in found] == [9]
+    assert "where the arm stood when the program started" in found[0]["message"]
+
+
 def test_a_move_that_blends_leaves_the_position_unknown(tmp_path, capsys):
     # with a blend radius the thread goes on before the arm is there: what it reads next
     # is a point on the way, so nothing is followed

@@ -245,11 +245,30 @@ def test_a_missing_installation_is_named(tmp_path, capsys):
     assert main(["check", str(program), "--json"]) == 0
     assert "no installation default.installation beside the program" in json.loads(
         capsys.readouterr().out)["context"]
-    program.write_text(_program('<Set type="DigitalOutput"><pin referencedName="gripper"/>'
-                                '<digitalValue>1</digitalValue></Set>'))
-    assert main(["check", str(program)]) == 1
-    err = capsys.readouterr().err
-    assert f"{program}: error: node Robot Program > Set" in err and "Traceback" not in err
+
+
+def test_io_named_only_in_a_missing_installation(tmp_path, capsys):
+    # a user's name for an input or output (a renamed pin, a Modbus signal) is resolved by
+    # the installation: without it the program still compiles; a read is a value the check
+    # does not know (its condition a warning that says so), a Set of it keeps its marker
+    program = tmp_path / "alone.urp"
+    program.write_text(_program(
+        '<Set type="DigitalOutput"><pin referencedName="gripper"/>'
+        '<digitalValue>1</digitalValue></Set>'
+        '<Wait type="DigitalInput"><pin referencedName="part_ready"/>'
+        '<digitalValue>1</digitalValue></Wait>'))
+    assert main(["compile", str(program)]) == 0
+    out, err = capsys.readouterr()
+    assert "I/O named only in the missing installation (gripper, part_ready)" in err
+    assert '$ 2 "Set gripper=On"' in out and "while (part_ready == False):" in out
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    (waits,) = [f for f in report["findings"] if f["code"] == "URS210"]
+    assert "an I/O the installation default.installation names" in waits["message"]
+    assert main(["lint", str(program), "--format", "json"]) == 0
+    (found,) = json.loads(capsys.readouterr().out)
+    assert found["severity"] == "warning" and "'part_ready'" in found["message"]
 
 
 def test_a_feature_of_a_missing_installation_is_not_a_mistake_of_the_program(tmp_path,

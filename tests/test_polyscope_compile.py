@@ -152,10 +152,19 @@ def test_urcap_and_unknown_nodes_are_marked_not_dropped(lines):
 
 
 def test_an_unnamed_io_is_an_error_naming_the_node():
+    import dataclasses
+
+    from urdsl.polyscope.installation import read_installation
+
+    # an installation that does not name 'gripper'
+    installation = dataclasses.replace(read_installation(DATA / "cell.installation"),
+                                       io_names=())
     with pytest.raises(CompileError) as error:
-        compile_program(read_urp(CELL))  # without the installation that names 'gripper'
+        compile_program(read_urp(CELL), installation)
     assert "Robot Program > Loop > Set" in str(error.value)
     assert "'gripper' is not named in the installation" in str(error.value)
+    # without the installation that would name it, the name is what it is
+    assert compile_program(read_urp(CELL)).unknown_io == ("gripper", "part_present")
 
 
 # ---- the commands --------------------------------------------------------------------------

@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 from test_polyscope_variants import WAYPOINT, compiled
 
-from urdsl.polyscope.compile import CompileError
+from urdsl.polyscope.compile import CompileError, compile_program
 
 
 def test_until_expression_stops_the_direction_when_it_holds():
@@ -247,3 +247,39 @@ def test_assignment_of_two_calls_typed_together_is_written_as_polyscope_writes_i
     with pytest.raises(CompileError, match="Robot Program > here"):
         compiled("""<Assignment valueSource="Expression"><variable name="here"/>
           <expression><ExpressionToken token="1 +"/></expression></Assignment>""")
+
+
+def test_a_relative_start_on_kinematics_never_filled_in_uses_the_waypoints_own():
+    # underautomation/UniversalRobots.NET "all instructions" (UR16e): the program's top-level
+    # <kinematics> is status NOT_INITIALIZED with every value 0, and the relative waypoint's
+    # start refers to it; its end carries the arm's kinematics. Both poses come from the
+    # arm's: a start and end that differ in wrist 3 alone are at the same place.
+    from test_polyscope_programs import KINEMATICS
+
+    from urdsl.polyscope.urp import parse_urp
+
+    zeros = ('<kinematics status="NOT_INITIALIZED" validChecksum="false">'
+             + "".join(f'<{key} value="0.0, 0.0, 0.0, 0.0, 0.0, 0.0"/>'
+                       for key in ("deltaTheta", "a", "d", "alpha")) + "</kinematics>")
+    arm = KINEMATICS.replace("<kinematics", "<Kinematics").replace("</kinematics>",
+                                                                   "</Kinematics>")
+    waypoint = RELATIVE.format(
+        start='<relativeFromPosition><JointAngles angles="0.3, -1.5, 1.5, -1.5, -1.5, 0.0"/>'
+              '<TCPOffset pose="0, 0, 0, 0, 0, 0"/>'
+              '<Kinematics reference="../../../../../../../../kinematics"/>'
+              '</relativeFromPosition>',
+        end='<position><JointAngles angles="0.3, -1.5, 1.5, -1.5, -1.5, 0.3"/>'
+            f'<TCPOffset pose="0, 0, 0, 0, 0, 0"/>{arm}</position>')
+    text = (f'<URProgram name="t" installation="t" createdIn="5.11.1" lastSavedIn="5.11.1">'
+            f'{zeros}<children><MainProgram runOnlyOnce="true"><children>{waypoint}'
+            '</children></MainProgram></children></URProgram>')
+    lines = compile_program(parse_urp(text.encode(), "t.urp")).text.splitlines()
+    poses = {}
+    for line in lines:
+        for name in ("Slide_from_p", "Slide_to_p"):
+            if line.strip().startswith(f"global {name} = p["):
+                poses[name] = [float(v) for v in line.split("p[", 1)[1].rstrip("]").split(",")]
+    assert set(poses) == {"Slide_from_p", "Slide_to_p"}
+    assert max(abs(a - b) for a, b in zip(poses["Slide_from_p"][:3], poses["Slide_to_p"][:3],
+                                          strict=True)) < 1e-9
+    assert max(abs(v) for v in poses["Slide_from_p"][:3]) > 0.1  # a place of the arm

@@ -199,9 +199,13 @@ def missing_features(generated: Generated) -> dict[str, str]:
         return {}
     program = generated.program
     named = f"{program.installation}.installation" if program.installation else "(none named)"
-    return {name: f"a {'feature' if name in program.feature_variables else 'name'} of the "
-                  f"installation {named} (not beside the program)"
-            for name in sorted(program.installation_names)}  # feature variables too
+    out = {name: f"a {'feature' if name in program.feature_variables else 'name'} of the "
+                 f"installation {named} (not beside the program)"
+           for name in sorted(program.installation_names)}  # feature variables too
+    for name in generated.compiled.unknown_io:
+        out.setdefault(name, f"an I/O the installation {named} names (not beside the "
+                             "program)")
+    return out
 
 
 def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
@@ -485,6 +489,14 @@ def send_check(path: str, robot: str, check: bool):
         return None
     except ScriptError as error:
         print(error.diagnostic.render(), file=sys.stderr)
+        return None
+    if generated.compiled.unknown_io:
+        # compiled for reading and checking only: the robot would stop at the first of these
+        # names, and the outputs they name would never be set
+        named = generated.program.installation or "?"
+        print(f"{path}: not sent: the I/O {', '.join(generated.compiled.unknown_io)} "
+              f"named only in the installation {named}.installation, which is not beside "
+              "the program; put it there to send the program", file=sys.stderr)
         return None
     report = None
     if check:

@@ -135,7 +135,12 @@ def load_all(path: str | Path, warn: Callable[[str], None] = _warn
         file = folder / relative
         return file.read_bytes() if file.is_file() else None
 
-    return program, installation, compile_program(program, installation, variables, files)
+    compiled = compile_program(program, installation, variables, files)
+    if compiled.unknown_io:
+        warn(f"{path}: I/O named only in the missing installation ("
+             f"{', '.join(compiled.unknown_io)}): read as values of their own, unknown to "
+             "the check; the Set nodes writing them are written as their markers alone")
+    return program, installation, compiled
 
 
 def compile_urp(path: str, output: str | None) -> int:

@@ -109,6 +109,9 @@ class Compiled:
     numbers: dict[int, Node] = field(default_factory=dict)
     labels: dict[int, str] = field(default_factory=dict)
     """Marker number → the label PolyScope shows (in English)."""
+    unknown_io: tuple[str, ...] = ()
+    """I/O names a missing installation would resolve (a renamed pin or a Modbus signal):
+    read as a name of that value, their Set nodes left with their marker alone."""
 
     @property
     def text(self) -> str:
@@ -512,6 +515,7 @@ class _Compiler:
         self.base_variable = bool(getattr(installation, "base_variable", False))
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
+        self.unknown_io: dict[str, None] = {}  # I/O names of a missing installation, in order
         saved = _version(program.saved_in or program.created_in)
         # PolyScope before 3.12 (seen: 3.5.0, 3.8.0, 3.10.1 and 3.11.0; 3.12.1, 3.14.1,
         # 3.15 on write them) writes its markers without the breakAfter/noBreak flags, and
@@ -607,7 +611,7 @@ class _Compiler:
             # [U: other words]
             name = "P" + name
         module = _ascii_names(Module((FunctionDef(name, (), tuple(body)),)))
-        return Compiled(module, self.numbers, self.labels)
+        return Compiled(module, self.numbers, self.labels, tuple(self.unknown_io))
 
     def _all_nodes(self, suppressed: bool = False):
         """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
@@ -723,13 +727,17 @@ class _Compiler:
 
     def pose_of(self, node: Node, prefix: str = "") -> tuple[float, ...] | None:
         """The waypoint's TCP pose: as stored (PolyScope 3), else by forward kinematics of its
-        joint angles with the arm's calibration and the waypoint's TCP (PolyScope 5)."""
+        joint angles with the arm's calibration and the waypoint's TCP (PolyScope 5). The
+        calibration is the one stored with those joints, else the waypoint's own (a relative
+        waypoint's start may refer to a block PolyScope never filled in), else the
+        program's."""
         stored = node.fields.get(prefix + "pose")
         if stored and len(stored) == 6:
             return tuple(stored)
         q = node.fields.get(prefix + "q")
         tcp = node.fields.get(prefix + "tcp_offset") or (0.0,) * 6
-        kinematics = node.fields.get(prefix + "kinematics") or self.program.kinematics
+        kinematics = node.fields.get(prefix + "kinematics") or node.fields.get("kinematics") \
+            or self.program.kinematics
         if not q or kinematics is None:
             return None
         return waypoint_pose(q, tcp, kinematics)
@@ -968,6 +976,17 @@ class _Compiler:
                 return name
         return pin
 
+    def io_of_missing_installation(self, pin: str) -> bool:
+        """Whether ``pin`` is a name only the installation could resolve, and it is not
+        there: a user's name for a pin (``gripperopen``) or a Modbus signal. PolyScope writes
+        the pin's or signal's own function, which nothing here says; urdsl reads the name
+        as a value of its own (unknown to the check) and writes nothing for a Set of it."""
+        if self.installation is not None or pin in self.pins or _PIN.match(pin) \
+                or not pin.isidentifier():
+            return False
+        self.unknown_io[pin] = None
+        return True
+
     def resolve_pin(self, pin: str, node: Node) -> tuple[str, int]:
         target = self.pins.get(pin, pin)
         match = _PIN.match(target)
@@ -983,6 +1002,8 @@ class _Compiler:
         return None
 
     def pin_read(self, pin: str, node: Node) -> Expr:
+        if self.io_of_missing_installation(pin):
+            return Name(pin)
         if pin not in self.pins and self.modbus_signal(pin) is not None:
             return _call("modbus_get_signal_status", String(pin))
         kind, index = self.resolve_pin(pin, node)
@@ -1011,6 +1032,8 @@ class _Compiler:
             pin = str(node.fields.get("pin"))
             value = node.fields.get("digitalValue") in ("1", "true", "True")
             label = f"Set {self.pin_label(pin)}={'On' if value else 'Off'}"
+            if self.io_of_missing_installation(pin):
+                return [self.marker(node, label)]
             if pin not in self.pins and self.modbus_signal(pin) is not None:
                 # a Modbus output signal of the installation (seen: 3.10.1,
                 # alan1982br/gs1_carnaval_Photobooth_robot_arm_UR venosa draft3)
@@ -1023,8 +1046,10 @@ class _Compiler:
             return [self.marker(node, label), _stmt(function, Number(index), Bool(value))]
         if kind == "AnalogOutput":
             pin = str(node.fields.get("pin"))
-            bank, index = self.resolve_pin(pin, node)
             value = float(str(node.fields.get("analogValue", "0")))
+            if self.io_of_missing_installation(pin):
+                return [self.marker(node, f"Set {pin}={value}")]
+            bank, index = self.resolve_pin(pin, node)
             return [self.marker(node, f"Set {self.pin_label(pin)}={value}"),
                     _stmt("set_standard_analog_out", Number(index),
                           _num(value / self.analog_full_scale(index)))]
@@ -1069,6 +1094,8 @@ class _Compiler:
         if not length:
             return self.n_unknown(node)
         pin = str(node.fields.get("pin"))
+        if self.io_of_missing_installation(pin):
+            return [self.marker(node, f"Set {pin}=HI:Pulse {length[0]}")]
         bank, index = self.resolve_pin(pin, node)
         function = _SET_FUNCTIONS.get(bank)
         if function is None:
@@ -1102,6 +1129,8 @@ class _Compiler:
         expression = node.fields["expression"]
         value = self.expr(self.script_of(expression, node), node)
         label = f"Set {self.pin_label(pin)}={expression.label}"
+        if self.io_of_missing_installation(pin):
+            return [self.marker(node, label)]
         signal = self.modbus_signal(pin) if pin not in self.pins else None
         if signal is not None:
             if signal.kind != "DIGITAL_OUTPUT":

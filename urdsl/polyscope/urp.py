@@ -499,6 +499,11 @@ def _kinematics(element: ElementTree.Element) -> Kinematics | None:
         values[key] = _floats(child.get("value") if child is not None else None)
     if not all(len(v) == 6 for v in values.values()):
         return None
+    if not any(values["a"]) and not any(values["d"]):
+        # a block PolyScope never filled in (``status="NOT_INITIALIZED"``, every value 0:
+        # seen as a program's top-level block that a relative waypoint's start refers to,
+        # underautomation/UniversalRobots.NET): no arm, so no kinematics
+        return None
     return Kinematics(values["deltaTheta"], values["a"], values["d"], values["alpha"])
 
 

@@ -449,9 +449,11 @@ def _flange_pose(rt, node):
 
 @implements("get_target_waypoint")
 def _target_waypoint(rt, node):
-    """Where the current (or last) move goes: the end of everything planned so far."""
+    """Where the current (or last) move goes: the end of everything planned so far; while
+    the arm's position is unknown offline (see :func:`_stopped_by_condition`), as unknown as
+    the TCP pose there (PolyScope's Direction node aims from it)."""
     arm = _arm(rt, node)
-    return _to_pose(arm.fk(arm.target_joints))
+    return _stopped_by_condition(rt, arm, arm.tcp) or _to_pose(arm.fk(arm.target_joints))
 
 
 @implements("is_steady")

@@ -1221,9 +1221,13 @@ def _compiled_urp(path: Path) -> str:
     from ..polyscope.urp import UrpError
 
     try:
-        _program, compiled = load(path)
-        return compiled.text
+        program, compiled = load(path)
     except (UrpError, CompileError) as error:
         raise SimError(str(error)) from None
     except RecursionError:
         raise SimError(f"{path.name}: the program nests too deeply") from None
+    if compiled.unknown_io:  # a controller runs a program with the installation it names
+        raise SimError(f"{path.name}: the I/O {', '.join(compiled.unknown_io)} named only in "
+                       f"the installation {program.installation or '?'}.installation, which "
+                       "is not beside the program")
+    return compiled.text
