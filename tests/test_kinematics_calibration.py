@@ -175,3 +175,35 @@ def test_bad_calibration_files_say_what_is_wrong(tmp_path, text, message):
 def test_missing_calibration_file(tmp_path):
     with pytest.raises(KinematicsError, match="cannot read"):
         Calibration.from_toml(tmp_path / "nope.toml")
+
+
+# A PolyScope CircleMove as a real program has it (fixed mode): the tool turns 137 degrees
+# with the arc, and the solution of the end pose closest to the start joints is the other
+# wrist branch; the arm follows its own branch along the arc and ends there.
+VIA = "p[0.43973, -0.13088, 0.34327, 2.25459, -2.18644, -0.05556]"
+END = "p[0.43973, 0.02929, 0.26428, 2.25459, -2.18644, -0.05556]"
+ARC_PROGRAM = f"""\
+def arc():
+  movej([-0.18898, -1.68862, -2.04162, -1.01197, 1.58984, -0.21996], a=1.4, v=1.05)
+  movec({VIA}, {END}, a=1.2, v=0.25, r=0, mode=1)
+  movej([0.0, -1.51627, -1.99442, -1.22741, 1.5951, -0.031], a=1.4, v=1.05)
+end
+"""
+
+
+@pytest.mark.parametrize("deltas", [None, DELTAS], ids=["nominal", "calibrated"])
+def test_a_move_after_a_wide_arc_starts_where_the_arc_ended(deltas):
+    from urdsl.verify.run import CheckOptions, check_text
+
+    options = CheckOptions(robot="ur5e", start_joints=np.array(
+        [-0.18898, -1.68862, -2.04162, -1.01197, 1.58984, -0.21996]))
+    if deltas is not None:
+        options.calibration = Calibration(**deltas, model="ur5e")
+    report = check_text(ARC_PROGRAM, "arc.script", options=options)
+    assert [f for f in report.findings if f.code == "URS302"] == []
+    arc_rows = np.flatnonzero(report.trace.segment == 1)
+    after_rows = np.flatnonzero(report.trace.segment == 2)
+    # the traced arc ends on the wrist branch it started on (wrist 2 keeps its sign) and
+    # the next move starts right there
+    assert report.trace.q[arc_rows[-1], 4] > 0
+    assert np.abs(report.trace.q[after_rows[0]] - report.trace.q[arc_rows[-1]]).max() < 0.05

@@ -348,6 +348,23 @@ class MotionPlanner:
         near = self._q if q_near is None else q_near
         return self.kinematics.ik(pose, near, tcp=self.tcp)
 
+    def _line_end(self, pose: np.ndarray, q_from: np.ndarray) -> np.ndarray:
+        """Joints (rad) where a straight-line or circular move from ``q_from`` to ``pose``
+        ends: the target's solution on the IK branch the move starts on, as
+        :meth:`resolve` chooses it for a batch (:func:`continue_branch`) and as the trace
+        follows the path (:func:`urdsl.motion.tracking.track`). The solution closest to
+        ``q_from`` may be another branch when the move turns the tool far (a 150° arc):
+        the next move would then start where the traced path did not end. Raises the
+        model's KinematicsError for a pose out of reach."""
+        model = self.kinematics
+        if not hasattr(model, "ik_all_many"):
+            return self.ik(pose, q_from)
+        solutions, _ = model.ik_all_many(np.asarray(pose, dtype=float)[None], tcp=self.tcp)
+        chosen, found = continue_branch(model, solutions, q_from, self.tcp)
+        if not found[0]:
+            return self.ik(pose, q_from)  # raises: out of reach or outside the joint limits
+        return chosen[0]
+
     # ---- moves -----------------------------------------------------------------------------
 
     def movej(self, q: np.ndarray, a: float, v: float, t: float, r: float, span: Span,
@@ -550,8 +567,8 @@ class MotionPlanner:
             segment = self._segment(kind, profile, None, None, r, span, params, pose_from, pose)
         else:
             q_from = self._q
-            segment = self._segment(kind, profile, q_from, self.ik(pose, q_from), r, span,
-                                    params, pose_from, pose)
+            segment = self._segment(kind, profile, q_from, self._line_end(pose, q_from), r,
+                                    span, params, pose_from, pose)
         if via is not None:
             segment.via = via[:3, 3].copy()
         return self._add(segment, now)
