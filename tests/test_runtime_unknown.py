@@ -444,3 +444,51 @@ def test_a_dotted_xmlrpc_method_is_a_device_call():
                  "ready = regs[0] == 1\n")
     assert result.error is None
     assert "ModbusServiceWrapper.readRegisters()" in result.globals["regs"].source
+
+
+COMMANDED = """\
+def tray():
+  movej([0, -1.57, 1.57, -1.57, -1.57, 0])
+  socket_open("127.0.0.1", 30000, "pc")
+  left = 10
+  while (True):
+    {wait}
+    movel(p[0.4 - 0.1 * left, -0.3, 0.2, 0, 3.14, 0], a=1.2, v=0.5)
+    left = left - 1
+  end
+end
+"""
+"""A cell program that takes the next piece of a tray each pass, with a counter it never
+resets: after the tray's last piece its target leaves the arm's reach (pass 10 on)."""
+
+WAIT_FOR_PC = """reply = socket_read_string("pc", timeout=2)
+    while (reply == ""):
+      reply = socket_read_string("pc", timeout=2)
+    end"""
+
+
+def test_what_the_passes_of_a_device_paced_loop_accumulate_is_a_warning():
+    # every pass waits for the PC's command: how many passes there are is the PC's to say
+    # (a game's nine moves); the tray running empty is then a warning that says so
+    from urdsl.verify.run import CheckOptions, check_text
+
+    options = CheckOptions(robot="ur5e", max_time=200)
+    report = check_text(COMMANDED.format(wait=WAIT_FOR_PC), "tray.script", options=options)
+    (reach,) = [f for f in report.findings if f.code == "URS301"]
+    assert reach.severity == "warning"
+    assert "depends on how many times that device answers" in reach.message
+    assert "socket_read_string()" in reach.message
+    # without the wait, every pass happens whatever a device says: an error
+    report = check_text(COMMANDED.format(wait="sleep(0.1)"), "tray.script", options=options)
+    (reach,) = [f for f in report.findings if f.code == "URS301"]
+    assert reach.severity == "error"
+
+
+def test_an_error_of_a_device_paced_loops_first_passes_stays_an_error():
+    # out of reach in the first pass: no device reply decides that
+    from urdsl.verify.run import CheckOptions, check_text
+
+    text = COMMANDED.format(wait=WAIT_FOR_PC).replace("left = 10", "left = -10")
+    report = check_text(text, "tray.script", options=CheckOptions(robot="ur5e", max_time=200))
+    (reach,) = [f for f in report.findings if f.code == "URS301"]
+    assert reach.severity == "error"

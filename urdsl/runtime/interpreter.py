@@ -140,6 +140,10 @@ class RunResult:
     forever: LoopPasses | None = None
     """The innermost ``while True`` loop of the main thread that was still running when the
     run stopped (at ``max_time``, the wall-clock bound or a stop), with its pass times."""
+    paced: DevicePaced | None = None
+    """When the main thread's ``while True`` loop (the innermost still running, also after an
+    error) had every pass paced by a device's replies: which passes (see
+    :class:`DevicePaced`); None otherwise."""
     stopped_early: Event | None = None
     """Why the run stopped before the program's end without an error: ``"blocked"`` (the
     program waits forever, e.g. a read with timeout 0 that nothing answers) or
@@ -154,12 +158,28 @@ REPEAT_STATES = 512
 """Begin states of one loop kept for comparison (a loop of a longer period runs on)."""
 
 
+@dataclass
+class DevicePaced:
+    """A ``while True`` loop of the main thread (``span``) every pass of which so far went
+    where it went because the check followed a working device (it decided a condition or a
+    loop on a value read from outside, ``source``): from pass 3 on (robot time ``since``, s),
+    until ``until`` (the first pass that decided nothing so, or None), the state a pass
+    begins in has changed with every device reply before it. What happens there first depends
+    on how many times the device answers — a PC that sends a game's nine moves, a PLC that
+    stops when the pallet is full — which nothing offline says."""
+
+    span: Span
+    since: float
+    until: float | None
+    source: str
+
+
 class LoopPasses:
     """The passes of a ``while True`` loop of the main thread: how many began, and when (robot
     time, s). A pass runs from one start of the loop's body to the next."""
 
     __slots__ = ("span", "count", "first", "second", "last", "shortest", "longest", "states",
-                 "repeats")
+                 "repeats", "_decided", "paced_since", "paced_until", "_chain", "source")
 
     def __init__(self, span: Span) -> None:
         self.span = span
@@ -170,10 +190,25 @@ class LoopPasses:
         self.first = self.second = self.last = 0.0
         self.shortest = math.inf
         self.longest = 0.0
+        self._decided = 0  # device decisions made before this pass began
+        self._chain = True  # every pass so far decided something on a device's reply
+        self.paced_since: float | None = None
+        self.paced_until: float | None = None
+        self.source = ""  # the reply the first pass decided on last
 
-    def begin(self, time: float) -> None:
-        """A pass begins at robot time ``time`` (s)."""
+    def begin(self, time: float, decided: int = 0, source: str = "") -> None:
+        """A pass begins at robot time ``time`` (s); ``decided``: the device decisions the
+        run has made so far, ``source`` the last one's reply (see :class:`DevicePaced`)."""
+        if self.count >= 1 and self._chain and decided <= self._decided:
+            self._chain = False  # the pass that ended decided nothing on a device
+            if self.paced_since is not None:
+                self.paced_until = time
+        if self.count == 1:
+            self.source = source
+        self._decided = decided
         self.count += 1
+        if self.count == 3 and self._chain:
+            self.paced_since = time
         if self.count == 1:
             self.first = time
         else:
@@ -295,6 +330,10 @@ class Interpreter:
         self.loop_node: n.Node | None = None  # the loop last entered (for "how far")
         # the main thread's ``while True`` loops that are running, outermost first
         self.forever: list[LoopPasses] = []
+        # decisions taken on a device's unknown reply (a condition, a loop's test), and the
+        # last one's reply: see DevicePaced
+        self.device_decisions = 0
+        self.device_source = ""
         self.unknown = getattr(self.env, "devices", "quiet") == "unknown"
         # replies taken for device reads compared with constants (see _device_reply)
         self.device_replies: dict[str, object] = {}
@@ -339,6 +378,10 @@ class Interpreter:
                     thread.glet.throw(greenlet.GreenletExit)
         if result.error is None and self.forever:
             result.forever = self.forever[-1]
+        if self.forever and self.forever[-1].paced_since is not None:
+            passes = self.forever[-1]
+            result.paced = DevicePaced(passes.span, passes.paced_since, passes.paced_until,
+                                       passes.source)
         if self.robot is not None:
             self.robot.finish(self.time)
             self.time = max(self.time, getattr(self.robot, "end_time", self.time))
@@ -541,6 +584,12 @@ class Interpreter:
             self.current.name != "main" else ""
         raise _StopRun(Event(self.time, "deadline",
                              f"stopped at robot time {self.time:.3f} s{where}", span))
+
+    def decided_on(self, value: Unknown) -> None:
+        """The run took a path on a device's unknown reply ``value`` (see
+        :class:`DevicePaced`)."""
+        self.device_decisions += 1
+        self.device_source = value.source
 
     def warn_once(self, message: str, node: Any, unknown: Unknown | None = None) -> None:
         """A warning about what depends on a value unknown offline, once per statement.
@@ -898,6 +947,7 @@ class _Compiler:
             for index, (test, body, test_node, ending, stopping) in enumerate(branches):
                 value = test(frame)
                 if type(value) is Unknown:
+                    rt.decided_on(value)
                     # follow a working device: not into an error branch (it ends the
                     # program), not against the reply the program expects, else in
                     working = take = not ending and value.lean is not False
@@ -962,7 +1012,7 @@ class _Compiler:
             unknown_passes = 0
             while True:
                 if passes is not None:
-                    passes.begin(rt.time)
+                    passes.begin(rt.time, rt.device_decisions, rt.device_source)
                     if rt.config.stop_repeating:
                         # the polling loop's pass count decides its device branches until
                         # the device is taken as idle
@@ -972,6 +1022,7 @@ class _Compiler:
                     polling[0] += 1
                 value = test(frame)
                 if type(value) is Unknown:
+                    rt.decided_on(value)
                     unknown_passes += 1
                     if value.lean is False:  # the expected reply came at once
                         rt.warn_once(

@@ -287,8 +287,12 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     report.findings.extend(_trace_findings(trace, planner, robot, options, final,
                                            module.span))
     report.findings = group_urcap_notes(blocks, report.findings)
+    if result.paced is not None:
+        report.findings = device_paced(report.findings, result.paced)
     report.sort()
     return report
+
+
 
 
 def generated_threads(module, blocks: list[tuple[str, int, int]]) -> set[str]:
@@ -380,6 +384,36 @@ PATH_CODES = frozenset({"URS302", "URS304", "URS305", "URS306", "URS307", "URS30
 """Findings about the way a move goes (not its target), which depend on where it starts.
 A joint position limit (URS303) is not among them: a movej interpolates the joints, so only
 its ends can pass a limit, and the target's joints are what the controller would command."""
+
+
+PACED_CODES = PATH_CODES | {"URS301", "URS303"}
+"""Where the arm goes (its targets, paths, joints): what a device-paced loop accumulates moves
+it (a counter that picks the next tray place). A loop that spins once the device is idle
+(URS207) and the program's own mistakes are not about how many passes the device drives."""
+
+
+def device_paced(findings: list[Finding], paced) -> list[Finding]:
+    """Errors about where the arm goes (:data:`PACED_CODES`) that first happen in a pass of
+    the main loop whose state every device reply before it changed
+    (:class:`~urdsl.runtime.interpreter.DevicePaced`: pass 3 on, while every pass decided
+    something on a device's reply) follow from how many times the device answers, which
+    nothing offline says: warnings that say so, once per statement and cause as before. An
+    error of the first two passes stays an error (a pass that begins as an earlier one did
+    is not run: the check stops there)."""
+    out = []
+    for finding in findings:
+        moment = finding.time
+        if finding.severity != "error" or finding.code not in PACED_CODES or moment is None \
+                or moment < paced.since - 1e-9 \
+                or (paced.until is not None and moment >= paced.until - 1e-9):
+            out.append(finding)
+            continue
+        why = (f"first in pass 3 or later of the loop at line {paced.span.line}, every pass "
+               f"of which went on with a reply of {paced.source} (the check follows a working "
+               "device): whether the program gets here depends on how many times that "
+               "device answers")
+        out.append(replace(finding, severity="warning", message=f"{finding.message}; {why}"))
+    return out
 
 
 def _from_unknown_start(findings: list[Finding], planner) -> list[Finding]:
