@@ -12,8 +12,9 @@ script does two things:
 
 ``run --root OUT [--tune|--held|--all] [--project ID] [--timeout S] [--json FILE]``
     As a user would, run ``urdsl lint OUT/<id>`` (the folder) and ``urdsl check FILE`` for every
-    ``.script`` of the project, each in its own process with a wall-clock limit (killed at
-    ``--timeout`` s and recorded as a timeout). Collect every error finding, match it against
+    ``.script`` of the project and every ``.urp`` without its ``.script``, each in its own
+    process with a wall-clock limit (killed at ``--timeout`` s and recorded as a timeout).
+    Collect every error finding, match it against
     the labels by (project, tool, file, line, code) and print precision per tool and rule
     (overall, tuning projects, held-back projects), the wall time of every run, the labelled-true
     findings no longer reported ("lost") and the unlabelled findings. Exit status 0.
@@ -297,8 +298,15 @@ def check_file(project: Project, root: Path, script: Path, timeout: float) -> Ru
 
 
 def project_scripts(root: Path, project: Project) -> list[Path]:
-    return sorted(path for path in (root / project.id).rglob("*")
-                  if path.is_file() and path.suffix.lower() == ".script")
+    """The files ``urdsl check`` runs on: every ``.script``, and every PolyScope program
+    (``.urp``) with no ``.script`` of its name beside it (with one, PolyScope's export is
+    what the robot ran and what is checked; without, the user checks the program)."""
+    files = [path for path in (root / project.id).rglob("*") if path.is_file()]
+    scripts = [path for path in files if path.suffix.lower() == ".script"]
+    exported = {path.with_suffix("").as_posix().lower() for path in scripts}
+    programs = [path for path in files if path.suffix.lower() == ".urp"
+                and path.with_suffix("").as_posix().lower() not in exported]
+    return sorted(scripts + programs)
 
 
 @dataclass
