@@ -118,8 +118,13 @@ def test_a_broken_program_is_one_message(tmp_path, capsys, data):
     program = tmp_path / "broken.urp"
     program.write_bytes(data)
     assert main(["check", str(program)]) == 1
-    err = capsys.readouterr().err
-    assert str(program) in err and "Traceback" not in err
+    captured = capsys.readouterr()
+    assert f"{program}:1:1: error:" in captured.out and "URS001" in captured.out
+    assert f"{program}: not checked" in captured.out and "Traceback" not in captured.err
+    assert main(["check", "--json", str(program)]) == 1  # the same, for a machine
+    report = json.loads(capsys.readouterr().out)
+    assert report["ok"] is False and report["checked"] is False
+    assert [f["code"] for f in report["findings"]] == ["URS001"]
     assert main(["lint", str(program)]) == 1
     assert str(program) in capsys.readouterr().out
 

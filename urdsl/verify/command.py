@@ -167,9 +167,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                 continue
         elif name.lower().endswith(".urp") and not is_text_file(name):
             report = _bounded(name, options, lambda o, n=name: _check_urp(n, args, o))
-            if report is None:
-                failed = True
-                continue
+            failed = failed or not report.checked
         else:
             source = read_input(name)
             report = _bounded(name, options, lambda o, s=source: _check_script(s, args, o))
@@ -337,13 +335,13 @@ def _export_calibration(path: str | None, options) -> str | None:
 
 
 def _check_urp(name: str, args: argparse.Namespace, options):
-    """A PolyScope program: compiled, then checked (see :mod:`urdsl.polyscope.check`);
-    None (the message printed) when it cannot be compiled."""
+    """A PolyScope program: compiled, then checked (see :mod:`urdsl.polyscope.check`); when
+    it cannot be compiled, the report of :func:`_not_compiled`."""
     from pathlib import Path
 
     from .._cli import UsageError
     from ..polyscope.check import check_urp
-    from ..polyscope.compile import CompileError
+    from ..polyscope.compile import CompileError, MissingInstallation
     from ..polyscope.urp import UrpError
 
     if not Path(name).is_file():
@@ -352,9 +350,27 @@ def _check_urp(name: str, args: argparse.Namespace, options):
         report = check_urp(name, options, robot_given=bool(args.robot),
                            start_joints=args.start_joints or args.start_joints_deg,
                            tcp=args.tcp, nominal=args.nominal, cell_path=args.cell)
+    except MissingInstallation as error:  # not a mistake of the program, as in lint
+        return _not_compiled(name, options, "warning", "not checked: ", str(error))
     except (UrpError, CompileError) as error:
-        print(str(error), file=sys.stderr)
-        return None
+        return _not_compiled(name, options, "error", "", str(error))
+    return report
+
+
+def _not_compiled(name: str, options, severity: str, prefix: str, text: str):
+    """The report of a PolyScope program that cannot be compiled: one URS001 finding at the
+    program's first line with the compiler's message (which names the node and its place
+    in the file), as ``urdsl lint X.urp`` gives it; not checked, so the command fails."""
+    from ..script.nodes import Source, Span
+    from .findings import Finding
+    from .report import Report
+
+    message = text.split(": error: ", 1)[1] if ": error: " in text else text
+    if message.startswith(f"{name}: "):  # the finding names the file already
+        message = message[len(name) + 2:]
+    report = Report(name, options.robot, checked=False)
+    report.findings.append(Finding("URS001", severity, prefix + message,
+                                   Span(Source("", name), 0, 0)))
     return report
 
 

@@ -94,6 +94,7 @@ class Report:
     trace: Any = field(default=None, repr=False)
     inferred: Any = None  # urdsl.verify.infer.Inference: robot, start, TCP the check used
     context: str | None = None  # the project context the program ran in, if any
+    checked: bool = True  # False: the program could not be compiled, nothing ran (URS001)
 
     def sort(self) -> None:
         """Order findings by position in the file, then by time, with one finding per
@@ -132,7 +133,8 @@ class Report:
         return {
             "file": self.file,
             "robot": self.robot,
-            "ok": not self.has_errors,
+            "ok": self.checked and not self.has_errors,
+            **({} if self.checked else {"checked": False}),
             "cycle_time": round(self.cycle_time, 6),
             **({"loop": self.loop.to_dict()} if self.loop is not None else {}),
             "context": self.context,
@@ -166,6 +168,9 @@ class Report:
         return "\n".join(lines) + "\n"
 
     def summary(self) -> str:
+        if not self.checked:
+            return (f"{self.file}: not checked: {self.count('error')} error(s), "
+                    f"{self.count('warning')} warning(s)")
         verdict = "FAILED" if self.has_errors else "ok"
         return (f"{self.file}: {verdict} on {self.robot}: {self.count('error')} error(s), "
                 f"{self.count('warning')} warning(s), {self.count('info')} info; "
@@ -197,7 +202,7 @@ class Report:
             console.print(Text(self.context))
         for line in self.inferred.lines() if self.inferred is not None else ():
             console.print(Text(line, style="cyan"))
-        style = "bold red" if self.has_errors else "bold green"
+        style = "bold green" if self.checked and not self.has_errors else "bold red"
         console.print(Text(self.summary(), style=style))
 
     def plot(self, path, robot_model=None) -> None:
