@@ -358,3 +358,16 @@ def test_an_export_is_checked_on_the_arm_of_the_program_beside_it(tmp_path, caps
     assert "calibration of arm.urp's <kinematics>" in report["context"]
     assert main(["check", str(export), "--robot", "ur5e", "--json", "--nominal"]) == 1
     assert any(f["code"] == "URS301" for f in json.loads(capsys.readouterr().out)["findings"])
+
+
+def test_a_polyscope_1_program_is_urdsls_limit_not_the_programs_mistake(tmp_path, capsys):
+    # a CB2 controller runs it; urdsl cannot read it: a warning, never an error
+    program = tmp_path / "old.urp"
+    program.write_bytes(b"<gui.program.ProgramRootNode/>")
+    assert main(["lint", "--format", "json", str(program)]) == 0
+    (found,) = json.loads(capsys.readouterr().out)
+    assert found["severity"] == "warning" and found["message"].startswith("not linted: a "
+                                                                          "PolyScope 1.x")
+    assert main(["check", "--json", str(program)]) == 1  # nothing was checked
+    report = json.loads(capsys.readouterr().out)
+    assert report["checked"] is False and report["summary"]["error"] == 0

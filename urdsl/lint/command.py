@@ -249,7 +249,7 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         urcap_diagnostics,
     )
     from ..polyscope.compile import CompileError, MissingInstallation
-    from ..polyscope.urp import UrpError
+    from ..polyscope.urp import UnsupportedProgram, UrpError
     from ..script.diagnostics import Diagnostic
     from .config import ConfigError, settings_for
     from .linter import lint_text
@@ -268,6 +268,10 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         message = text.split(": node ", 1)[1] if ": node " in text else text
         return [Diagnostic(name, 1, 1, "warning", "URS001",
                            f"not linted: node {message}")]
+    except UnsupportedProgram as error:  # urdsl's limit, not the program's mistake
+        text = str(error)
+        message = text.split(": error: ", 1)[1] if ": error: " in text else text
+        return [Diagnostic(name, 1, 1, "warning", "URS001", f"not linted: {message}")]
     except (UrpError, CompileError) as error:
         text = str(error)
         message = text.split(": error: ", 1)[1] if ": error: " in text else text

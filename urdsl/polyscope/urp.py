@@ -44,6 +44,11 @@ class UrpError(Exception):
     version or a broken reference. The message names the file (and the node when known)."""
 
 
+class UnsupportedProgram(UrpError):
+    """A PolyScope program urdsl cannot read though a controller may run it (PolyScope 1.x):
+    not a mistake of the program."""
+
+
 _SYMBOLS = {"≔": "=", "≟": "==", "≠": "!=", "≤": "<=", "≥": ">=", "∧": " and ", "∨": " or ",
             "⊕": " xor ", "¬": " not ", "≡": "=="}
 """PolyScope's expression editor symbols and their URScript spelling."""
@@ -230,9 +235,10 @@ def parse_urp(data: bytes, path: str = "<urp>") -> Program:
         raise UrpError(f"{path}: error: not a readable PolyScope program ({what}: "
                        f"{error})") from None
     if root.tag.startswith("gui.program."):
-        raise UrpError(f"{path}: error: a PolyScope 1.x program (<{root.tag}>); urdsl reads "
-                       "programs saved by PolyScope 3.x and 5.x (root <URProgram>): open and "
-                       "save it in PolyScope 3 or later")
+        raise UnsupportedProgram(
+            f"{path}: error: a PolyScope 1.x program (<{root.tag}>); urdsl reads programs "
+            "saved by PolyScope 3.x and 5.x (root <URProgram>): open and save it in "
+            "PolyScope 3 or later")
     if root.tag != "URProgram":
         raise UrpError(f"{path}: error: not a PolyScope program (root element <{root.tag}>, "
                        "expected <URProgram>)")
