@@ -127,6 +127,8 @@ CLEAN = [
     ("URS118", "thread watch():\n  while not get_standard_digital_in(0):\n    sync()\n  end\nend\n"
      "i = 0\nwhile i < 10:\n  i = i + 1\nend\n", {}),
     ("URS118", "def wait():\n  sleep(0.1)\nend\nwhile True:\n  wait()\nend\n", {}),
+    # its first pass ends the program (a PolyScope Loop around a Halt)
+    ("URS118", "mode = read_input_integer_register(0)\nwhile mode == 3:\n  halt\nend\n", {}),
     ("URS119", 'textmsg("done")\n', {}),
     ("URS119", "def print(s):\n  textmsg(s)\nend\nprint(1)\n", {}),
     ("URS120", "def main():\n  def f():\n    local c = 0\n    textmsg(c)\n  end\n  f()\nend\n",

@@ -355,6 +355,8 @@ def busy_loop(ctx: LintContext) -> Iterator[Diagnostic]:
             end = ends[index]
             if timed[end] > timed[index]:
                 continue
+            if any(isinstance(item, (n.Halt, n.Break, n.Return)) for item in statement.body):
+                continue  # its first pass leaves it (``while mode == 3: halt``)
             tested = {node.id for node in n.walk(statement.test) if isinstance(node, n.Name)}
             if any(_within(assigning.get(name, ()), index + 1, end) for name in tested):
                 continue  # a counting loop: it ends by itself
