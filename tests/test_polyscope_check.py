@@ -371,3 +371,42 @@ def test_a_polyscope_1_program_is_urdsls_limit_not_the_programs_mistake(tmp_path
     assert main(["check", "--json", str(program)]) == 1  # nothing was checked
     report = json.loads(capsys.readouterr().out)
     assert report["checked"] is False and report["summary"]["error"] == 0
+
+
+def _taught(name: str, joints: str, tcp: str) -> str:
+    return (f'<Waypoint type="Fixed" name="{name}" kinematicsFlags="3"><motionParameters/>'
+            f'<position><JointAngles angles="{joints}"/><TCPOffset pose="{tcp}"/></position>'
+            '</Waypoint>')
+
+
+UP = "0.0, -1.5707963, 0.0, -1.5707963, 0.0, 0.0"  # the arm stretched straight up
+FLANGE_KINEMATICS = ('<kinematics><deltaTheta value="0, 0, 0, 0, 0, 0"/>'
+                     '<a value="0.0, -0.425, -0.3922, 0.0, 0.0, 0.0"/>'
+                     '<d value="0.1625, 0.0, 0.0, 0.1333, 0.0997, 0.0996"/>'
+                     '<alpha value="1.5707963267948966, 0, 0, 1.5707963267948966, '
+                     '-1.5707963267948966, 0"/></kinematics>')
+
+
+def test_without_its_installation_the_tcp_the_waypoints_were_taught_with(tmp_path, capsys):
+    # the installation's preamble sets the active TCP; without it, the TCP PolyScope stored
+    # with the taught waypoints: a pose taught straight up with a 0.19 m gripper is reached
+    # with it, and lies out of reach of the flange
+    program = tmp_path / "up.urp"
+    move = ('<Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true">'
+            '<children>{}</children></Move>')
+    program.write_text(_program(move.format(
+        _taught("Home", "0.3, -1.2, 1.2, -1.5, -1.5, 0.0", "0.0, 0.0, 0.19, 0.0, 0.0, 0.0")
+        + _taught("Up", UP, "0.0, 0.0, 0.19, 0.0, 0.0, 0.0")), FLANGE_KINEMATICS))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert "TCP p[0, 0, 0.19, 0, 0, 0] the waypoints were taught with" in report["context"]
+    assert main(["check", str(program), "--json", "--tcp", "0,0,0,0,0,0"]) == 1  # the flange
+    assert any(f["code"] == "URS301" for f in json.loads(capsys.readouterr().out)["findings"])
+    # taught with two TCPs: which one is active is the missing installation's to say
+    program.write_text(_program(move.format(
+        _taught("Home", "0.3, -1.2, 1.2, -1.5, -1.5, 0.0", "0.0, 0.0, 0.05, 0.0, 0.0, 0.0")
+        + _taught("Up", UP, "0.0, 0.0, 0.19, 0.0, 0.0, 0.0")), FLANGE_KINEMATICS))
+    assert main(["check", str(program), "--json"]) == 0
+    (reach,) = [f for f in json.loads(capsys.readouterr().out)["findings"]
+                if f["code"] == "URS301"]
+    assert reach["severity"] == "warning" and "2 different TCPs" in reach["message"]

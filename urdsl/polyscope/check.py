@@ -22,6 +22,8 @@ import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+import numpy as np
+
 from ..script import nodes as n
 from ..script.diagnostics import Diagnostic
 from .compile import Compiled
@@ -375,6 +377,18 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
                 notes.append("the program's <kinematics> matches no "
                              + (f"{options.robot}" if robot_given else "UR model")
                              + "; nominal kinematics used")
+    taught = None
+    tcp_unknown = False
+    if tcp is None and generated.installation is None:
+        # the preamble that sets the active TCP is the installation's: without it, the TCP
+        # the waypoints were taught with (PolyScope keeps it with each), when there is one
+        tcps = taught_tcps(generated.program)
+        if len(tcps) == 1 and any(abs(v) > 1e-9 for v in tcps[0]):
+            taught = tcps[0]
+            notes.append("TCP p[" + ", ".join(f"{v:.6g}" for v in taught) + "] the "
+                         "waypoints were taught with (the installation that sets it is "
+                         "missing)")
+        tcp_unknown = len(tcps) > 1
     inference = infer(module, path, robot=options.robot if robot_given else calibrated_model,
                       start_joints=start_joints, tcp=tcp, default_robot=options.robot)
     if calibrated_model is not None and not robot_given:
@@ -383,6 +397,8 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         inference.robot_line = lambda: (  # type: ignore[method-assign]
             f"robot {model} from the program's <kinematics> (the arm's calibration)")
     file_options = apply(options, inference, tcp_given=tcp is not None)
+    if taught is not None:
+        file_options = dataclasses.replace(file_options, tcp=np.array(taught))
     if cell_path and file_options.robot != options.robot:
         from .._cli import load_cell
 
@@ -405,6 +421,8 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     urcaps = {number for number, _node in generated.urcap_nodes()}
     report = check_tree(with_urcap_time(module, urcaps), generated.filename, file_options)
     report.inferred = inference
+    if tcp_unknown:
+        report.findings = tcp_dependent(report.findings, len(tcps))
     report.findings = node_findings(generated, report.findings)
     source = module.span.source
     for diagnostic in urcap_diagnostics(generated):
@@ -416,6 +434,37 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     report.context = "; ".join(notes)
     report.generated = generated  # type: ignore[attr-defined]
     return report
+
+
+def taught_tcps(program: Program) -> list[tuple[float, ...]]:
+    """The TCPs (poses in the flange frame, m and rad) the taught waypoints of ``program``
+    were taught with (PolyScope stores one with each), each once (equal to 0.1 mm and 0.1
+    mrad), in program order."""
+    seen: dict[tuple, tuple[float, ...]] = {}
+    for root in program.top:
+        for node in root.walk():
+            offset = node.fields.get("tcp_offset") if node.kind == "Waypoint" else None
+            if offset is not None and len(offset) == 6:
+                seen.setdefault(tuple(round(v, 4) for v in offset), tuple(offset))
+    return list(seen.values())
+
+
+def tcp_dependent(findings: list, count: int) -> list:
+    """Errors about where the arm goes (URS301-URS308) of a program whose installation, which
+    sets the active TCP, is missing, and whose waypoints were taught with ``count`` different
+    TCPs: every target the controller solves with the active TCP depends on it, so they are
+    warnings that say so."""
+    from ..verify.run import PACED_CODES
+
+    out = []
+    for finding in findings:
+        if finding.severity == "error" and finding.code in PACED_CODES:
+            finding = replace(finding, severity="warning", message=(
+                f"{finding.message}; depends on the active TCP, which the missing "
+                f"installation sets (the waypoints were taught with {count} different TCPs)"),
+                hint="put the program's installation beside it, or give --tcp")
+        out.append(finding)
+    return out
 
 
 def installation_defaults(options, installation: Installation, cell_given: bool) -> list[str]:
