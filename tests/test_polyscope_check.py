@@ -410,3 +410,19 @@ def test_without_its_installation_the_tcp_the_waypoints_were_taught_with(tmp_pat
     (reach,) = [f for f in json.loads(capsys.readouterr().out)["findings"]
                 if f["code"] == "URS301"]
     assert reach["severity"] == "warning" and "2 different TCPs" in reach["message"]
+
+
+def test_what_a_urcaps_function_gives_is_unknown_not_none(tmp_path, capsys):
+    # with a URCap in the program, a function only its code defines stands in as a device:
+    # what it returns (a pose the program then indexes) is unknown, not none
+    program = tmp_path / "urcap.urp"
+    program.write_text(_program(
+        URCAP + '<Script type="Line"><expression>'
+        + _chars("pose = p_rel(get_actual_tcp_pose(), p[0, 0, 0.1, 0, 0, 0])")
+        + '</expression></Script><Script type="Line"><expression>'
+        + _chars("pose[2] = pose[2] + 0.01") + "</expression></Script>"))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    assert "functions defined by code urdsl cannot generate, taken as devices: p_rel" in \
+        report["context"]

@@ -492,3 +492,9 @@ def test_an_error_of_a_device_paced_loops_first_passes_stays_an_error():
     report = check_text(text, "tray.script", options=CheckOptions(robot="ur5e", max_time=200))
     (reach,) = [f for f in report.findings if f.code == "URS301"]
     assert reach.severity == "error"
+
+
+def test_a_handle_a_builtin_factory_gives_is_a_device_not_none():
+    # eip_writer_factory (EtherNet/IP) gives a writer whose methods the program calls
+    result = run('w = eip_writer_factory(1, 2)\nw.define_bit(1, 0, "ready")\n')
+    assert result.error is None

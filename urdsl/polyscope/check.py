@@ -253,7 +253,8 @@ def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Modu
     stubs = tuple(
         n.FunctionDef(name, tuple(n.Param(f"arg{i + 1}") for i in range(positional[name])) +
                       tuple(n.Param(k, n.Number(0)) for k in keywords[name]),
-                      (n.ExprStmt(n.Call(n.Name("sleep"), (n.Number(DEVICE_REPLY_TIME),))),))
+                      (n.ExprStmt(n.Call(n.Name("sleep"), (n.Number(DEVICE_REPLY_TIME),))),
+                       n.Return(n.Name(stand_in_reply(name)))))
         for name in sorted(calls))
     body = module.body
     if len(body) == 1 and isinstance(body[0], n.FunctionDef):
@@ -262,6 +263,13 @@ def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Modu
     else:
         body = stubs + tuple(body)
     return dataclasses.replace(module, body=body), sorted(calls)
+
+
+def stand_in_reply(name: str) -> str:
+    """The global a stand-in for function ``name`` (:func:`with_urcap_functions`) returns: the
+    check gives it an unknown value, the reply of code urdsl cannot see (a factory's
+    handle, a computed pose), never none."""
+    return f"urdsl_reply_of_{name}"
 
 
 def with_urcap_time(module: n.Module, numbers: set[int]) -> n.Module:
@@ -415,6 +423,9 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         notes.append("unknown values (URCap nodes' results, names of a missing "
                      "installation): " + ", ".join(sorted(file_options.unknown_globals)))
     module, stand_ins = with_urcap_functions(generated, module)
+    for name in stand_ins:
+        file_options.unknown_globals[stand_in_reply(name)] = \
+            f"the reply of {name}(), which code only a URCap generates defines"
     if stand_ins:
         notes.append("functions defined by code urdsl cannot generate, taken as devices: "
                      + ", ".join(stand_ins))

@@ -144,6 +144,8 @@ class BuiltinTable:
         rt.event_once("unsupported", f"{row.name}() is not simulated; it did nothing here",
                       node.span)
         kind = row.returns[0] if row.returns else "None"
+        if kind == "Object":  # a handle (an EtherNet/IP writer): its methods are device calls
+            return _RemoteHandle(row.name, "")
         if kind == "Array":  # nearly all of them return a 6-vector (joints, wrench, speeds)
             return ListValue([0.0] * _ARRAY_LENGTHS.get(row.name, 6))
         if kind == "Pose":
