@@ -24,7 +24,7 @@ def test_manifest_split_is_every_third_project_and_commits_are_pinned():
         assert len(project.commit) == 40 and int(project.commit, 16) >= 0
         held = int(project.id) % 3 == 0 or int(project.id) >= BLIND_FIRST
         assert project.split == ("held" if held else "tune")
-        assert project.generation in ("cb3", "e-series", "unknown")
+        assert project.generation in ("cb2", "cb3", "e-series", "unknown")
     assert 3 * sum(project.split == "held" for project in projects) >= len(projects)
     repos = [project.repo for project in projects]
     assert max(repos.count(repo) for repo in repos) <= 2
