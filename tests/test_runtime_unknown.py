@@ -498,3 +498,17 @@ def test_a_handle_a_builtin_factory_gives_is_a_device_not_none():
     # eip_writer_factory (EtherNet/IP) gives a writer whose methods the program calls
     result = run('w = eip_writer_factory(1, 2)\nw.define_bit(1, 0, "ready")\n')
     assert result.error is None
+
+
+def test_a_thread_polling_a_device_does_not_pace_the_main_loop():
+    # the gripper's status is read all along by a thread; the main loop's passes happen
+    # whatever it says, so what they accumulate stays an error
+    from urdsl.verify.run import CheckOptions, check_text
+
+    watcher = ('thread watch():\n    while (True):\n      if (read_input_integer_register(0)'
+               ' == 1):\n        textmsg("ready")\n      end\n      sync()\n    end\n  end\n'
+               '  run watch()\n  ')
+    text = COMMANDED.format(wait="sleep(0.1)").replace("  left = 10\n", watcher + "left = 10\n")
+    report = check_text(text, "tray.script", options=CheckOptions(robot="ur5e", max_time=200))
+    (reach,) = [f for f in report.findings if f.code == "URS301"]
+    assert reach.severity == "error"

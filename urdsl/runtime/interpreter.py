@@ -587,7 +587,10 @@ class Interpreter:
 
     def decided_on(self, value: Unknown) -> None:
         """The run took a path on a device's unknown reply ``value`` (see
-        :class:`DevicePaced`)."""
+        :class:`DevicePaced`); only the main thread's decisions pace its loop (a thread that
+        polls a gripper all along does not)."""
+        if self.current is not None and self.current.parent is not None:
+            return
         self.device_decisions += 1
         self.device_source = value.source
 

@@ -293,8 +293,6 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     return report
 
 
-
-
 def generated_threads(module, blocks: list[tuple[str, int, int]]) -> set[str]:
     """Threads PolyScope or a URCap (its code in ``blocks``, see :func:`urcap_blocks`) wrote
     into a program (a step counter, a gripper's communication thread): the program may end
