@@ -28,8 +28,10 @@ import math
 import os
 import re
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from ..polyscope.variables import VariablesFile, parse_variables, read_variables
 from ..script import nodes as n
@@ -398,30 +400,18 @@ def installation_features(path: Path) -> VariablesFile | None:
     read (a ``.urp`` that names it says so). PolyScope writes them into the preamble of every
     program run with that installation, so a script file a program includes may use them.
     Cached as :func:`load_script`."""
+    return _cached(path, "features", _features_file)
+
+
+def _features_file(path: Path) -> VariablesFile | None:
+    """:func:`installation_features`, not cached."""
+    from ..polyscope.compile import ascii_name
     from ..polyscope.installation import InstallationError, read_installation
 
-    key = _cache_key(path, "features")
-    if key is None:
-        return None
-    if key in _FEATURES:
-        return _FEATURES[key]
     try:
         installation = read_installation(path)
     except (InstallationError, OSError):
-        installation = None
-    if len(_FEATURES) > 512:
-        _FEATURES.clear()
-    _FEATURES[key] = features = None if installation is None else _features_file(
-        installation, path)
-    return features
-
-
-_FEATURES: dict[tuple, VariablesFile | None] = {}
-
-
-def _features_file(installation, path: Path) -> VariablesFile | None:
-    """:func:`installation_features` of an installation read."""
-    from ..polyscope.compile import ascii_name
+        return None
 
     # named as PolyScope writes them in a script ("点_1" is u28857_1); a name or pose that
     # still is no URScript (a damaged file) is left out, never reported as the user's line
@@ -562,7 +552,9 @@ def _key(path: Path) -> str:
         return str(path)
 
 
-_CACHE: dict[tuple, ScriptFile | None] = {}
+_CACHE: dict[tuple, Any] = {}
+"""What :func:`_cached` read, by :func:`_cache_key` (at most 512 entries, then it starts
+again)."""
 
 
 def _cache_key(path: Path, kind: str) -> tuple | None:
@@ -579,25 +571,34 @@ def _cache_key(path: Path, kind: str) -> tuple | None:
             os.getcwd() if path.is_absolute() else "")  # the name shown depends on it
 
 
+def _cached(path: Path, kind: str, read: Callable[[Path], Any]) -> Any:
+    """``read(path)``, cached by :func:`_cache_key` (None when the file cannot be read or is
+    too large, without calling ``read``)."""
+    key = _cache_key(path, kind)
+    if key is None:
+        return None
+    if key in _CACHE:
+        return _CACHE[key]
+    value = read(path)
+    if len(_CACHE) > 512:
+        _CACHE.clear()
+    _CACHE[key] = value
+    return value
+
+
 def load_script(path: Path) -> ScriptFile | None:
     """The parsed script file at ``path`` (None when it cannot be read or is too large).
     Parsed files are cached by path, size and modification time (and, for an absolute path,
     the working folder its shown name is relative to)."""
-    key = _cache_key(path, "script")
-    if key is None:
-        return None
-    cached = _CACHE.get(key)
-    if cached is not None:
-        return cached
+    return _cached(path, "script", _read_script)
+
+
+def _read_script(path: Path) -> ScriptFile | None:
     try:
         text = path.read_text(encoding="utf-8", errors="replace")
     except OSError:
         return None
-    script = script_file(path, _display(path), text)
-    if len(_CACHE) > 512:
-        _CACHE.clear()
-    _CACHE[key] = script
-    return script
+    return script_file(path, _display(path), text)
 
 
 def load_urp(path: Path) -> ScriptFile | None:
@@ -605,25 +606,18 @@ def load_urp(path: Path) -> ScriptFile | None:
     files its Script nodes name, its installation and variables, as ``urdsl compile``
     writes it), as a host of those files; None when it cannot be read or compiled (that is
     said by ``urdsl lint``/``check`` of the ``.urp`` itself). Cached as :func:`load_script`."""
-    key = _cache_key(path, "urp")
-    if key is None:
-        return None
-    if key in _CACHE:
-        return _CACHE[key]
+    return _cached(path, "urp", _read_urp)
+
+
+def _read_urp(path: Path) -> ScriptFile | None:
     from ..polyscope.command import load
 
     try:
         # a missing installation is said by a lint or check of the .urp itself, not here
         _program, compiled = load(path, warn=lambda _message: None)
-        text = compiled.text
     except Exception:  # noqa: BLE001 - any unreadable program is simply not a host here
-        script = None
-    else:
-        script = script_file(path, _display(path), text)
-    if len(_CACHE) > 512:
-        _CACHE.clear()
-    _CACHE[key] = script
-    return script
+        return None
+    return script_file(path, _display(path), compiled.text)
 
 
 def script_file(path: Path, filename: str, text: str) -> ScriptFile:
