@@ -264,13 +264,15 @@ def test_io_named_only_in_a_missing_installation(tmp_path, capsys):
         '<digitalValue>1</digitalValue></Wait>'))
     assert main(["compile", str(program)]) == 0
     out, err = capsys.readouterr()
-    assert "I/O named only in the missing installation (gripper, part_ready)" in err
+    assert "values only the missing installation gives (gripper (an I/O), part_ready " \
+           "(an I/O))" in err
     assert '$ 2 "Set gripper=On"' in out and "while (part_ready == False):" in out
     assert main(["check", str(program), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert not [f for f in report["findings"] if f["severity"] == "error"]
     (waits,) = [f for f in report["findings"] if f["code"] == "URS210"]
-    assert "an I/O the installation default.installation names" in waits["message"]
+    assert "an I/O of the installation default.installation (not beside the program)" \
+        in waits["message"]
     assert main(["lint", str(program), "--format", "json"]) == 0
     (found,) = json.loads(capsys.readouterr().out)
     assert found["severity"] == "warning" and "'part_ready'" in found["message"]
@@ -410,6 +412,32 @@ def test_without_its_installation_the_tcp_the_waypoints_were_taught_with(tmp_pat
     (reach,) = [f for f in json.loads(capsys.readouterr().out)["findings"]
                 if f["code"] == "URS301"]
     assert reach["severity"] == "warning" and "2 different TCPs" in reach["message"]
+
+
+def test_safe_home_without_the_installation_moves_to_an_unknown_position(tmp_path, capsys):
+    # the program is valid with its installation; the repository lacks the installation:
+    # lint and check read the rest of it, the home position is a value they do not know
+    from urdsl.polyscope.compile import SAFE_HOME
+
+    program = tmp_path / "home.urp"
+    program.write_text(_program(
+        '<Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true">'
+        '<children><SafeHome positionOptionType="SPEED_AND_ACCELERATION" speed="1.05" '
+        'acceleration="1.4"/>'
+        + _taught("Waypoint_1", "0.3, -1.2, 1.2, -1.5, -1.5, 0.0", "0, 0, 0, 0, 0, 0")
+        + '</children></Move>', FLANGE_KINEMATICS))
+    assert main(["lint", str(program)]) == 0
+    out = capsys.readouterr().out
+    assert "URS001" not in out and "error" not in out
+    assert f"name '{SAFE_HOME}' is not defined: the safe home position of the installation " \
+           "default.installation (not beside the program)" in out
+    assert main(["check", str(program)]) == 0
+    captured = capsys.readouterr()
+    assert "URS001" not in captured.out and "1 move(s)" in captured.out  # the waypoint's
+    assert f"{SAFE_HOME} (the safe home position)" in captured.err
+    assert main(["send", str(program), "--host", "127.0.0.1", "--dry-run"]) == 1
+    assert f"not sent: {SAFE_HOME} (the safe home position) only in the installation " \
+           "default.installation" in capsys.readouterr().err
 
 
 def test_what_a_urcaps_function_gives_is_unknown_not_none(tmp_path, capsys):

@@ -164,7 +164,8 @@ def test_an_unnamed_io_is_an_error_naming_the_node():
     assert "Robot Program > Loop > Set" in str(error.value)
     assert "'gripper' is not named in the installation" in str(error.value)
     # without the installation that would name it, the name is what it is
-    assert compile_program(read_urp(CELL)).unknown_io == ("gripper", "part_present")
+    assert compile_program(read_urp(CELL)).unknown == {"gripper": "an I/O",
+                                                       "part_present": "an I/O"}
 
 
 # ---- the commands --------------------------------------------------------------------------
@@ -304,21 +305,3 @@ def test_safe_home_moves_to_the_installations_position():
         compile_program(program, parse_installation(b"<Installation/>", "i"))
 
 
-def test_safe_home_without_the_installation_is_a_warning_of_lint(tmp_path, capsys):
-    # the program is valid with its installation; the repository lacks the installation
-    from urdsl.polyscope.compile import MissingInstallation
-    from urdsl.polyscope.urp import parse_urp
-
-    text = (b'<URProgram name="p" lastSavedIn="5.11.1" installation="default"><children>'
-            b'<MainProgram runOnlyOnce="true"><children><Move motionType="MoveJ" speed="1.0" '
-            b'acceleration="1.4"><children><SafeHome positionOptionType='
-            b'"SPEED_AND_ACCELERATION" speed="1.05" acceleration="1.4"/></children></Move>'
-            b'</children></MainProgram></children></URProgram>')
-    with pytest.raises(MissingInstallation, match="installation the program names"):
-        compile_program(parse_urp(text, "p.urp"))
-    (tmp_path / "p.urp").write_bytes(text)
-    status = main(["lint", str(tmp_path / "p.urp")])
-    out = capsys.readouterr().out
-    assert status == 0
-    assert "Found 1 warning in 1 file." in out
-    assert "URS001 not linted: node Robot Program > MoveJ > SafeHome" in out

@@ -127,7 +127,7 @@ def test_send_of_a_program_that_cannot_be_compiled_is_one_message(tmp_path, caps
     err = capsys.readouterr().err
     # 'nowhere' may be a name of the installation, which is not there: read, checked and
     # linted as an unknown value, but never sent
-    assert f"{program}: not sent: the I/O nowhere named only in the installation" in err
+    assert f"{program}: not sent: nowhere (an I/O) only in the installation" in err
     assert "Traceback" not in err
 
 

@@ -248,7 +248,7 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         soften_urcap_names,
         urcap_diagnostics,
     )
-    from ..polyscope.compile import CompileError, MissingInstallation
+    from ..polyscope.compile import CompileError
     from ..polyscope.urp import UnsupportedProgram, UrpError
     from ..script.diagnostics import Diagnostic
     from .config import ConfigError, settings_for
@@ -263,11 +263,6 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         raise UsageError(str(error)) from None
     try:
         generated = generate(name)
-    except MissingInstallation as error:  # not a mistake of the program: a warning
-        text = str(error)
-        message = text.split(": node ", 1)[1] if ": node " in text else text
-        return [Diagnostic(name, 1, 1, "warning", "URS001",
-                           f"not linted: node {message}")]
     except UnsupportedProgram as error:  # urdsl's limit, not the program's mistake
         text = str(error)
         message = text.split(": error: ", 1)[1] if ": error: " in text else text

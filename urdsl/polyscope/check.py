@@ -204,9 +204,8 @@ def missing_features(generated: Generated) -> dict[str, str]:
     out = {name: f"a {'feature' if name in program.feature_variables else 'name'} of the "
                  f"installation {named} (not beside the program)"
            for name in sorted(program.installation_names)}  # feature variables too
-    for name in generated.compiled.unknown_io:
-        out.setdefault(name, f"an I/O the installation {named} names (not beside the "
-                             "program)")
+    for name, what in generated.compiled.unknown.items():
+        out.setdefault(name, f"{what} of the installation {named} (not beside the program)")
     return out
 
 
@@ -550,13 +549,13 @@ def send_check(path: str, robot: str, check: bool):
     except ScriptError as error:
         print(error.diagnostic.render(), file=sys.stderr)
         return None
-    if generated.compiled.unknown_io:
+    if generated.compiled.unknown:
         # compiled for reading and checking only: the robot would stop at the first of these
         # names, and the outputs they name would never be set
         named = generated.program.installation or "?"
-        print(f"{path}: not sent: the I/O {', '.join(generated.compiled.unknown_io)} "
-              f"named only in the installation {named}.installation, which is not beside "
-              "the program; put it there to send the program", file=sys.stderr)
+        print(f"{path}: not sent: {generated.compiled.unknown_text()} only in the "
+              f"installation {named}.installation, which is not beside the program; put it "
+              "there to send the program", file=sys.stderr)
         return None
     report = None
     if check:

@@ -136,10 +136,10 @@ def load_all(path: str | Path, warn: Callable[[str], None] = _warn
         return file.read_bytes() if file.is_file() else None
 
     compiled = compile_program(program, installation, variables, files)
-    if compiled.unknown_io:
-        warn(f"{path}: I/O named only in the missing installation ("
-             f"{', '.join(compiled.unknown_io)}): read as values of their own, unknown to "
-             "the check; the Set nodes writing them are written as their markers alone")
+    if compiled.unknown:
+        warn(f"{path}: values only the missing installation gives ({compiled.unknown_text()}): "
+             "read as names of their own, unknown to the check; the Set nodes writing such "
+             "an I/O are written as their markers alone")
     return program, installation, compiled
 
 

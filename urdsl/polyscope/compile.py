@@ -95,9 +95,9 @@ class CompileError(Exception):
     """A program node that cannot be compiled; the message names the file and node path."""
 
 
-class MissingInstallation(CompileError):
-    """A node needs data of the program's installation (its safe home position), and the
-    installation the program names is not beside it: the program may well be right."""
+SAFE_HOME = "urdsl_safe_home"
+"""The name a SafeHome node moves to when the installation the program names is not beside
+it: the installation's safe home joint positions (rad), unknown to urdsl."""
 
 
 @dataclass
@@ -109,9 +109,16 @@ class Compiled:
     numbers: dict[int, Node] = field(default_factory=dict)
     labels: dict[int, str] = field(default_factory=dict)
     """Marker number → the label PolyScope shows (in English)."""
-    unknown_io: tuple[str, ...] = ()
-    """I/O names a missing installation would resolve (a renamed pin or a Modbus signal):
-    read as a name of that value, their Set nodes left with their marker alone."""
+    unknown: dict[str, str] = field(default_factory=dict)
+    """Names standing for what only the missing installation gives, in order, each with what
+    it stands for: its I/O names (a renamed pin or a Modbus signal: read as a name of that
+    value, their Set nodes left with their marker alone) and its safe home position
+    (``SAFE_HOME``). Unknown to the check; a controller would stop at the first of them."""
+
+    def unknown_text(self) -> str:
+        """:attr:`unknown` for a message: ``gripper (an I/O), urdsl_safe_home (the safe home
+        position)``."""
+        return ", ".join(f"{name} ({what})" for name, what in self.unknown.items())
 
     @property
     def text(self) -> str:
@@ -515,7 +522,7 @@ class _Compiler:
         self.base_variable = bool(getattr(installation, "base_variable", False))
         self.version = program.major_version or 5
         self.pulses = 0  # single pulse threads written so far
-        self.unknown_io: dict[str, None] = {}  # I/O names of a missing installation, in order
+        self.unknown: dict[str, str] = {}  # names of a missing installation's values, in order
         saved = _version(program.saved_in or program.created_in)
         # PolyScope before 3.12 (seen: 3.5.0, 3.8.0, 3.10.1 and 3.11.0; 3.12.1, 3.14.1,
         # 3.15 on write them) writes its markers without the breakAfter/noBreak flags, and
@@ -611,7 +618,7 @@ class _Compiler:
             # [U: other words]
             name = "P" + name
         module = _ascii_names(Module((FunctionDef(name, (), tuple(body)),)))
-        return Compiled(module, self.numbers, self.labels, tuple(self.unknown_io))
+        return Compiled(module, self.numbers, self.labels, dict(self.unknown))
 
     def _all_nodes(self, suppressed: bool = False):
         """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
@@ -984,7 +991,7 @@ class _Compiler:
         if self.installation is not None or pin in self.pins or _PIN.match(pin) \
                 or not pin.isidentifier():
             return False
-        self.unknown_io[pin] = None
+        self.unknown[pin] = "an I/O"
         return True
 
     def resolve_pin(self, pin: str, node: Node) -> tuple[str, int]:
@@ -1530,17 +1537,20 @@ class _Compiler:
             If(Paren(BinOp(">", Name("stepsToRetract"), Number(0))), found)]
 
     def n_SafeHome(self, node: Node) -> list[Item]:
-        """A move to the installation's safe home joint positions (rad)."""
+        """A move to the installation's safe home joint positions (rad). Without the
+        installation the program names, the position is :data:`SAFE_HOME`, a name of a value
+        only that installation gives (unknown to the check, refused by send and sim)."""
         settings = (self.installation.settings or {}) if self.installation else {}
         position = settings.get("SafeHomeSettings", {}).get("position")
+        joints: Expr
         if not position and self.installation is None:
-            raise MissingInstallation(
-                f"{self.program.path}: node {node.path}: needs the installation's safe home "
-                "position, and the installation the program names is not beside it")
-        if not position:
+            self.unknown[SAFE_HOME] = "the safe home position"
+            joints = Name(SAFE_HOME)
+        elif not position:
             raise self.error(node, "the installation's safe home position is unknown "
                                    "(no installation with SafeHomeSettings beside the program)")
-        joints = List(tuple(_num(float(v)) for v in position.split(",")))
+        else:
+            joints = List(tuple(_num(float(v)) for v in position.split(",")))
         keywords: list[Keyword] = []
         if node.attrs.get("positionOptionType") == "TIME" and node.attrs.get("nextMotionTime"):
             keywords.append(Keyword("t", _num(float(node.attrs["nextMotionTime"]))))

@@ -1226,8 +1226,8 @@ def _compiled_urp(path: Path) -> str:
         raise SimError(str(error)) from None
     except RecursionError:
         raise SimError(f"{path.name}: the program nests too deeply") from None
-    if compiled.unknown_io:  # a controller runs a program with the installation it names
-        raise SimError(f"{path.name}: the I/O {', '.join(compiled.unknown_io)} named only in "
-                       f"the installation {program.installation or '?'}.installation, which "
-                       "is not beside the program")
+    if compiled.unknown:  # a controller runs a program with the installation it names
+        raise SimError(f"{path.name}: {compiled.unknown_text()} only in the installation "
+                       f"{program.installation or '?'}.installation, which is not beside the "
+                       "program")
     return compiled.text

@@ -341,7 +341,7 @@ def _check_urp(name: str, args: argparse.Namespace, options):
 
     from .._cli import UsageError
     from ..polyscope.check import check_urp
-    from ..polyscope.compile import CompileError, MissingInstallation
+    from ..polyscope.compile import CompileError
     from ..polyscope.urp import UnsupportedProgram, UrpError
 
     if not Path(name).is_file():
@@ -350,7 +350,7 @@ def _check_urp(name: str, args: argparse.Namespace, options):
         report = check_urp(name, options, robot_given=bool(args.robot),
                            start_joints=args.start_joints or args.start_joints_deg,
                            tcp=args.tcp, nominal=args.nominal, cell_path=args.cell)
-    except (MissingInstallation, UnsupportedProgram) as error:  # not the program's mistake
+    except UnsupportedProgram as error:  # urdsl's limit, not the program's mistake
         return _not_compiled(name, options, "warning", "not checked: ", str(error))
     except (UrpError, CompileError) as error:
         return _not_compiled(name, options, "error", "", str(error))
