@@ -611,12 +611,14 @@ def load_urp(path: Path) -> ScriptFile | None:
 
 def _read_urp(path: Path) -> ScriptFile | None:
     from ..polyscope.command import load
+    from ..polyscope.compile import CompileError
+    from ..polyscope.urp import UrpError
 
     try:
         # a missing installation is said by a lint or check of the .urp itself, not here
         _program, compiled = load(path, warn=lambda _message: None)
-    except Exception:  # noqa: BLE001 - any unreadable program is simply not a host here
-        return None
+    except (UrpError, CompileError, OSError, RecursionError):
+        return None  # an unreadable program is not a host here; its own lint says why
     return script_file(path, _display(path), compiled.text)
 
 
