@@ -6,6 +6,8 @@ XML, as read_urp accepts it); the expected forms are those of real PolyScope scr
 
 from __future__ import annotations
 
+import gzip
+
 import pytest
 from test_polyscope_programs import KINEMATICS  # the same UR5e arm
 
@@ -402,6 +404,12 @@ def test_urscript_saved_as_urp_is_named_as_such():
         parse_urp(b"textmsg(get_actual_joint_positions())\nsleep(0.5)\n", "main_cycle.urp")
     with pytest.raises(UrpError, match="not well-formed XML"):
         parse_urp(b"textmsg(1\n", "broken.urp")
+    # an empty file parses as an empty script, but is nothing: a program the controller
+    # cannot load (seen: a 31-byte gzip of nothing among a project's sample programs)
+    with pytest.raises(UrpError, match=r"empty once decompressed: not a PolyScope program"):
+        parse_urp(gzip.compress(b""), "program.urp")
+    with pytest.raises(UrpError, match=r"error: empty: not a PolyScope program"):
+        parse_urp(b" \n", "program.urp")
 
 
 def test_polyscope_before_3_15_writes_markers_without_flags():

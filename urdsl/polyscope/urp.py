@@ -223,6 +223,10 @@ def read_urp(path: str | Path) -> Program:
 def parse_urp(data: bytes, path: str = "<urp>") -> Program:
     """Parse the bytes of a ``.urp`` file (gzip or plain XML) into a :class:`Program`."""
     xml = _decompress(data, path)
+    if not xml.strip():
+        raise UrpError(f"{path}: error: empty{' once decompressed' if xml != data else ''}: "
+                       "not a PolyScope program (PolyScope saves a program as XML); the "
+                       "controller cannot load it")
     try:
         root = ElementTree.fromstring(xml)
     except ElementTree.ParseError as error:
