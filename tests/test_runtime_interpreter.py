@@ -75,6 +75,18 @@ def test_the_manuals_list_struct_and_matrix_methods():
     assert "has no method 'shape'" in error("x = [1, 2]\ny = x.shape()\n").message
 
 
+def test_inv_of_a_matrix_and_of_a_pose():
+    # the manual's inv(m) takes a square non-singular matrix, and a pose (its inverse pose);
+    # seen in a PolyScope program: pose_trans(inv(teach_frame), p)
+    assert value("x = inv([[2, 0], [0, 4]])") == ListValue([ListValue([0.5, 0.0]),
+                                                            ListValue([0.0, 0.25])])
+    p = "p[0.1, -0.2, 0.3, 0.4, 0.5, -0.6]"
+    inverse = value(f"x = inv({p})")
+    assert type(inverse) is PoseValue
+    assert list(inverse) == pytest.approx(list(value(f"x = pose_inv({p})")), abs=1e-12)
+    assert "matrix of numbers, not a" in error("x = inv([1, 2])").message
+
+
 # ---- scoping and calls ---------------------------------------------------------------------
 
 

@@ -518,6 +518,12 @@ def _make_list(rt, node, length, initial_value, capacity=None):
 
 @implements("inv")
 def _inv(rt, node, m):
+    """The inverse of a square non-singular matrix, or of a pose (as ``pose_inv``: URScript's
+    ``inv`` accepts a pose too)."""
+    if type(m) is PoseValue:
+        from ..kinematics import pose as posemath
+
+        return PoseValue(list(map(float, posemath.pose_inv(list(m)))))
     rows = _matrix_rows(rt, node, m, "inv")
     if len(rows) != len(rows[0]):
         raise rt.error("type", f"inv() needs a square matrix, got {len(rows)}x{len(rows[0])}",
