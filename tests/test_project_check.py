@@ -189,6 +189,22 @@ def test_a_global_whose_elements_another_file_sets_is_unknown(tmp_path, capsys):
     assert "grip_detected" in report["context"]
 
 
+def test_a_function_borrowed_from_another_file_writes_that_files_global(tmp_path, capsys):
+    # ur_rtde's header and control loop: the header's function toggles the header's global
+    # (assigned, not declared, in the function: the controller binds it to the global);
+    # taken alone, the function read its own unassigned local: "not defined"
+    (tmp_path / "header.script").write_text(
+        "global finished = -2\n"
+        "def signal_finished():\n  if finished == -1:\n    finished = -2\n  else:\n"
+        "    finished = -1\n  end\n  write_output_integer_register(2, finished)\nend\n"
+        "def scratch():\n  scratch_value = 3\n  return scratch_value\nend\n")
+    (tmp_path / "loop.script").write_text("signal_finished()\nx = scratch()\nsync()\n")
+    status, report = check(capsys, str(tmp_path / "loop.script"))
+    assert status == 0, report["findings"]
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    assert "finished" in report["context"] and "scratch_value" not in report["context"]
+
+
 def test_a_constant_another_file_gives_once_keeps_its_value(tmp_path, capsys):
     (tmp_path / "setup.script").write_text(
         "def init():\n  global dist = 3.0\nend\n")

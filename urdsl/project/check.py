@@ -123,6 +123,24 @@ def _bound_in_file(analysis, name: str, scope) -> bool:
     return name in analysis.globals or name in analysis.functions or name in analysis.threads
 
 
+def _assigned_free(function: n.Stmt) -> set[str]:
+    """The variables ``function`` (a ``def`` or ``thread``) assigns without declaring them
+    ``local`` (its parameters excluded): globals where one of that name exists."""
+    from ..lint.scope import analyse
+
+    try:
+        analysis = analyse(_alone(function))
+    except RecursionError:
+        return set()
+    found: set[str] = set()
+    for scope in analysis.scopes:
+        if scope.kind == "top":
+            continue
+        found.update(name for name in scope.assigned
+                     if name not in scope.declared_local and name not in scope.params)
+    return found
+
+
 def _alone(statement: n.Stmt) -> n.Module:
     """A module holding one statement, never taken for a whole program."""
     return n.Module((statement, n.ExprStmt(n.NoneLit())))
@@ -309,8 +327,17 @@ def _collect(context: FileContext, module: n.Module) -> tuple[list[Definition], 
         definition = pick(name, kinds, use)
         if definition is None:
             return
-        follow(_alone(definition.node) if definition.kind in ("function", "thread")
-               else n.Module((definition.node,)))
+        if definition.kind in ("function", "thread"):
+            follow(_alone(definition.node))
+            # a name it assigns without ``local`` is its file's global where that file has
+            # one (the controller binds a free variable to a global of that name): taken alone,
+            # the function would read its own unassigned local instead
+            for written in sorted(_assigned_free(definition.node)):
+                if any(other.kind == "global" and other.filename == definition.filename
+                       for _relation, other in context.definitions(written, _READ)):
+                    need(written, _READ, "read")
+        else:
+            follow(n.Module((definition.node,)))
         chosen.append(definition)
 
     def follow(tree: n.Module) -> None:
