@@ -82,3 +82,19 @@ def test_shoulder_singularity_for_every_model(name):
     robot = Robot.model(name)
     q = shoulder_singular_q(robot.spec, theta3=0.1)
     assert robot.singularity(q[None])["shoulder"][0] < 1e-9
+
+
+def test_a_linearized_factory_table_measures_as_the_arm_it_describes():
+    # PolyScope's "linearized" tables move the three parallel axes' frames metres along the
+    # axes, offsets that cancel (d2 + d3 + d4 is the arm's d4): the same arm, so the same
+    # distances; measured on the frames' own offsets, every move of an e-Series export passed
+    # "within 0 m" of the shoulder and elbow singularities
+    from urdsl.kinematics import Calibration
+
+    nominal = Robot.model("ur5e")
+    linearized = Robot.model("ur5e", Calibration(delta_d=[0.0, 79.4, -95.5, 16.1, 0.0, 0.0]))
+    Q = np.random.default_rng(7).uniform(-math.pi, math.pi, (40, 6))
+    assert np.allclose(linearized.fk_many(Q), nominal.fk_many(Q), atol=1e-9)
+    expected, measured = nominal.singularity(Q), linearized.singularity(Q)
+    for kind in ("shoulder", "elbow", "wrist", "manipulability"):
+        assert np.allclose(measured[kind], expected[kind], atol=1e-9), kind

@@ -488,13 +488,30 @@ class Robot:
         if self.calibration is None:
             return _nominal_singularity(Q, *self._nominal)
         axes, origins = self.axes_many(Q)
+        # Factory tables are often "linearized": the three parallel axes get offsets of tens
+        # of metres along them that cancel (d2 + d3 + d4 is the arm's d4), and a2, a3 are
+        # then not the link lengths. Only points where the arm is are used: the wrist centre,
+        # the shoulder (frame 1's origin), wrist 1's axis at frame 4's origin, and the elbow
+        # axis's point nearest the shoulder, all seen along the shoulder axis.
         wrist = origins[:, 5]
-        d4 = float(self._dh[2][3])
+        lateral = float(np.sum(self._dh[2][1:4]))  # the wrist centre's offset from the base
         r2 = wrist[:, 0] ** 2 + wrist[:, 1] ** 2
-        shoulder = np.sqrt(np.maximum(r2 - d4 * d4, 0.0))
-        a2, a3 = abs(float(self._dh[1][1])), abs(float(self._dh[1][2]))
-        length = np.linalg.norm(origins[:, 3] - origins[:, 1], axis=1)
-        elbow = np.maximum(np.minimum(a2 + a3 - length, length - abs(a2 - a3)), 0.0)
+        shoulder = np.sqrt(np.maximum(r2 - lateral * lateral, 0.0))
+        base, along = origins[:, 1], axes[:, 1]
+
+        def seen_along_shoulder_axis(point: np.ndarray) -> np.ndarray:
+            offset = point - base
+            return offset - np.sum(offset * along, axis=1)[:, None] * along
+
+        to_shoulder = base - origins[:, 2]
+        elbow_point = origins[:, 2] + np.sum(to_shoulder * axes[:, 2], axis=1)[:, None] * \
+            axes[:, 2]
+        elbow_at = seen_along_shoulder_axis(elbow_point)
+        wrist_at = seen_along_shoulder_axis(origins[:, 4])
+        a2 = np.linalg.norm(elbow_at, axis=1)
+        a3 = np.linalg.norm(wrist_at - elbow_at, axis=1)
+        length = np.linalg.norm(wrist_at, axis=1)
+        elbow = np.maximum(np.minimum(a2 + a3 - length, length - np.abs(a2 - a3)), 0.0)
         sin_wrist = np.linalg.norm(np.cross(axes[:, 3], axes[:, 5]), axis=1)
         wrist_angle = np.arcsin(np.clip(sin_wrist, 0.0, 1.0))
         flange = origins[:, 6]
