@@ -303,7 +303,8 @@ def project_scripts(root: Path, project: Project) -> list[Path]:
     what the robot ran and what is checked; without, the user checks the program)."""
     files = [path for path in (root / project.id).rglob("*") if path.is_file()]
     scripts = [path for path in files if path.suffix.lower() == ".script"]
-    exported = {path.with_suffix("").as_posix().lower() for path in scripts}
+    exported = {path.with_suffix("").as_posix().lower() for path in scripts
+                if path.read_bytes().strip()}  # an empty .script is no export
     programs = [path for path in files if path.suffix.lower() == ".urp"
                 and path.with_suffix("").as_posix().lower() not in exported]
     return sorted(scripts + programs)

@@ -184,8 +184,8 @@ def test_lint_of_a_folder_takes_polyscopes_script_for_a_urp_beside_it(tmp_path, 
     assert "name pick.urp to lint its program tree" in captured.err
     assert "tool.script" not in captured.err
     # a .urp without its .script is linted: a program PolyScope could not run is an error
-    # (an I/O its installation does not name)
-    (cell / "pick.script").unlink()
+    # (an I/O its installation does not name); an empty .script beside it is no export
+    (cell / "pick.script").write_text("")
     (cell / "default.installation").write_bytes(
         (Path(__file__).parent / "data" / "polyscope" / "cell.installation").read_bytes())
     (cell / "pick.urp").write_bytes(program('<Set type="DigitalOutput"><pin '

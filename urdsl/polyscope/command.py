@@ -21,9 +21,9 @@ SCRIPT_SUFFIXES = (".script", ".urscript", ".urs")
 def collect_programs(folder: str | Path) -> tuple[list[str], list[tuple[str, str]]]:
     """The programs in ``folder`` and its subfolders (hidden ones left out), sorted:
     URScript files and PolyScope programs (``.urp``), except a ``.urp`` with a ``.script`` of
-    the same name beside it. That ``.script`` is what PolyScope generated when it saved the
-    program and what the controller ran: it holds the code URCaps generate and the preamble
-    of the installation the program ran with, which compiling the ``.urp`` here cannot
+    the same name beside it (not empty). That ``.script`` is what PolyScope generated when it
+    saved the program and what the controller ran: it holds the code URCaps generate and the
+    preamble of the installation the program ran with, which compiling the ``.urp`` here cannot
     reproduce (a folder check of the ``.urp`` reported the URCaps' names as undefined).
     Name the ``.urp`` itself to lint or check its program tree. Returns ``(files,
     skipped)``, ``skipped`` holding ``(urp, script)`` pairs."""
@@ -32,7 +32,9 @@ def collect_programs(folder: str | Path) -> tuple[list[str], list[tuple[str, str
         path for path in root.rglob("*")
         if path.suffix.lower() in (*SCRIPT_SUFFIXES, ".urp") and path.is_file()
         and not any(part.startswith(".") for part in path.parts[len(root.parts):]))
-    scripts = {path.with_suffix(""): path for path in found if path.suffix.lower() == ".script"}
+    # an empty .script (a lost export, a placeholder) is not what PolyScope wrote
+    scripts = {path.with_suffix(""): path for path in found
+               if path.suffix.lower() == ".script" and _has_text(path)}
     files: list[str] = []
     skipped: list[tuple[str, str]] = []
     for path in found:
@@ -42,6 +44,15 @@ def collect_programs(folder: str | Path) -> tuple[list[str], list[tuple[str, str
         else:
             files.append(str(path))
     return files, skipped
+
+
+def _has_text(path: Path) -> bool:
+    """Whether the file at ``path`` holds more than white space (read up to 4 KiB)."""
+    try:
+        with path.open("rb") as file:
+            return bool(file.read(4096).strip())
+    except OSError:
+        return False
 
 
 def report_skipped(skipped: list[tuple[str, str]], verb: str) -> None:
