@@ -205,6 +205,29 @@ def test_a_function_borrowed_from_another_file_writes_that_files_global(tmp_path
     assert "finished" in report["context"] and "scratch_value" not in report["context"]
 
 
+def test_a_fragment_takes_definitions_from_the_program_version_that_inlined_it(
+        tmp_path, capsys):
+    # two saved versions of a welding program inline the same script file; the older one
+    # inlined an older version of it and defines weld(index, table); the newer weld(index,
+    # table, kind), which this version of the file calls
+    body = ["n = 1", "table = 2", "kind = 3", "textmsg(n)", "textmsg(table)", "textmsg(kind)",
+            "weld(n, table, kind)", "sleep(0.1)", "textmsg(\"done\")", "sync()"]
+    (tmp_path / "weld_steps.script").write_text("\n".join(body) + "\n")
+
+    def program(name: str, params: str, lines: list[str]) -> str:
+        inlined = "".join(f"  {line}\n" for line in lines)
+        return (f"def {name}():\n  def weld({params}):\n    textmsg(index)\n  end\n"
+                f'  $ 1 "Robot Program"\n{inlined}end\n')
+
+    older = [line.replace("weld(n, table, kind)", "weld(n, table)") for line in body]
+    (tmp_path / "a_cell_v1.script").write_text(program("cell_v1", "index, table", older))
+    (tmp_path / "b_cell_v2.script").write_text(program("cell_v2", "index, table, kind", body))
+    status, report = check(capsys, str(tmp_path / "weld_steps.script"))
+    assert status == 0, report["findings"]
+    assert "b_cell_v2.script, " in report["context"]  # the exact one first
+    assert main(["lint", str(tmp_path / "weld_steps.script")]) == 0
+
+
 def test_a_constant_another_file_gives_once_keeps_its_value(tmp_path, capsys):
     (tmp_path / "setup.script").write_text(
         "def init():\n  global dist = 3.0\nend\n")

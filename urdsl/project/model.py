@@ -179,7 +179,7 @@ class FileContext:
                     found.append(("variables", Definition(
                         name, "installation variable", variables.filename, variable.span,
                         variable.statement)))
-        hosts = {id(s) for s in self.hosts}
+        hosts = {id(s): rank for rank, s in enumerate(self.hosts)}  # best host first
         included = {id(s) for s in self.included}
         order = {"host": 0, "included": 1, "explicit": 2, "other": 3}
         ranked = []
@@ -188,8 +188,10 @@ class FileContext:
                 continue
             relation = ("host" if id(script) in hosts else "included" if id(script) in included
                         else "explicit" if self.project.is_explicit(script) else "other")
-            ranked.append((order[relation], index, relation, definition))
-        found.extend((relation, definition) for _o, _i, relation, definition in sorted(ranked))
+            ranked.append((order[relation], hosts.get(id(script), 0), index, relation,
+                           definition))
+        found.extend((relation, definition)
+                     for _o, _h, _i, relation, definition in sorted(ranked, key=lambda r: r[:3]))
         return found
 
     def _resolve(self, name: str, kinds: frozenset[str]) -> Resolution | None:
@@ -341,16 +343,20 @@ class Project:
         return self._by_name.get(name, [])
 
     def hosts_of(self, script: ScriptFile) -> list[ScriptFile]:
-        """The hosts that include ``script`` (by ``Script:`` label or inlined code)."""
+        """The hosts that include ``script`` (by ``Script:`` label or inlined code), those
+        holding more of its code in order first (of several saved versions of a program, the
+        one that inlined this version of the file; its definitions are looked up first)."""
         if self._hosts is None:
             self._hosts = {}
             hosts = [s for s in self.files if s.is_host and s.module is not None]
             for fragment in self.files:
-                self._hosts[id(fragment)] = [
-                    h for h in hosts if h is not fragment and _includes(h, fragment)]
+                self._hosts[id(fragment)] = _best_first(
+                    [h for h in hosts if h is not fragment and _includes(h, fragment)],
+                    fragment)
         if id(script) not in self._hosts:
             hosts = [s for s in self.files if s.is_host and s.module is not None]
-            return [h for h in hosts if h is not script and _includes(h, script)]
+            return _best_first([h for h in hosts if h is not script and _includes(h, script)],
+                               script)
         return self._hosts[id(script)]
 
     def context(self, path: str | Path, text: str | None = None,
@@ -782,6 +788,16 @@ def _includes(host: ScriptFile, fragment: ScriptFile) -> bool:
         return _share(lines, host.code_lines) >= _SUBPROGRAM_SHARE
     return (len(lines) >= 2 and _share(lines, host.code_lines) >= _INLINE_SHARE
             and _in_order(lines, host) >= _INLINE_SHARE)
+
+
+def _best_first(hosts: list[ScriptFile], fragment: ScriptFile) -> list[ScriptFile]:
+    """``hosts`` of ``fragment``, those holding a larger share of its code lines in their
+    order first (a ``Script:`` label names the file, not its version); otherwise in file
+    order."""
+    lines = fragment.code_line_list
+    if len(hosts) < 2 or not lines:
+        return hosts
+    return sorted(hosts, key=lambda host: -_in_order(lines, host))
 
 
 _GAP = 3
