@@ -182,3 +182,31 @@ def test_make_list_needs_whole_lengths():
     report = check_text("l = make_list(0.5, 0)\n", "ml.script")
     assert [f.code for f in report.findings] == ["URS203"]
     assert "whole number" in report.findings[0].message
+
+
+def test_a_speed_a_move_ends_with_is_not_the_next_moves():
+    # a movel that crosses the wrist singularity just before its end still turns wrist 3 fast
+    # at its last sample; the next move's first sample shares that central difference, and
+    # the movej after it was reported too (seen on a PolyScope export: 4.91 rad/s on a movej
+    # whose own samples stay under 1.1 rad/s)
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from urdsl.script.nodes import Source, Span
+    from urdsl.verify.checks import joint_speeds
+
+    limits = np.full(6, 3.14)
+    qd = np.zeros((8, 6))
+    qd[2:4, 5] = 60.0  # the movel's singular turn, up to its last sample (3)
+    qd[4, 5] = 7.0     # the movej's first sample: half of the movel's last step
+    qd[5:, 5] = 1.0
+    source = Source("movel(a)\nmovej(b)\n", "t.script")
+    segments = [SimpleNamespace(kind="movel", span=Span(source, 0, 8)),
+                SimpleNamespace(kind="movej", span=Span(source, 9, 17))]
+    trace = SimpleNamespace(qd=qd, times=np.arange(8) * 0.002, segments=segments,
+                            segment=np.array([0, 0, 0, 0, 1, 1, 1, 1]))
+    (finding,) = joint_speeds(trace, limits)
+    assert finding.span.line == 1 and "60.00 rad/s" in finding.message
+    qd[6, 5] = 5.0  # a speed the movej reaches by itself stays its own
+    assert [f.span.line for f in joint_speeds(trace, limits)] == [1, 2]

@@ -147,6 +147,12 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
     over = _rows_where(trace.qd, lambda qd: np.abs(qd) > bound)
     if exclude is not None:
         over &= ~exclude
+    # a move's first sample shares its central difference with the move before: a speed the
+    # move before still had there (a path through a singularity that ends in it) is that
+    # move's, not this one's
+    first = np.flatnonzero(trace.segment[1:] != trace.segment[:-1]) + 1
+    carried = first[over[first] & over[first - 1]]
+    over[carried] = False
     findings = []
     for segment, sample in _per_segment(trace, over):
         ratio = np.abs(trace.qd[sample]) / limits
@@ -154,6 +160,7 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
         inside = trace.segment == segment
         if exclude is not None:
             inside &= ~exclude
+        inside[carried] = False
         peak = float(np.max(np.abs(trace.qd[inside, joint])))
         findings.append(Finding.of(
             "URS304",
