@@ -210,3 +210,17 @@ def test_a_speed_a_move_ends_with_is_not_the_next_moves():
     assert finding.span.line == 1 and "60.00 rad/s" in finding.message
     qd[6, 5] = 5.0  # a speed the movej reaches by itself stays its own
     assert [f.span.line for f in joint_speeds(trace, limits)] == [1, 2]
+
+
+def test_a_tcp_change_between_moves_is_no_tcp_speed():
+    # set_tcp moves the TCP point 5 cm while the arm stands still: differentiated across the
+    # change it was 0.05 m / 2 ms = 25 m/s over a cell's 1.5 m/s (a PolyScope program that
+    # switches from a deburring to a polishing tool)
+    text = ("movej([0, -1.57, 1.57, -1.57, -1.57, 0])\n"
+            "set_tcp(p[0, 0, 0.05, 0, 0, 0])\n"
+            "movej([0.1, -1.57, 1.57, -1.57, -1.57, 0], a=1.4, v=0.1)\n")
+    report = check(text, tcp_speed_limit=1.5)
+    assert not [f for f in report.findings if f.code == "URS306"], report.findings
+    fast = text.replace("v=0.1", "v=3.0")  # a real overspeed is still one
+    report = check(fast, tcp_speed_limit=0.1)
+    assert [f.code for f in report.findings if f.code == "URS306"] == ["URS306"]

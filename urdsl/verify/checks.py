@@ -283,25 +283,43 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
 def _tcp_positions(trace: Trace, robot, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """TCP positions (M, 3) in m for every ``stride``-th sample, with the sample indices;
     each sample uses the TCP that was active for its move."""
-    from ..motion.trace import tcp_groups
-
     index = np.arange(0, len(trace.times), stride)
     positions = np.empty((len(index), 3))
-    group_of_move, tcps = tcp_groups(trace.segments)
-    # samples at rest before the first move (-1) use the first move's TCP
-    group = np.append(group_of_move, group_of_move[:1])[trace.segment[index]]
+    group, tcps = _tcp_group_of_samples(trace, index)
     for number in np.unique(group):
         rows = group == number
         positions[rows] = robot.fk_many(trace.q[index[rows]], tcp=tcps[number])[:, :3, 3]
     return positions, index
 
 
+def _tcp_group_of_samples(trace: Trace, index: np.ndarray) -> tuple[np.ndarray, list]:
+    """For the samples ``index``, the number of the TCP active in their move, and the TCPs."""
+    from ..motion.trace import tcp_groups
+
+    group_of_move, tcps = tcp_groups(trace.segments)
+    # samples at rest before the first move (-1) use the first move's TCP
+    return np.append(group_of_move, group_of_move[:1])[trace.segment[index]], tcps
+
+
 def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
     """URS306: the TCP moves faster than the user's limit (m/s), e.g. 0.25 m/s in a
-    collaborative cell."""
-    positions, _ = _tcp_positions(trace, robot)
-    speed = np.linalg.norm(np.gradient(positions, trace.dt, axis=0), axis=1) \
-        if len(positions) > 1 else np.zeros(len(positions))
+    collaborative cell. Where the program changed its TCP (``set_tcp``) between two samples,
+    the TCP point jumps without the arm moving: each side is differentiated on its own."""
+    positions, index = _tcp_positions(trace, robot)
+    if len(positions) < 2:
+        speed = np.zeros(len(positions))
+    else:
+        velocity = np.gradient(positions, trace.dt, axis=0)
+        group, _tcps = _tcp_group_of_samples(trace, index)
+        for last in np.flatnonzero(group[1:] != group[:-1]):  # the TCP changes after it
+            first = last + 1
+            before = last >= 1 and group[last - 1] == group[last]
+            velocity[last] = (positions[last] - positions[last - 1]) / trace.dt if before \
+                else 0.0
+            after = first + 1 < len(positions) and group[first + 1] == group[first]
+            velocity[first] = (positions[first + 1] - positions[first]) / trace.dt if after \
+                else 0.0
+        speed = np.linalg.norm(velocity, axis=1)
     findings = []
     for segment, sample in _per_segment(trace, speed > limit * (1 + 1e-6)):
         peak = float(np.max(speed[trace.segment == segment]))
