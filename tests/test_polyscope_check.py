@@ -225,13 +225,36 @@ def test_installation_joint_limits_reach_the_check(cell, capsys):
                for f in report["findings"])
 
 
-def test_installation_safety_planes_are_cell_planes(cell, capsys):
+def test_installation_safety_planes_reach_the_check(cell, capsys):
     _with_safety(cell, _safety(plane="[0.0, 0.0, -1.0]"))  # stay below z = 0.3 m
     main(["check", str(cell), "--json"])
     report = json.loads(capsys.readouterr().out)
-    assert "1 safety plane(s) as cell planes (Ceiling)" in report["context"]  # not the trigger
-    assert any(f["code"] == "URS308" and "Ceiling" in f["message"]
+    # not the trigger plane, which restricts nothing
+    assert "1 safety plane(s) for the TCP and elbow (Ceiling)" in report["context"]
+    assert any(f["code"] == "URS308" and "safety plane Ceiling" in f["message"]
                for f in report["findings"])
+
+
+@pytest.mark.parametrize(("height", "elbow", "found"), [
+    (0.5, False, None),        # only the forearm reaches over it: allowed
+    (0.5, True, "elbow"),      # the plane restricts the elbow too (at 0.565 m)
+    (0.4, False, "TCP"),       # the TCP (the flange, 0.465 m) is beyond
+])
+def test_a_safety_plane_restricts_the_tcp_and_elbow_not_the_links(height, elbow, found):
+    # UR's safety system watches the TCP (and tool) and, where a plane says so, the elbow:
+    # a forearm over a plane is no violation (an arm taught there was reported colliding)
+    from urdsl.polyscope.installation import SafetyPlane
+    from urdsl.verify.run import CheckOptions, check_text
+
+    plane = SafetyPlane("Head", (0.0, 0.0, -1.0), height, "BOTH", elbow)
+    report = check_text("movej([0, -1.9, 1.9, -1.57, -1.57, 0])\n"
+                        "movej([0.2, -1.9, 1.9, -1.57, -1.57, 0])\n", "p.script",
+                        options=CheckOptions(safety_planes=(plane,)))
+    hits = [f.message for f in report.findings if f.code == "URS308"]
+    if found is None:
+        assert hits == []
+    else:
+        assert hits and all(f"the {found} passes the safety plane Head" in hit for hit in hits)
 
 
 def test_the_demo_program_is_checked_by_node(capsys):

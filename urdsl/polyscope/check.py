@@ -415,8 +415,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         notes.append(f"on this very arm: the {calibration.model} calibration of the program's "
                      "<kinematics>")
     if generated.installation is not None and generated.installation.safety is not None:
-        notes.extend(installation_defaults(file_options, generated.installation,
-                                           cell_given=bool(cell_path)))
+        notes.extend(installation_defaults(file_options, generated.installation))
     file_options.unknown_globals = urcap_values(generated, module)
     if file_options.unknown_globals:
         notes.append("unknown values (URCap nodes' results, names of a missing "
@@ -477,17 +476,16 @@ def tcp_dependent(findings: list, count: int) -> list:
     return out
 
 
-def installation_defaults(options, installation: Installation, cell_given: bool) -> list[str]:
+def installation_defaults(options, installation: Installation) -> list[str]:
     """Set the installation's normal-mode safety limits on ``options`` (a
     :class:`~urdsl.verify.run.CheckOptions` for its robot) where the command line left them
     open: joint position limits (a joint the installation does not limit keeps the model's),
     joint speed limits, the TCP speed limit, and the safety planes that restrict normal mode
-    (``NORMAL``, ``BOTH``) as planes of the cell (unless ``--cell`` was given). Returns what
-    was taken, for the report."""
+    (``NORMAL``, ``BOTH``), which the TCP (and the elbow where a plane restricts it) must not
+    pass (URS308). Returns what was taken, for the report."""
     import numpy as np
 
     from ..kinematics import Robot
-    from ..kinematics.collision import CollisionModel
 
     safety = installation.safety
     if safety is None:
@@ -509,15 +507,12 @@ def installation_defaults(options, installation: Installation, cell_given: bool)
     if options.tcp_speed_limit is None and safety.tcp_speed is not None:
         options.tcp_speed_limit = safety.tcp_speed
         taken.append(f"TCP speed limit {safety.tcp_speed:g} m/s")
-    planes = [p for p in safety.planes if p.mode in ("NORMAL", "BOTH")]
-    if planes and not cell_given:
-        cell = options.cell if isinstance(options.cell, CollisionModel) else \
-            CollisionModel(robot)
-        for plane in planes:
-            cell.add_plane(plane.normal, -plane.distance, plane.name)
-        options.cell = cell
-        taken.append(f"{len(planes)} safety plane(s) as cell planes ("
-                     + ", ".join(p.name for p in planes) + ")")
+    planes = tuple(p for p in safety.planes if p.mode in ("NORMAL", "BOTH"))
+    if planes and not options.safety_planes:
+        options.safety_planes = planes
+        taken.append(f"{len(planes)} safety plane(s) for the TCP"
+                     + (" and elbow" if any(p.elbow for p in planes) else "")
+                     + " (" + ", ".join(p.name for p in planes) + ")")
     if not taken:
         return []
     return [f"from {Path(installation.path).name}: " + ", ".join(taken)]

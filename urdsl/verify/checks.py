@@ -443,6 +443,59 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
     return findings
 
 
+SAFETY_PLANE_TOLERANCE = 0.001
+"""How far (m) the TCP or elbow may be beyond a safety plane before URS308 reports it: a
+waypoint taught on the plane's boundary is where the arm was."""
+
+
+def safety_planes(trace: Trace, robot, planes, step: float = 0.02) -> list[Finding]:
+    """URS308: the TCP, and the elbow where a plane restricts it, passes beyond a safety plane
+    of the installation (``normal·x + distance < 0``), checked every ``step`` s of robot time
+    from the first move on. The controller's safety system watches these points of the arm
+    (and the tool's spheres), not its links: a forearm that reaches over a plane is allowed."""
+    if not planes or not trace.segments:
+        return []
+    from ..kinematics import Robot
+
+    stride = max(1, int(round(step / trace.dt)))
+    tcp, index = _tcp_positions(trace, robot, stride)
+    moving = trace.segment[index] >= 0
+    tcp, index = tcp[moving], index[moving]
+    elbow = None
+    if any(plane.elbow for plane in planes):
+        # the elbow joint, on the nominal arm of the model (within a calibration's millimetres;
+        # a factory table's frames on the parallel axes may lie metres along them)
+        nominal = Robot.model(robot.spec.name)
+        elbow = nominal.frames_many(trace.q[index])[:, 2, :3, 3]
+    beyond = np.zeros(len(index), dtype=bool)
+    depth = np.zeros(len(index))
+    what = np.empty(len(index), dtype=object)
+    for plane in planes:
+        normal = np.asarray(plane.normal, dtype=float)
+        normal = normal / np.linalg.norm(normal)
+        points = [("TCP", tcp)] + ([("elbow", elbow)] if plane.elbow and elbow is not None
+                                   else [])
+        for part, where in points:
+            past = -(where @ normal + float(plane.distance))
+            new = (past > SAFETY_PLANE_TOLERANCE) & ~beyond
+            beyond |= new
+            depth[new] = past[new]
+            what[new] = f"the {part} passes the safety plane {plane.name}"
+    hit = np.zeros(len(trace.times), dtype=bool)
+    hit[index[beyond]] = True
+    position = {int(sample): i for i, sample in enumerate(index)}
+    findings = []
+    for segment, sample in _per_segment(trace, hit):
+        i = position[sample]
+        findings.append(Finding.of(
+            "URS308", f"{what[i]} by {depth[i] * 1000:.0f} mm at t={trace.times[sample]:.3f} s "
+            "(the controller stops the arm there)",
+            _span(trace, segment), float(trace.times[sample]),
+            "keep the TCP on the allowed side of the plane, or change the installation's "
+            "safety planes", cause=str(what[i])))
+    return findings
+
+
 # ---- the registered checks, in code order ----------------------------------------------------
 
 _READY = "movej([0, -1.9, 1.9, -1.57, -1.57, 0])  # tool down, in front of the robot"
@@ -582,7 +635,8 @@ cell.toml) and against each other. The finding names the colliding pair and the 
 def _collisions(ctx: TraceContext) -> list[Finding]:
     options = ctx.options
     return collisions(ctx.trace, ctx.robot, options.cell, options.collision_step,
-                      options.self_collision, ctx.deadline, ctx.partial)
+                      options.self_collision, ctx.deadline, ctx.partial) + \
+        safety_planes(ctx.trace, ctx.robot, options.safety_planes, options.collision_step)
 
 
 @trace_check(

@@ -123,6 +123,10 @@ class CheckOptions:
     joint_speed_limit: tuple[float, ...] | None = None
     """Joint speed limits [rad/s] set for the cell (a PolyScope installation's), below the
     model's."""
+    safety_planes: tuple = ()
+    """Safety planes (a PolyScope installation's, :class:`urdsl.polyscope.installation.
+    SafetyPlane`: ``name``, ``normal``, ``distance``, ``elbow``) the TCP, and the elbow where
+    the plane restricts it, must stay on the allowed side of (``normal·x + distance ≥ 0``)."""
     start_unknown: bool = False
     """Whether the program starts wherever the arm was left (no start pose given with
     ``start_joints`` or inferred from the program): then ``start_joints`` is only where the
