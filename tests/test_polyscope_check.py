@@ -437,6 +437,22 @@ def test_without_its_installation_the_tcp_the_waypoints_were_taught_with(tmp_pat
     assert reach["severity"] == "warning" and "2 different TCPs" in reach["message"]
 
 
+def test_the_variables_of_a_missing_installation_are_read_beside_it(tmp_path, capsys):
+    # a repository that commits default.variables but not default.installation: the program's
+    # variable waypoint is an installation variable, defined (seen: a 5.7 course exercise)
+    program = tmp_path / "course.urp"
+    program.write_text(_program(
+        '<Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true">'
+        '<children><Waypoint type="Variable" name="safe_pose" kinematicsFlags="-1">'
+        '<motionParameters/><variable name="safe_pose"/></Waypoint></children></Move>'))
+    (tmp_path / "default.variables").write_text(
+        "#\n#Sun Apr 05 17:41:00 CEST 2020\nsafe_pose=[0, -0.78, -1.57, -2.15, 1.57, 0]\n")
+    assert main(["lint", str(program)]) == 0
+    assert "URS101" not in capsys.readouterr().out
+    assert main(["compile", str(program)]) == 0
+    assert "global safe_pose = [0, -0.78, -1.57, -2.15, 1.57, 0]" in capsys.readouterr().out
+
+
 def test_safe_home_without_the_installation_moves_to_an_unknown_position(tmp_path, capsys):
     # the program is valid with its installation; the repository lacks the installation:
     # lint and check read the rest of it, the home position is a value they do not know

@@ -133,14 +133,17 @@ def load_all(path: str | Path, warn: Callable[[str], None] = _warn
     """:func:`load`, also giving the installation read (None when there is none)."""
     program = read_urp(path)
     installation = _installation_for(program, path, warn)
+    folder = Path(path).parent
     variables: list[tuple[str, str]] = []
-    if installation is not None:
-        file = Path(installation.path).with_suffix(".variables")
+    # the installation's variables live in a file of its name beside it, kept also where the
+    # installation itself is missing (a repository that commits default.variables alone)
+    file = Path(installation.path).with_suffix(".variables") if installation is not None \
+        else folder / f"{program.installation}.variables" if program.installation else None
+    if file is not None:
         try:
             variables = parse_variables(file.read_bytes())
         except OSError:
             variables = []
-    folder = Path(path).parent
 
     def files(relative: str) -> bytes | None:
         file = folder / relative

@@ -175,7 +175,7 @@ def preamble_blocks(program: Program, installation: Installation | None,
         if movable.get(kind):
             blocks.append((kind, movable[kind]))
     values: list[Item] = []
-    for name, value in variables if installation is not None else ():
+    for name, value in variables:  # also beside a missing installation (its .variables)
         try:
             values.append(Declare("global", name, _value(value)))
         except ValueError:  # not a value URScript reads: PolyScope would not run it
