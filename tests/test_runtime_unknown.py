@@ -512,3 +512,24 @@ def test_a_thread_polling_a_device_does_not_pace_the_main_loop():
     report = check_text(text, "tray.script", options=CheckOptions(robot="ur5e", max_time=200))
     (reach,) = [f for f in report.findings if f.code == "URS301"]
     assert reach.severity == "error"
+
+
+def test_what_a_builtin_urdsl_does_not_simulate_returns_is_unknown_not_zeros():
+    # offline, a builtin urdsl does not model returns a value it does not know (zeros were
+    # taken for a pose the program then moved to); with devices that answer, the neutral one
+    result = run("w = tool_pose()\nx = w[2]\n")
+    assert result.error is None, result.error
+    assert isinstance(result.globals["w"], Unknown) and isinstance(result.globals["x"], Unknown)
+    assert not isinstance(run("w = tool_pose()\n", devices="quiet").globals["w"], Unknown)
+
+
+def test_get_joint_positions_reads_the_arms_joints():
+    # a PolyScope Script node turns wrist 3 to its limit: q = get_joint_positions() (External
+    # Control's name for the joints) then q[5] = d2r(-350): with zeros for the joints, the
+    # arm was sent straight out
+    from urdsl.verify.run import check_text
+
+    report = check_text("movej([0.3, -1.5, 1.5, -1.5, -1.5, 0])\nq = get_joint_positions()\n"
+                        "q[5] = d2r(-350)\ntextmsg(q)\nmovej(q)\n", "wrist.script")
+    (shown,) = [e.message for e in report.events if e.kind == "textmsg"]
+    assert shown.startswith("[0.3, -1.5, 1.5, -1.5, -1.5, -6.1")

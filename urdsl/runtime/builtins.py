@@ -146,6 +146,10 @@ class BuiltinTable:
         kind = row.returns[0] if row.returns else "None"
         if kind == "Object":  # a handle (an EtherNet/IP writer): its methods are device calls
             return _RemoteHandle(row.name, "")
+        if rt.unknown and kind != "None":
+            # checking offline: what the controller would return is not known here, and a
+            # neutral value (zeros) would be taken for the arm's state or a device's reply
+            return unknown_from(row.name, node)
         if kind == "Array":  # nearly all of them return a 6-vector (joints, wrench, speeds)
             return ListValue([0.0] * _ARRAY_LENGTHS.get(row.name, 6))
         if kind == "Pose":

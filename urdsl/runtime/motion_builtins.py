@@ -257,8 +257,10 @@ def _end_freedrive(rt, node):
     """The arm is held again where the operator left it (still unknown offline)."""
 
 
-@implements("get_actual_joint_positions", "get_target_joint_positions")
+@implements("get_actual_joint_positions", "get_target_joint_positions", "get_joint_positions")
 def _joints(rt, node):
+    """The arm's joints (rad); ``get_joint_positions`` is the undocumented name UR's External
+    Control script reads them by [X]."""
     arm = _arm(rt, node)
     return _stopped_by_condition(rt, arm) or _vector(arm.joints_at(rt.time))
 
