@@ -3,6 +3,8 @@ hang of issue 14 as a regression test; device replies are unknown, not none."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from urdsl.cli import main
@@ -224,3 +226,21 @@ def test_a_tcp_change_between_moves_is_no_tcp_speed():
     fast = text.replace("v=0.1", "v=3.0")  # a real overspeed is still one
     report = check(fast, tcp_speed_limit=0.1)
     assert [f.code for f in report.findings if f.code == "URS306"] == ["URS306"]
+
+
+def test_a_joint_limit_at_an_assumed_start_is_not_the_programs():
+    # an installation limits the shoulder to -82°; the program starts wherever the arm was
+    # left, which the check draws at its default pose (shoulder -90°): neither that pose nor
+    # the first move's start is the program's, its target is
+    low = (-6.28, math.radians(-82), -3.14, -6.28, -6.28, -6.28)
+    high = (6.28, 0.0, 3.14, 6.28, 6.28, 6.28)
+    text = "sleep(1)\nmovej([0.2, -1.2, 1.5, -1.8, -1.57, 0])\n"
+    report = check(text, q_min=low, q_max=high, start_unknown=True)
+    assert not [f for f in report.findings if f.code == "URS303"], report.findings
+    assert not [f for f in check(text.replace("-1.2", "-1.5"), q_min=low, q_max=high,
+                                 start_unknown=True).findings
+                if f.code == "URS303" and f.severity == "error"] == []  # a target beyond
+    # given, the start is the user's: named at the first move, not at '<generated>:0:0'
+    (found,) = [f for f in check(text, q_min=low, q_max=high).findings if f.code == "URS303"]
+    assert found.span.line == 2 and "where the arm starts, before this first move" in \
+        found.message

@@ -120,19 +120,26 @@ def _span(trace: Trace, segment: int):
     return trace.segments[segment].span if segment >= 0 else NO_SPAN
 
 
-def joint_limits(trace: Trace, lower: np.ndarray, upper: np.ndarray) -> list[Finding]:
-    """URS303: joint positions outside [lower, upper] (rad)."""
+def joint_limits(trace: Trace, lower: np.ndarray, upper: np.ndarray,
+                 exclude: np.ndarray | None = None) -> list[Finding]:
+    """URS303: joint positions outside [lower, upper] (rad); samples in ``exclude`` are left
+    out."""
     low, high = lower - 1e-9, upper + 1e-9
     outside = _rows_where(trace.q, lambda q: (q < low) | (q > high))
+    if exclude is not None:
+        outside &= ~exclude
     findings = []
     for segment, sample in _per_segment(trace, outside):
         joint = int(np.argmax((trace.q[sample] < low) | (trace.q[sample] > high)))
         value = trace.q[sample, joint]
         bound = upper[joint] if value > upper[joint] else lower[joint]
+        where = f"at t={trace.times[sample]:.3f} s"
+        if segment < 0 and trace.segments:  # at rest before the first move: its start
+            segment, where = 0, "where the arm starts, before this first move"
         findings.append(Finding.of(
             "URS303",
             f"{JOINTS[joint]} joint reaches {np.degrees(value):.1f}° "
-            f"(limit {np.degrees(bound):.1f}°) at t={trace.times[sample]:.3f} s",
+            f"(limit {np.degrees(bound):.1f}°) {where}",
             _span(trace, segment), float(trace.times[sample]),
             "choose a target closer to the current joints, or another IK solution",
             cause=f"{JOINTS[joint]} {'upper' if value > upper[joint] else 'lower'}"))
@@ -538,7 +545,28 @@ def _joint_limits(ctx: TraceContext) -> list[Finding]:
     options, robot = ctx.options, ctx.robot
     q_min = np.asarray(options.q_min if options.q_min is not None else robot.q_min)
     q_max = np.asarray(options.q_max if options.q_max is not None else robot.q_max)
-    return joint_limits(ctx.trace, q_min, q_max)
+    return joint_limits(ctx.trace, q_min, q_max, _unknown_starts(ctx))
+
+
+def _unknown_starts(ctx: TraceContext) -> np.ndarray | None:
+    """The samples where the simulated arm stands in for a position unknown offline: at rest
+    before the first move when the program starts wherever the arm was left, and every
+    sample but the last of a move from such a position (a movej interpolates the joints, so
+    only its ends can pass a limit, and its start is the unknown one)."""
+    trace = ctx.trace
+    segment = trace.segment
+    unknown = [index for index, move in enumerate(trace.segments)
+               if move.params.get("from_unknown")]
+    if not unknown and not ctx.options.start_unknown:
+        return None
+    mask = np.isin(segment, unknown)
+    ends = np.flatnonzero(mask[:-1] & (segment[1:] != segment[:-1]))
+    mask[ends] = False
+    if len(mask) and mask[-1]:
+        mask[-1] = False
+    if ctx.options.start_unknown:
+        mask |= segment < 0
+    return mask
 
 
 @trace_check(
