@@ -471,6 +471,14 @@ def test_a_direction_move_is_still_checked_up_to_where_it_could_stop(tmp_path):
     report = check(DIRECTION, cell=str(cell))
     (finding,) = only(report, "URS308")  # the floor is on its way down
     assert finding.span.line == 15 and "URS301" not in report.codes()
+    # a warning: a move until tool contact is made to stop at what it touches first
+    assert finding.severity == "warning" and "on a move its condition stops" in \
+        finding.message
+    plain = DIRECTION.replace("movel(towardsPos, a=1.2, v=0.1)",
+                              "movel(pose_add(get_target_tcp_pose(), p[0, 0, -0.8, 0, 0, 0]), "
+                              "a=1.2, v=0.1)").replace("kill move_thread_han_3", "sync()")
+    (floor,) = only(check(plain, cell=str(cell)), "URS308")  # no condition stops it
+    assert floor.severity == "error"
 
 
 def test_the_same_far_target_without_a_condition_is_unreachable():

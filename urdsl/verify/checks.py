@@ -450,8 +450,9 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
     return findings
 
 
-SAFETY_PLANE_TOLERANCE = 0.001
-"""How far (m) the TCP or elbow may be beyond a safety plane before URS308 reports it: a
+SAFETY_PLANE_TOLERANCE = 0.005
+"""How far (m) the TCP or elbow may be beyond a safety plane before URS308 reports it (as two
+link shapes may overlap, :data:`SELF_OVERLAP_TOLERANCE`): a
 waypoint taught on the plane's boundary is where the arm was."""
 
 

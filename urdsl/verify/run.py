@@ -445,6 +445,26 @@ def _from_unknown_start(findings: list[Finding], planner) -> list[Finding]:
     return kept
 
 
+def _before_its_condition(findings: list[Finding], planner) -> list[Finding]:
+    """What a move that a condition stops (a Direction node's Until, see
+    :mod:`urdsl.motion.direction`) hits on its way (URS308: an obstacle, a safety plane) is a
+    warning: such moves are made to go until they touch something (tool contact on a table)
+    or a signal says so, which offline is not known to come first."""
+    if not planner.stoppable:
+        return findings
+    moves = [s for s in planner.segments if s.span in planner.stoppable]
+    out = []
+    for finding in findings:
+        moment = finding.time
+        if finding.code == "URS308" and finding.severity == "error" and moment is not None \
+                and any(s.start - 1e-9 <= moment <= s.end + 1e-9 for s in moves):
+            finding = replace(finding, severity="warning", message=(
+                f"{finding.message}, on a move its condition stops (Until): unless the "
+                "condition holds first"))
+        out.append(finding)
+    return out
+
+
 def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: float | None,
                     span) -> list[Finding]:
     """The trace checks, in order; once ``deadline`` (``time.monotonic()``) has passed the
@@ -471,6 +491,7 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
             break
         findings += check.run(ctx)
     findings = _from_unknown_start(findings, planner)
+    findings = _before_its_condition(findings, planner)
     for label, reached in ctx.partial.items():
         findings.append(Finding.of(
             "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s; "
