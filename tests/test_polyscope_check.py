@@ -453,6 +453,27 @@ def test_the_variables_of_a_missing_installation_are_read_beside_it(tmp_path, ca
     assert "global safe_pose = [0, -0.78, -1.57, -2.15, 1.57, 0]" in capsys.readouterr().out
 
 
+def test_an_io_another_installation_does_not_name_is_unknown_not_an_error(tmp_path, capsys):
+    # the program names längs_multi.installation, which is not there; the folder's
+    # default.installation is compiled with in its place, and cannot say what the program's
+    # own names for its I/O are
+    program = tmp_path / "stack.urp"
+    program.write_text(_program(
+        '<Set type="DigitalOutput"><pin referencedName="licht_start"/>'
+        '<digitalValue>1</digitalValue></Set>').replace('installation="default"',
+                                                         'installation="längs_multi"'))
+    shutil.copy(DATA / "cell.installation", tmp_path / "default.installation")
+    assert main(["lint", str(program)]) == 0
+    captured = capsys.readouterr()
+    assert "URS001" not in captured.out
+    assert "the installation it names, längs_multi.installation, is not there; compiled " \
+           "with default.installation beside it instead" in captured.err
+    # named, the same installation's silence about the name is the program's mistake
+    program.write_text(program.read_text().replace('"längs_multi"', '"default"'))
+    assert main(["lint", str(program)]) == 1
+    assert "'licht_start' is not named in the installation" in capsys.readouterr().out
+
+
 def test_safe_home_without_the_installation_moves_to_an_unknown_position(tmp_path, capsys):
     # the program is valid with its installation; the repository lacks the installation:
     # lint and check read the rest of it, the home position is a value they do not know

@@ -197,13 +197,13 @@ def missing_features(generated: Generated) -> dict[str, str]:
     """Installation variables and features the program refers to while its installation is
     not there (the preamble and ``.variables`` that define them are not read): each with
     where its value would come from."""
-    if generated.installation is not None:
-        return {}
     program = generated.program
     named = f"{program.installation}.installation" if program.installation else "(none named)"
-    out = {name: f"a {'feature' if name in program.feature_variables else 'name'} of the "
-                 f"installation {named} (not beside the program)"
-           for name in sorted(program.installation_names)}  # feature variables too
+    out = {} if generated.installation is not None else {
+        name: f"a {'feature' if name in program.feature_variables else 'name'} of the "
+              f"installation {named} (not beside the program)"
+        for name in sorted(program.installation_names)}  # feature variables too
+    # also with another installation found beside the program in its place
     for name, what in generated.compiled.unknown.items():
         out.setdefault(name, f"{what} of the installation {named} (not beside the program)")
     return out

@@ -107,6 +107,11 @@ def _installation_for(program: Program, path: str | Path,
             break
     if candidate is None:
         candidate = find_installation(path)
+        if candidate is not None and program.installation and \
+                candidate.stem not in (program.installation, Path(path).stem):
+            warn(f"{path}: the installation it names, {program.installation}.installation, is "
+                 f"not there; compiled with {candidate.name} beside it instead (an I/O name "
+                 "only the named one gives is read as an unknown value)")
     if candidate is None:
         if program.installation:
             warn(f"{path}: the installation it names, "

@@ -983,13 +983,27 @@ class _Compiler:
                 return name
         return pin
 
+    def installation_named(self) -> bool:
+        """Whether the installation compiled with is the one the program names (by its name
+        or path, or renamed with the program), not another one found beside it: an I/O
+        name only the named one may give is then a mistake of the program."""
+        if self.installation is None:
+            return False
+        stem = posixpath.basename(str(self.installation.path).replace("\\", "/"))
+        stem = stem[:-len(".installation")] if stem.endswith(".installation") else stem
+        program = self.program
+        named = {program.installation,
+                 posixpath.basename(program.installation_path or ""),
+                 posixpath.splitext(posixpath.basename(program.path.replace("\\", "/")))[0]}
+        return stem in named
+
     def io_of_missing_installation(self, pin: str) -> bool:
         """Whether ``pin`` is a name only the installation could resolve, and it is not
         there: a user's name for a pin (``gripperopen``) or a Modbus signal. PolyScope writes
         the pin's or signal's own function, which nothing here says; urdsl reads the name
         as a value of its own (unknown to the check) and writes nothing for a Set of it."""
-        if self.installation is not None or pin in self.pins or _PIN.match(pin) \
-                or not pin.isidentifier():
+        if (self.installation is not None and self.installation_named()) or \
+                pin in self.pins or _PIN.match(pin) or not pin.isidentifier():
             return False
         self.unknown[pin] = "an I/O"
         return True
