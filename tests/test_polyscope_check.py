@@ -474,6 +474,19 @@ def test_an_io_another_installation_does_not_name_is_unknown_not_an_error(tmp_pa
     assert "'licht_start' is not named in the installation" in capsys.readouterr().out
 
 
+def test_a_loop_holding_a_urcap_node_is_not_a_busy_loop(tmp_path, capsys):
+    # a Robot Program that loops forever over one gripper node: the URCap's code (which
+    # urdsl cannot see) waits for the gripper; a loop of nothing stays URS118
+    program = tmp_path / "grip.urp"
+    program.write_text(_program(URCAP).replace('runOnlyOnce="true"', 'runOnlyOnce="false"'))
+    main(["lint", str(program)])
+    assert "URS118" not in capsys.readouterr().out
+    program.write_text(_program('<Comment comment="nothing"/>').replace(
+        'runOnlyOnce="true"', 'runOnlyOnce="false"'))
+    main(["lint", str(program)])
+    assert "URS118" in capsys.readouterr().out
+
+
 def test_safe_home_without_the_installation_moves_to_an_unknown_position(tmp_path, capsys):
     # the program is valid with its installation; the repository lacks the installation:
     # lint and check read the rest of it, the home position is a value they do not know

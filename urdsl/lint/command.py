@@ -247,6 +247,7 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         node_findings,
         soften_urcap_names,
         urcap_diagnostics,
+        without_urcap_busy_loops,
     )
     from ..polyscope.compile import CompileError
     from ..polyscope.urp import UnsupportedProgram, UrpError
@@ -271,8 +272,8 @@ def _lint_urp(name: str, select, ignore, args: argparse.Namespace) -> list:
         text = str(error)
         message = text.split(": error: ", 1)[1] if ": error: " in text else text
         return [Diagnostic(name, 1, 1, "error", "URS001", message)]
-    found = node_findings(generated, soften_urcap_names(
-        generated, lint_text(generated.text, generated.filename, settings)))
+    found = node_findings(generated, without_urcap_busy_loops(generated, soften_urcap_names(
+        generated, lint_text(generated.text, generated.filename, settings))))
     wanted = not select or any("URS214".startswith(code) for code in select)
     if wanted and not any("URS214".startswith(code) for code in ignore):
         found.extend(urcap_diagnostics(generated))

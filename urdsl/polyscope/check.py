@@ -161,6 +161,28 @@ def urcap_sources(generated: Generated) -> list[str]:
 _UNDEFINED_NAME = re.compile(r"name '(\w+)' is not defined")
 
 
+def without_urcap_busy_loops(generated: Generated, found: list) -> list:
+    """Lint findings of a compiled program without URS118 ("never gives up its time slice")
+    on a loop that holds a URCap node: only the URCap generates its code, which may well
+    take time (a gripper's command waits for the gripper)."""
+    urcaps = {number for number, _node in generated.urcap_nodes()}
+    busy = [finding for finding in found if finding.code == "URS118"]
+    if not urcaps or not busy:
+        return found
+    from ..script import parse
+    from ..script.diagnostics import ScriptError
+
+    try:
+        module = parse(generated.text, generated.filename)
+    except (ScriptError, RecursionError):
+        return found
+    holding = {node.span.line for node in n.walk(module) if isinstance(node, n.While)
+               and any(isinstance(inner, n.Marker) and inner.number in urcaps
+                       for inner in n.walk(node))}
+    return [finding for finding in found
+            if finding.code != "URS118" or finding.line not in holding]
+
+
 def soften_urcap_names(generated: Generated, found: list) -> list:
     """Lint findings of a compiled program that code urdsl cannot generate or read would
     complete: a name or function defined nowhere in what urdsl generated (URS101, URS102)
