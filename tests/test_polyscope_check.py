@@ -513,6 +513,26 @@ def test_safe_home_without_the_installation_moves_to_an_unknown_position(tmp_pat
            "default.installation" in capsys.readouterr().err
 
 
+def test_waypoints_taught_with_another_tcp_than_the_installations_are_noted(tmp_path, capsys):
+    # the installation was edited after the waypoints were taught (its TCP is 0.1 m, they
+    # were taught with 0.19 m): PolyScope takes the active TCP to the taught poses, so the
+    # arm stands elsewhere than taught, which the report says
+    program = tmp_path / "edited.urp"
+    move = ('<Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true">'
+            '<children>{}</children></Move>')
+    program.write_text(_program(move.format(
+        _taught("Home", "0.3, -1.2, 1.2, -1.5, -1.5, 0.0", "0.0, 0.0, 0.19, 0.0, 0.0, 0.0")),
+        FLANGE_KINEMATICS))
+    shutil.copy(DATA / "cell.installation", tmp_path / "default.installation")
+    main(["check", str(program), "--json"])
+    context = json.loads(capsys.readouterr().out)["context"]
+    assert "the waypoints were taught with TCP p[0, 0, 0.19, 0, 0, 0], the installation's " \
+           "active TCP is p[0, 0, 0.1, 0, 0, 0]" in context
+    program.write_text(program.read_text().replace("0.0, 0.0, 0.19,", "0.0, 0.0, 0.1,"))
+    main(["check", str(program), "--json"])
+    assert "were taught with TCP" not in json.loads(capsys.readouterr().out)["context"]
+
+
 def test_what_a_urcaps_function_gives_is_unknown_not_none(tmp_path, capsys):
     # with a URCap in the program, a function only its code defines stands in as a device:
     # what it returns (a pose the program then indexes) is unknown, not none

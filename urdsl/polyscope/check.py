@@ -428,6 +428,16 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     file_options = apply(options, inference, tcp_given=tcp is not None)
     if taught is not None:
         file_options = dataclasses.replace(file_options, tcp=np.array(taught))
+    elif tcp is None and generated.installation is not None and inference.tcp is not None:
+        tcps = taught_tcps(generated.program)
+        active = np.asarray(inference.tcp, dtype=float)
+        if len(tcps) == 1 and (np.linalg.norm(np.subtract(tcps[0][:3], active[:3])) > 1e-3
+                               or np.linalg.norm(np.subtract(tcps[0][3:], active[3:])) > 1e-2):
+            # an installation edited after the waypoints were taught (or another one)
+            notes.append("the waypoints were taught with TCP p[" + ", ".join(
+                f"{v:.6g}" for v in tcps[0]) + "], the installation's active TCP is p["
+                + ", ".join(f"{v:.6g}" for v in active) + "]: the active TCP goes to the taught "
+                "poses, so the arm's joints are not those taught")
     if cell_path and file_options.robot != options.robot:
         from .._cli import load_cell
 
