@@ -309,3 +309,23 @@ def test_a_builtin_model_that_fails_on_its_arguments_is_an_error_at_the_call(cal
     (error,) = [f for f in report.findings if f.severity == "error"]
     assert error.code == "URS203" and (error.span.line, error.span.column) == (2, 5)
     assert "cannot take these arguments" in error.message
+
+
+def test_get_inverse_kin_of_a_taught_waypoint_is_its_joints_near_a_singularity():
+    # a waypoint PolyScope wrote with wrist 2 at -0.07° on an arm 2.8 mm off the nominal
+    # UR5e: the model's nearest solution turned wrist 1 by a radian, and the next movel
+    # away from the singularity turned it back at 4.5 rad/s; on the arm itself the answer
+    # is the taught joints
+    from urdsl.verify.run import check_text
+
+    pose = "p[.250543879133, .376142644240, .393738464893, .028656114718, 1.563205411513, " \
+           "-.035762589999]"
+    joints = "[1.5293444395065308, -1.5700282705114041, -1.8200201988220215, " \
+             "-2.831017633477682, -0.0012190977679651382, -1.6372764746295374]"
+    text = (f"movej({joints})\nq = get_inverse_kin({pose}, qnear={joints})\ntextmsg(q)\n"
+            f"r = get_inverse_kin(pose_add({pose}, p[0, 0, 0.02, 0, 0, 0]), qnear={joints})\n"
+            "textmsg(r)\n")
+    shown = [e.message for e in check_text(text, "taught.script").events
+             if e.kind == "textmsg"]
+    assert shown[0].startswith("[1.529344, -1.570028, -1.82002, -2.831018, -0.001219")
+    assert not shown[1].startswith("[1.529344, -1.570028")  # 2 cm away: the model's own

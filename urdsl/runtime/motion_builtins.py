@@ -303,14 +303,39 @@ def _forward_kin(rt, node, q="current_joint_positions", tcp="active_tcp"):
     return _to_pose(arm.kinematics.fk(joints, tcp=offset))
 
 
+TAUGHT_POSITION = 0.005
+"""How far (m) the model puts a given ``qnear`` from the pose asked, within which
+``get_inverse_kin`` takes ``qnear`` as the arm's own solution (see :func:`_inverse`)."""
+TAUGHT_ORIENTATION = 0.01
+"""The same bound on the orientation (rad)."""
+TAUGHT_JUMP = 0.05
+"""How far (rad) the model's solution must lie from ``qnear`` for that to matter."""
+
+
 def _inverse(rt, node, x, qnear, maxPositionError, maxOrientationError, tcp):  # noqa: N803
+    """The controller's solution for pose ``x`` nearest ``qnear`` (rad). PolyScope writes a
+    waypoint as ``get_inverse_kin(Waypoint_p, qnear=Waypoint_q)``: the pose and the joints
+    the arm had there, so on the arm itself the answer is ``qnear``. On a model a few
+    millimetres off that arm, near a singularity (wrist 2 at 0°) the model's nearest solution
+    can split wrist 1 and 3 a radian apart from the taught ones; when the model puts
+    ``qnear`` within :data:`TAUGHT_POSITION`/:data:`TAUGHT_ORIENTATION` of the pose and its
+    own solution more than :data:`TAUGHT_JUMP` from it, ``qnear`` is the answer."""
     arm = _arm(rt, node)
     target = posemath.to_matrix(_pose(rt, node, x, "x"))
     near = arm.joints_at(rt.time) if qnear is None else _numbers(rt, node, qnear, 6, "qnear")
     offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
     _number(rt, node, maxPositionError, "maxPositionError")
     _number(rt, node, maxOrientationError, "maxOrientationError")
-    return arm.kinematics.ik(target, near, tcp=offset)
+    solution = arm.kinematics.ik(target, near, tcp=offset)
+    if qnear is not None and np.max(np.abs(solution - near)) > TAUGHT_JUMP:
+        there = arm.kinematics.fk(near, tcp=offset)
+        turn = there[:3, :3].T @ target[:3, :3]
+        angle = float(np.arccos(np.clip((np.trace(turn) - 1) / 2, -1.0, 1.0)))
+        if np.linalg.norm(there[:3, 3] - target[:3, 3]) <= TAUGHT_POSITION and \
+                angle <= TAUGHT_ORIENTATION and bool(np.all(near >= arm.kinematics.q_min)) \
+                and bool(np.all(near <= arm.kinematics.q_max)):
+            return np.asarray(near, dtype=float)
+    return solution
 
 
 @implements("get_inverse_kin")
