@@ -286,6 +286,25 @@ def test_operator_assignment_and_an_undefined_expression():
                                        "no expression")
 
 
+def test_safe_home_with_a_stand_in_installation_is_unknown():
+    # the program names cell.installation; another one found beside it stands in and has no
+    # safe home: the position is the missing one's (unknown), not an error of the program
+    from urdsl.polyscope.compile import SAFE_HOME
+    from urdsl.polyscope.installation import parse_installation
+    from urdsl.polyscope.urp import parse_urp
+
+    program = parse_urp(
+        b'<URProgram name="p" lastSavedIn="5.11.1" installation="cell"><children>'
+        b'<MainProgram runOnlyOnce="true"><children><Move motionType="MoveJ" speed="1.0" '
+        b'acceleration="1.4"><children><SafeHome positionOptionType="SPEED_AND_ACCELERATION" '
+        b'speed="1.05" acceleration="1.4"/></children></Move></children></MainProgram>'
+        b'</children></URProgram>', "p.urp")
+    stand_in = parse_installation(b"<Installation/>", "default.installation")
+    assert compile_program(program, stand_in).unknown == {SAFE_HOME: "the safe home position"}
+    with pytest.raises(CompileError, match="safe home position is unknown"):
+        compile_program(program, parse_installation(b"<Installation/>", "cell.installation"))
+
+
 def test_safe_home_moves_to_the_installations_position():
     from urdsl.polyscope.installation import parse_installation
     from urdsl.polyscope.urp import parse_urp

@@ -989,6 +989,8 @@ class _Compiler:
         name only the named one may give is then a mistake of the program."""
         if self.installation is None:
             return False
+        if not self.program.installation:  # it names none: the one given is its own
+            return True
         stem = posixpath.basename(str(self.installation.path).replace("\\", "/"))
         stem = stem[:-len(".installation")] if stem.endswith(".installation") else stem
         program = self.program
@@ -1557,7 +1559,7 @@ class _Compiler:
         settings = (self.installation.settings or {}) if self.installation else {}
         position = settings.get("SafeHomeSettings", {}).get("position")
         joints: Expr
-        if not position and self.installation is None:
+        if not position and not self.installation_named():  # missing, or a stand-in
             self.unknown[SAFE_HOME] = "the safe home position"
             joints = Name(SAFE_HOME)
         elif not position:
