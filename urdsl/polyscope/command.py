@@ -8,7 +8,13 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from .compile import Compiled, CompileError, compile_program, parse_variables
+from .compile import (
+    Compiled,
+    CompileError,
+    compile_program,
+    names_installation,
+    parse_variables,
+)
 from .installation import Installation, InstallationError, find_installation, read_installation
 from .urp import Node, Program, UrpError, read_urp
 
@@ -107,8 +113,7 @@ def _installation_for(program: Program, path: str | Path,
             break
     if candidate is None:
         candidate = find_installation(path)
-        if candidate is not None and program.installation and \
-                candidate.stem not in (program.installation, Path(path).stem):
+        if candidate is not None and not names_installation(program, str(candidate)):
             warn(f"{path}: the installation it names, {program.installation}.installation, is "
                  f"not there; compiled with {candidate.name} beside it instead (an I/O name "
                  "only the named one gives is read as an unknown value)")

@@ -83,8 +83,8 @@ from .installation import Installation
 from .preamble import _call, _num, _stmt, _version, payload_statements, preamble
 from .urp import Expression, Kinematics, Node, Program
 
-__all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "parse_variables",
-           "script_file_candidates", "waypoint_pose"]
+__all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "names_installation",
+           "parse_variables", "script_file_candidates", "waypoint_pose"]
 
 FileReader = Callable[[str], "bytes | None"]
 """Reads a file by its path relative to the program's folder (``/``-separated, ``..``
@@ -98,6 +98,18 @@ class CompileError(Exception):
 SAFE_HOME = "urdsl_safe_home"
 """The name a SafeHome node moves to when the installation the program names is not beside
 it: the installation's safe home joint positions (rad), unknown to urdsl."""
+
+
+def names_installation(program: Program, path: str) -> bool:
+    """Whether the installation file at ``path`` is the one ``program`` names: by its name or
+    its relative path, or named like the program (the files renamed together); any one when
+    the program names none."""
+    if not program.installation:
+        return True
+    stem = posixpath.basename(path.replace("\\", "/"))
+    stem = stem[:-len(".installation")] if stem.endswith(".installation") else stem
+    return stem in {program.installation, posixpath.basename(program.installation_path or ""),
+                    posixpath.splitext(posixpath.basename(program.path.replace("\\", "/")))[0]}
 
 
 @dataclass
@@ -984,20 +996,11 @@ class _Compiler:
         return pin
 
     def installation_named(self) -> bool:
-        """Whether the installation compiled with is the one the program names (by its name
-        or path, or renamed with the program), not another one found beside it: an I/O
-        name only the named one may give is then a mistake of the program."""
-        if self.installation is None:
-            return False
-        if not self.program.installation:  # it names none: the one given is its own
-            return True
-        stem = posixpath.basename(str(self.installation.path).replace("\\", "/"))
-        stem = stem[:-len(".installation")] if stem.endswith(".installation") else stem
-        program = self.program
-        named = {program.installation,
-                 posixpath.basename(program.installation_path or ""),
-                 posixpath.splitext(posixpath.basename(program.path.replace("\\", "/")))[0]}
-        return stem in named
+        """Whether the installation compiled with is the one the program names (see
+        :func:`names_installation`), not another one found beside it: an I/O name only the
+        named one may give is then a mistake of the program."""
+        return self.installation is not None and names_installation(
+            self.program, str(self.installation.path))
 
     def io_of_missing_installation(self, pin: str) -> bool:
         """Whether ``pin`` is a name only the installation could resolve, and it is not
