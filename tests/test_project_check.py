@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from urdsl.cli import main
 from urdsl.lint import lint_text
 from urdsl.project.check import in_context, needed_names
@@ -471,3 +473,46 @@ def test_a_fragment_sees_the_features_of_the_installation_beside_it(tmp_path, ca
     fragment.write_text("textmsg(hidden)\n")  # a feature that is not variable: not there
     assert main(["lint", "--format", "json", str(fragment)]) == 1
     assert "'hidden'" in json.loads(capsys.readouterr().out)[0]["message"]
+
+
+def _urp_calling(subprogram: str, suppressed: bool) -> bytes:
+    """A PolyScope 5 program whose Robot Program calls the subprogram saved as
+    ``subprogram``.urp (kept synchronised with that file), the call suppressed or not."""
+    inner = (f'<subprogram name="{subprogram}" keepHidden="true" '
+             f'keepSynchronizedWithDisk="true"><programFile>/programs/cell/{subprogram}.urp'
+             f'</programFile><children><Script type="Line"><expression>'
+             + "".join(f'<ExpressionChar character="{c}"/>' for c in "lift()")
+             + "</expression></Script></children></subprogram>")
+    call = (f'<SuppressedNode><suppressedNode class="CallSubProgram">{inner}</suppressedNode>'
+            "</SuppressedNode>" if suppressed else f"<CallSubProgram>{inner}</CallSubProgram>")
+    return (f'<URProgram name="MAIN" installation="default" directory="/programs/cell" '
+            f'createdIn="5.13.0" lastSavedIn="5.13.0"><children><MainProgram '
+            f'runOnlyOnce="true"><children>{call}</children></MainProgram></children>'
+            f"</URProgram>").encode()
+
+
+SUBPROGRAM = ('def SUB_A():\n  $ 1 "Robot Program"\n  $ 2 "lift()"\n  lift()\n'
+              '  $ 3 "Wait: 0.5"\n  sleep(0.5)\nend\n')
+
+
+@pytest.mark.parametrize("suppressed", [False, True])
+def test_a_subprogram_saved_as_its_own_program_is_checked_in_its_callers_context(
+        tmp_path, capsys, suppressed):
+    # PolyScope saves a subprogram as a program (SUB_A.urp, SUB_A.script) that its caller's
+    # .urp names; its lines may call functions the caller defines. The caller's exported
+    # .script can be older than its .urp and not inline the subprogram at all (seen:
+    # CA-Giken/docker-noetic-capc, ursim/programs.UR10/GD/SUB_104.script, whose call in
+    # MAIN.urp is suppressed and whose MAIN.script predates it)
+    (tmp_path / "MAIN.urp").write_bytes(_urp_calling("SUB_A", suppressed))
+    (tmp_path / "MAIN.script").write_text(
+        'def MAIN():\n  $ 1 "BeforeStart"\n  def lift():\n    textmsg("lift")\n  end\n'
+        '  $ 2 "Robot Program"\n  lift()\nend\n')
+    (tmp_path / "SUB_A.script").write_text(SUBPROGRAM)
+    status, report = check(capsys, str(tmp_path / "SUB_A.script"))
+    assert status == 0, report["findings"]
+    assert "MAIN.script" in report["context"]
+    assert main(["lint", str(tmp_path)]) == 0
+    capsys.readouterr()
+    # a program that names no such subprogram is no caller: the name stays undefined
+    (tmp_path / "MAIN.urp").write_bytes(_urp_calling("SUB_OTHER", suppressed))
+    assert check(capsys, str(tmp_path / "SUB_A.script"))[0] == 1

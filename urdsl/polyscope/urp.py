@@ -188,6 +188,22 @@ class Program:
     refer to (``referencedName``); the installation's preamble and ``.variables`` define
     them."""
 
+    def subprogram_files(self) -> frozenset[str]:
+        """The file names (without folders, lower case) of the subprogram programs this
+        program calls or holds (``<programFile>/programs/GD/SUB_104.urp</programFile>``),
+        suppressed calls included: a subprogram saved as its own program is written to be
+        run from here."""
+        found: set[str] = set()
+        nodes = [*self.subprograms]
+        for top in self.top:
+            nodes.extend(node.fields.get("subprogram") for node in top.walk()  # type: ignore
+                         if node.kind == "CallSubProgram")
+        for node in nodes:
+            file = node.fields.get("file") if isinstance(node, Node) else None
+            if isinstance(file, str) and file:
+                found.add(re.split(r"[\\/]", file)[-1].lower())
+        return frozenset(found)
+
     @property
     def major_version(self) -> int | None:
         version = self.saved_in or self.created_in

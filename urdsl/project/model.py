@@ -18,12 +18,14 @@ at most three levels above) holding:
 
 A host **includes** a fragment when one of its ``$ N "Script: name.script"`` labels names the
 fragment's file, or when the fragment's code lines are found inlined in the host (at least
-80 % of them, or half of them for a subprogram whose ``def`` the host contains).
+80 % of them, or half of them for a subprogram whose ``def`` the host contains), or when the
+host's PolyScope program (its ``.urp``) calls the fragment's ``.urp`` as a subprogram.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import os
 import re
@@ -107,6 +109,11 @@ class ScriptFile:
     assigned_later: dict[str, n.Stmt] = field(default_factory=dict)
     code_lines: frozenset[str] = frozenset()
     code_line_list: tuple[str, ...] = ()
+    subprogram_files: frozenset[str] = frozenset()
+    """File names (lower case, without folders) of the PolyScope subprograms the program
+    calls, from its ``.urp`` (for an exported ``.script``, the ``.urp`` of its name beside
+    it): a subprogram saved as a program of its own is included by its caller, even where
+    the caller's exported ``.script`` is older than its ``.urp``."""
 
     @property
     def is_host(self) -> bool:
@@ -573,7 +580,12 @@ def _cache_key(path: Path, kind: str) -> tuple | None:
         return None
     if stat.st_size > MAX_FILE_BYTES:
         return None
-    return (kind, str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns,
+    program: tuple = ()
+    if kind == "script":  # a PolyScope export is read with its program (subprogram_files)
+        with contextlib.suppress(OSError):
+            beside = path.with_suffix(URP_SUFFIX).stat()
+            program = (beside.st_size, beside.st_mtime_ns)
+    return (kind, str(path.resolve()), str(path), stat.st_size, stat.st_mtime_ns, program,
             os.getcwd() if path.is_absolute() else "")  # the name shown depends on it
 
 
@@ -604,7 +616,18 @@ def _read_script(path: Path) -> ScriptFile | None:
         text = path.read_text(encoding="utf-8", errors="replace")
     except OSError:
         return None
-    return script_file(path, _display(path), text)
+    script = script_file(path, _display(path), text)
+    program = path.with_suffix(URP_SUFFIX)
+    if script.is_host and program.is_file():  # PolyScope's export beside its program
+        from ..polyscope.urp import UrpError, read_urp
+
+        try:
+            files = read_urp(program).subprogram_files()
+        except (UrpError, RecursionError):
+            files = frozenset()
+        if files:
+            script = dataclasses.replace(script, subprogram_files=files)
+    return script
 
 
 def load_urp(path: Path) -> ScriptFile | None:
@@ -622,10 +645,11 @@ def _read_urp(path: Path) -> ScriptFile | None:
 
     try:
         # a missing installation is said by a lint or check of the .urp itself, not here
-        _program, compiled = load(path, warn=lambda _message: None)
+        program, compiled = load(path, warn=lambda _message: None)
     except (UrpError, CompileError, OSError, RecursionError):
         return None  # an unreadable program is not a host here; its own lint says why
-    return script_file(path, _display(path), compiled.text)
+    return dataclasses.replace(script_file(path, _display(path), compiled.text),
+                               subprogram_files=program.subprogram_files())
 
 
 def script_file(path: Path, filename: str, text: str) -> ScriptFile:
@@ -777,6 +801,8 @@ def _includes(host: ScriptFile, fragment: ScriptFile) -> bool:
     name = fragment.path.name.lower()
     if any(label.lower() == name for label in host.labels):
         return True
+    if fragment.path.stem.lower() + URP_SUFFIX in host.subprogram_files:
+        return True  # a subprogram the host's program calls, saved as its own program
     lines = fragment.code_line_list
     if not lines:
         return False
