@@ -31,6 +31,7 @@ from ..script.binder import Binding, Signature
 from ..script.nodes import NO_SPAN, Span
 from .errors import ScriptRuntimeError
 from .repeat import detached_threads, inert_names, pass_state
+from .shaped import MOTION_CALLS, Shaping, assigned_in, reads, root_name
 from .unknown import (
     DEVICE_READS,
     IDLE_AFTER_PASSES,
@@ -144,6 +145,9 @@ class RunResult:
     """When the main thread's ``while True`` loop (the innermost still running, also after an
     error) had every pass paced by a device's replies: which passes (see
     :class:`DevicePaced`); None otherwise."""
+    shaped_moves: dict = field(default_factory=dict)
+    """Motion calls (their span) whose target the run computed on a path it chose for a
+    device, with that device reply's source (see :mod:`urdsl.runtime.shaped`)."""
     stopped_early: Event | None = None
     """Why the run stopped before the program's end without an error: ``"blocked"`` (the
     program waits forever, e.g. a read with timeout 0 that nothing answers) or
@@ -334,6 +338,7 @@ class Interpreter:
         # last one's reply: see DevicePaced
         self.device_decisions = 0
         self.device_source = ""
+        self.shaping = Shaping()  # values computed on a path chosen for a device
         self.unknown = getattr(self.env, "devices", "quiet") == "unknown"
         # replies taken for device reads compared with constants (see _device_reply)
         self.device_replies: dict[str, object] = {}
@@ -390,6 +395,7 @@ class Interpreter:
         result.globals = self.globals
         result.warnings = self.warnings
         result.undefined = list(self.undefined.values())
+        result.shaped_moves = dict(self.shaping.moves)
         result.events_dropped = self.events_dropped
         if self.events_dropped:
             self.events.append(Event(self.time, "dropped", f"{self.events_dropped:,} more "
@@ -853,9 +859,17 @@ class _Compiler:
     def s_Assign(self, node: n.Assign):
         store = self.target(node.target)
         value = self.expr(node.value)
+        shaping = self.rt.shaping
+        name, whole = root_name(node.target), type(node.target) is n.Name
+        names = reads(node.value)
 
         def run(frame):
+            if not shaping.names:
+                store(frame, copy_value(value(frame)))
+                return
+            shaping.returned = None
             store(frame, copy_value(value(frame)))
+            shaping.assigned(name, _shaped_value(shaping, names), whole)
 
         return run
 
@@ -863,23 +877,34 @@ class _Compiler:
         rt = self.rt
         name = node.name
         value = self.expr(node.value) if node.value is not None else None
+        shaping = rt.shaping
+        names = reads(node.value)
+
+        def evaluate(frame):
+            if not shaping.names:
+                return copy_value(value(frame))  # type: ignore[misc]
+            shaping.returned = None
+            result = copy_value(value(frame))  # type: ignore[misc]
+            shaping.assigned(name, _shaped_value(shaping, names), True)
+            return result
+
         if node.scope == "global":
             def run(frame):
                 frame.global_names.add(name)
                 frame.local_names.discard(name)
                 if value is not None:
-                    rt.globals[name] = copy_value(value(frame))
+                    rt.globals[name] = evaluate(frame)
             return run
 
         def run_local(frame):
             if frame.top:  # the program's first level: global even when written local
                 if value is not None:
-                    rt.globals[name] = copy_value(value(frame))
+                    rt.globals[name] = evaluate(frame)
                 return
             frame.local_names.add(name)
             frame.global_names.discard(name)
             if value is not None:
-                frame.vars[name] = copy_value(value(frame))
+                frame.vars[name] = evaluate(frame)
             else:
                 frame.vars.pop(name, None)
 
@@ -887,9 +912,16 @@ class _Compiler:
 
     def s_Return(self, node: n.Return):
         value = self.expr(node.value) if node.value is not None else None
+        shaping = self.rt.shaping
+        names = reads(node.value)
 
         def run(frame):
+            if not shaping.names:
+                frame.retval = None if value is None else value(frame)
+                return RETURN
+            shaping.returned = None
             frame.retval = None if value is None else value(frame)
+            shaping.returned = _shaped_value(shaping, names)
             return RETURN
 
         return run
@@ -942,14 +974,21 @@ class _Compiler:
         orelse = self.block(node.orelse) if node.orelse is not None else None
         first_seen: dict[int, float] = {}  # branch -> robot time of its first unknown test
         polling = self._polling  # [passes] of the polling loop this statement is in, or None
+        shaping = rt.shaping
+        assigned = assigned_in(node.body, *(b.body for b in node.elifs), node.orelse)
+        tests = [reads(node.test)] + [reads(b.test) for b in node.elifs]
         taken = ("it takes this branch for the loop's first "
                  f"{IDLE_AFTER_PASSES} passes, then skips it (an idle device)"
                  if polling is not None else "it takes this branch")
 
         def run(frame):
+            source = None  # the device reply a test depended on: the rest is shaped
             for index, (test, body, test_node, ending, stopping) in enumerate(branches):
                 value = test(frame)
                 if type(value) is Unknown:
+                    if source is None:
+                        source = value.source
+                        shaping.decide(assigned, source)
                     rt.decided_on(value)
                     # follow a working device: not into an error branch (it ends the
                     # program), not against the reply the program expects, else in
@@ -975,6 +1014,10 @@ class _Compiler:
                     if not take:
                         continue
                     return body(frame)
+                if source is None and shaping.names:
+                    source = shaping.source(tests[index])
+                    if source is not None:
+                        shaping.decide(assigned, source)
                 if _truth(value, rt, test_node):
                     return body(frame)
             if orelse is not None:
@@ -993,6 +1036,8 @@ class _Compiler:
         finally:
             self._polling = outer
         test_node = node.test
+        shaping = rt.shaping
+        assigned, tested = assigned_in(node.body), reads(node.test)
         literal = test_node
         while type(literal) is n.Paren:
             literal = literal.expr
@@ -1013,6 +1058,7 @@ class _Compiler:
 
         def _loop(frame, passes):
             unknown_passes = 0
+            source = None  # the device reply the loop's test depended on: passes are shaped
             while True:
                 if passes is not None:
                     passes.begin(rt.time, rt.device_decisions, rt.device_source)
@@ -1024,6 +1070,11 @@ class _Compiler:
                 if polling is not None:
                     polling[0] += 1
                 value = test(frame)
+                if source is None and (type(value) is Unknown or shaping.names):
+                    source = value.source if type(value) is Unknown else \
+                        shaping.source(tested)
+                    if source is not None:
+                        shaping.decide(assigned, source)
                 if type(value) is Unknown:
                     rt.decided_on(value)
                     unknown_passes += 1
@@ -1449,6 +1500,10 @@ class _Compiler:
         keywords = [(k.name, self.expr(k.value)) for k in node.keywords if k.name not in fixed]
 
         unknown = rt.unknown
+        shaping = rt.shaping
+        arg_names = [reads(a) for a in node.args]
+        keyword_names = {k.name: reads(k.value) for k in node.keywords}
+        every = frozenset().union(*arg_names, *keyword_names.values())
 
         def call(frame):
             values = [a(frame) for a in args]
@@ -1460,6 +1515,10 @@ class _Compiler:
                 rt.calls += 1  # recursion without loops meets the wall-clock bound here
                 if not rt.calls & 1023:
                     rt.check_deadline(node)
+                if shaping.names:  # its parameters are shaped where their arguments are
+                    sources = ([shaping.source(names) for names in arg_names],
+                               {k: shaping.source(names) for k, names in keyword_names.items()})
+                    return self.call_user(function, values, named, node, sources)
                 return self.call_user(function, values, named, node)
             if unknown:
                 found = first_unknown(values, named)
@@ -1467,9 +1526,30 @@ class _Compiler:
                     return unknown_call(rt, name, values, named, found, node, builtin)
             return builtin(values, named, node)
 
-        return call
+        if name not in MOTION_CALLS:
+            return call
+        plain = call
 
-    def call_user(self, function: _Function, args: list, named: dict, node: n.Call) -> Any:
+        def motion(frame):
+            # a move whose target the run computed on a path chosen for a device
+            if not shaping.names:
+                return plain(frame)
+            shaping.returned = None
+            source = shaping.source(every)
+            try:
+                return plain(frame)
+            finally:
+                source = source or shaping.returned
+                shaping.returned = None
+                if source is not None:
+                    shaping.moves.setdefault(node.span, source)
+
+        return motion
+
+    def call_user(self, function: _Function, args: list, named: dict, node: n.Call,
+                  sources: tuple[list, dict] | None = None) -> Any:
+        """Call ``function``; ``sources``: the device replies that shaped each positional and
+        named argument (None for a plain one), when the run has shaped values."""
         rt = self.rt
         params = function.params
         # bound once per call shape by the one call binder (cached in the signature)
@@ -1485,6 +1565,15 @@ class _Compiler:
         defaults = function.defaults
         for index, name in binding.defaulted:
             bound[name] = copy_value(defaults[index](frame))
+        if sources is not None:
+            shaping = rt.shaping
+            positional, by_name = sources
+            for name, source in zip(binding.positional, positional, strict=True):
+                shaping.assigned(name, source, True)
+            for name in named:
+                shaping.assigned(name, by_name.get(name), True)
+            for _index, name in binding.defaulted:
+                shaping.assigned(name, None, True)
         frame.local_names.update(params)
         rt.depth += 1
         if rt.depth > rt.config.max_call_depth:
@@ -1538,6 +1627,17 @@ def assigned_names(module: n.Module) -> frozenset[str]:
         elif isinstance(node, n.Declare):
             names.add(node.name)
     return frozenset(names)
+
+
+def _shaped_value(shaping: Shaping, names: frozenset[str]) -> str | None:
+    """The device reply that shaped a value just computed from an expression reading
+    ``names`` (see :mod:`urdsl.runtime.shaped`): a shaped name it read, or a function that
+    returned a shaped value; None when plain. Takes :attr:`Shaping.returned`."""
+    source = shaping.source(names) if names else None
+    if source is None:
+        source = shaping.returned
+    shaping.returned = None
+    return source
 
 
 def _name_hint(name: str, frame: Frame, rt: Interpreter) -> str | None:

@@ -293,6 +293,8 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
     report.findings = group_urcap_notes(blocks, report.findings)
     if result.paced is not None:
         report.findings = device_paced(report.findings, result.paced)
+    if result.shaped_moves:
+        report.findings = device_shaped(report.findings, result.shaped_moves, planner)
     report.sort()
     return report
 
@@ -415,6 +417,38 @@ def device_paced(findings: list[Finding], paced) -> list[Finding]:
                "device): whether the program gets here depends on how many times that "
                "device answers")
         out.append(replace(finding, severity="warning", message=f"{finding.message}; {why}"))
+    return out
+
+
+def device_shaped(findings: list[Finding], moves: dict, planner) -> list[Finding]:
+    """Errors about where the arm goes (:data:`PACED_CODES`) at a move whose target the run
+    computed on a path it chose for a device (``moves``: the move's span -> that reply's
+    source; see :mod:`urdsl.runtime.shaped`), and about the path (:data:`PATH_CODES`) of the
+    move that starts where such a move ends, are warnings that say so: the check followed a
+    working device, whose real reply puts the target elsewhere."""
+    after: dict = {}
+    segments = planner.segments
+    for previous, segment in zip(segments, segments[1:], strict=False):
+        if previous.span in moves and segment.span not in moves:
+            after.setdefault(segment.span, moves[previous.span])
+    out = []
+    for finding in findings:
+        if finding.severity == "error":
+            source = moves.get(finding.span) if finding.code in PACED_CODES else None
+            if source is not None:
+                why = (f"this target was computed on the path the check chose for {source}, "
+                       "which is unknown offline (the check follows a working device): with "
+                       "the device's real reply the arm may go elsewhere")
+                if finding.code == "URS301":
+                    why += "; the check stopped at this move"
+            elif finding.code in PATH_CODES and finding.span in after:
+                source = after[finding.span]
+                why = (f"this move starts at the target of the move before it, which was "
+                       f"computed on the path the check chose for {source}, unknown offline")
+            if source is not None:
+                finding = replace(finding, severity="warning",
+                                  message=f"{finding.message}; {why}")
+        out.append(finding)
     return out
 
 
