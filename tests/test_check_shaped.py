@@ -85,3 +85,34 @@ def test_a_shaped_value_passed_to_a_function_and_returned_is_still_shaped(tmp_pa
                                                    "above(p[0.4, -0.2, 0.25, 0, 3.1416, 0], 0)"))
     status, report = check(capsys, "--no-project", "--robot", "ur5e", str(program))
     assert status == 1 and _errors(report) == [(20, "URS301")]
+
+
+LOOP = """def count():
+  socket_open("127.0.0.1", 2000, "s")
+  n = 0
+  while socket_read_string("s") != "done":
+    n = n + 1
+  end
+  step = 0.1 * n
+  movel(pose_trans(p[0.4, -0.2, 0.25, 0, 3.1416, 0], p[0, step, 0, 0, 0, 0]))
+  movel(p[0.4, -0.2, 0.25, 0, 3.1416, 0])
+  n = 2
+  movel(pose_trans(p[0.4, -0.2, 0.25, 0, 3.1416, 0], p[0, 0.1 * n, 0, 0, 0, 0]))
+end
+"""
+
+
+def test_what_a_loop_waiting_on_a_reply_counts_is_shaped_until_set_plainly():
+    from urdsl import parse
+    from urdsl.kinematics import Robot
+    from urdsl.motion.planner import MotionPlanner
+    from urdsl.runtime import Environment, Interpreter, RuntimeConfig
+
+    planner = MotionPlanner(Robot.model("ur5e"), [0, -1.9, 1.9, -1.57, -1.57, 0])
+    result = Interpreter(parse(LOOP, "count.script"), robot=planner,
+                         environment=Environment(devices="unknown"),
+                         config=RuntimeConfig()).run()
+    assert result.error is None
+    shaped = {span.line: source for span, source in result.shaped_moves.items()}
+    assert list(shaped) == [8]  # not the constant move, not the move after n = 2
+    assert "socket_read_string()" in shaped[8]
