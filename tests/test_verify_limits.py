@@ -244,3 +244,34 @@ def test_a_joint_limit_at_an_assumed_start_is_not_the_programs():
     (found,) = [f for f in check(text, q_min=low, q_max=high).findings if f.code == "URS303"]
     assert found.span.line == 2 and "where the arm starts, before this first move" in \
         found.message
+
+
+def test_a_tcp_speed_a_move_ends_with_is_not_the_next_moves():
+    # a move from where the arm's position is unknown offline is drawn from where the arm was
+    # last known, and that drawn path may race into the move's target (its findings are not
+    # reported); the next move's first sample shares its central difference, and a 0.4 m/s
+    # movel after it was reported at 5.2 m/s against an installation's 5 m/s limit (seen on a
+    # PolyScope subprogram, CA-Giken SUB_003)
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from urdsl.script.nodes import Source, Span
+    from urdsl.verify.checks import tcp_speed
+
+    dt = 0.002
+    x = np.concatenate([np.linspace(0.0, 0.15, 4), 0.2 + 0.0008 * np.arange(4)])
+    q = np.zeros((8, 6))
+    q[:, 0] = x  # the fake arm's TCP x is joint 1's value (m)
+    robot = SimpleNamespace(fk_many=lambda qs, tcp=None: np.stack(
+        [np.block([[np.eye(3), row[:3, None]], [np.zeros((1, 3)), np.ones((1, 1))]])
+         for row in qs]))
+    source = Source("movel(a)\nmovel(b)\n", "t.script")
+    segments = [SimpleNamespace(kind="movel", span=Span(source, 0, 8), tcp=None),
+                SimpleNamespace(kind="movel", span=Span(source, 9, 17), tcp=None)]
+    trace = SimpleNamespace(q=q, times=np.arange(8) * dt, dt=dt, segments=segments,
+                            segment=np.array([0, 0, 0, 0, 1, 1, 1, 1]))
+    (finding,) = tcp_speed(trace, robot, 5.0)
+    assert finding.span.line == 1  # 25 m/s on the drawn path, not the next move's
+    q[6:, 0] += 0.05  # a speed the second move reaches by itself stays its own
+    assert [f.span.line for f in tcp_speed(trace, robot, 5.0)] == [1, 2]

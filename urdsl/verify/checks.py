@@ -154,11 +154,7 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
     over = _rows_where(trace.qd, lambda qd: np.abs(qd) > bound)
     if exclude is not None:
         over &= ~exclude
-    # a move's first sample shares its central difference with the move before: a speed the
-    # move before still had there (a path through a singularity that ends in it) is that
-    # move's, not this one's
-    first = np.flatnonzero(trace.segment[1:] != trace.segment[:-1]) + 1
-    carried = first[over[first] & over[first - 1]]
+    carried = _carried(trace, over)
     over[carried] = False
     findings = []
     for segment, sample in _per_segment(trace, over):
@@ -176,6 +172,15 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
             _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
             cause=JOINTS[joint]))
     return findings
+
+
+def _carried(trace: Trace, over: np.ndarray) -> np.ndarray:
+    """The samples flagged in ``over`` (N,) only because a move's first sample shares its
+    central difference with the move before, which was flagged there too: a speed the move
+    before still had (a path through a singularity that ends in it, a path drawn from where
+    the arm was last known) is that move's, not this one's."""
+    first = np.flatnonzero(trace.segment[1:] != trace.segment[:-1]) + 1
+    return first[over[first] & over[first - 1]]
 
 
 def _speed_hint(trace: Trace, segment: int) -> str:
@@ -327,9 +332,12 @@ def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
             velocity[first] = (positions[first + 1] - positions[first]) / trace.dt if after \
                 else 0.0
         speed = np.linalg.norm(velocity, axis=1)
+    over = speed > limit * (1 + 1e-6)
+    if len(index) == len(trace.times):
+        over[_carried(trace, over)] = False
     findings = []
-    for segment, sample in _per_segment(trace, speed > limit * (1 + 1e-6)):
-        peak = float(np.max(speed[trace.segment == segment]))
+    for segment, sample in _per_segment(trace, over):
+        peak = float(np.max(speed[(trace.segment == segment) & over]))
         findings.append(Finding.of(
             "URS306", f"the TCP moves at {peak:.3f} m/s, over the cell's limit of {limit:g} m/s",
             _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
