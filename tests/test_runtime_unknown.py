@@ -533,3 +533,65 @@ def test_get_joint_positions_reads_the_arms_joints():
                         "q[5] = d2r(-350)\ntextmsg(q)\nmovej(q)\n", "wrist.script")
     (shown,) = [e.message for e in report.events if e.kind == "textmsg"]
     assert shown.startswith("[0.3, -1.5, 1.5, -1.5, -1.5, -6.1")
+
+
+PLC_CELL = """\
+while True:
+  global flag = 0
+  thread work():
+    if read_input_integer_register(4) == 1:
+      movej([0.3, -1.5708, 1.5708, -1.5708, -1.5708, 0])
+    end
+    flag = 1
+  end
+  if read_input_boolean_register(9):
+    global handle = run work()
+    while flag == 0:
+      if not read_input_boolean_register(9):
+        kill handle
+        flag = 2
+      else:
+        sync()
+      end
+    end
+  else:
+    flag = 2
+  end
+  if not read_input_boolean_register(9):
+    stopl(1.2)
+    sleep(999999)
+  end
+end
+"""
+
+
+def test_a_branch_that_stops_motion_fires_in_a_loop_that_gives_no_time():
+    # PolyScope's continuously checked If (a thread the loop kills when its input drops) and
+    # an If whose branch stops the arm: such a branch fires once the arm is at rest, and a
+    # loop that tests it again without robot time passing (nothing to wait for) sees it fire,
+    # as the controller does, instead of spinning with neither branch taken
+    from urdsl.verify.run import check_text
+
+    report = check_text(PLC_CELL, "sub.script")
+    assert not [f for f in report.findings if f.severity == "error"], report.findings
+    assert report.moves  # the PLC's first work order was followed
+
+
+def test_a_stopping_branch_in_a_thread_still_waits_for_the_move():
+    # the Until pattern: the move is checked to where it goes, the stop fires after it
+    from urdsl.verify.run import check_text
+
+    text = ("thread until():\n"
+            "  while True:\n"
+            "    if get_standard_digital_in(0):\n"
+            "      stopl(1.2)\n"
+            "    end\n"
+            "    sync()\n"
+            "  end\n"
+            "end\n"
+            "movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])\n"
+            "global t = run until()\n"
+            "movel(p[0.3, -0.3, 0.3, 0, 3.14, 0], v=0.1)\n"
+            "kill t\n")
+    report = check_text(text, "until.script")
+    assert len(report.moves) == 2 and report.moves[1].duration > 0.5

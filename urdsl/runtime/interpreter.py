@@ -972,7 +972,8 @@ class _Compiler:
         branches += [(self.expr(b.test), self.block(b.body), b.test, ends_program(b.body),
                       stops_motion(b.body)) for b in node.elifs]
         orelse = self.block(node.orelse) if node.orelse is not None else None
-        first_seen: dict[int, float] = {}  # branch -> robot time of its first unknown test
+        # branch -> [robot time of its first unknown test, tests at that time]
+        first_seen: dict[int, list] = {}
         polling = self._polling  # [passes] of the polling loop this statement is in, or None
         shaping = rt.shaping
         assigned = assigned_in(node.body, *(b.body for b in node.elifs), node.orelse)
@@ -996,9 +997,17 @@ class _Compiler:
                     if take and stopping:
                         # a sensor that stops a move (PolyScope's Until: tool contact, an
                         # input) fires once the move has come as far as it can go
-                        seen = first_seen.setdefault(index, rt.time)
+                        # fires once the move has come as far as it can (the arm at rest)
+                        # and robot time has passed since it was first tested; a loop that
+                        # tests it again without time passing (no move to wait for) sees it
+                        # fire on its second test, as it would not spin on the robot
+                        seen = first_seen.setdefault(index, [rt.time, 0])
+                        if rt.time > seen[0]:
+                            seen[1] = 2
+                        else:
+                            seen[1] += 1
                         free_at = getattr(rt.robot, "free_at", rt.time)
-                        take = rt.time > seen and free_at <= rt.time + 1e-9
+                        take = seen[1] >= 2 and free_at <= rt.time + 1e-9
                     elif take and polling is not None and polling[0] > IDLE_AFTER_PASSES:
                         take = False  # the device has gone idle: nothing to report
                     rt.warn_once(
