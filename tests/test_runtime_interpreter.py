@@ -329,3 +329,23 @@ def test_get_inverse_kin_of_a_taught_waypoint_is_its_joints_near_a_singularity()
              if e.kind == "textmsg"]
     assert shown[0].startswith("[1.529344, -1.570028, -1.82002, -2.831018, -0.001219")
     assert not shown[1].startswith("[1.529344, -1.570028")  # 2 cm away: the model's own
+
+
+def test_get_inverse_kin_of_a_waypoint_taught_stretched_out_is_its_joints():
+    # PolyScope's upright home, taught on the arm: its calibration puts the pose 0.3 mm
+    # beyond the nominal UR5e's reach, where the model has no solution; the taught joints
+    # are the arm's own (CederGroupHub alab_control OpenDoor_B Home_WP)
+    from urdsl.verify.run import check_text
+
+    pose = "p[-.001703142952, -.233433365732, 1.079483178718, -.009004197313, " \
+           "-2.218443849278, 2.216349783219]"
+    joints = "[-1.732503072560121E-6, -1.5707525371365882, 1.889864076787262E-5, " \
+             "-1.5708004436888636, -4.083315004521637E-5, -3.0819569722950746E-5]"
+    text = f"movej(get_inverse_kin({pose}, qnear={joints}))\n"
+    report = check_text(text, "home.script", robot="ur5e")
+    assert not [f for f in report.findings if f.severity == "error"], report.findings
+    # a pose further out is still out of reach, taught joints or not
+    far = pose.replace("1.079483178718", "1.09")
+    report = check_text(f"movej(get_inverse_kin({far}, qnear={joints}))\n", "far.script",
+                        robot="ur5e")
+    assert [f.code for f in report.findings if f.severity == "error"] == ["URS301"]

@@ -319,23 +319,38 @@ def _inverse(rt, node, x, qnear, maxPositionError, maxOrientationError, tcp):  #
     millimetres off that arm, near a singularity (wrist 2 at 0°) the model's nearest solution
     can split wrist 1 and 3 a radian apart from the taught ones; when the model puts
     ``qnear`` within :data:`TAUGHT_POSITION`/:data:`TAUGHT_ORIENTATION` of the pose and its
-    own solution more than :data:`TAUGHT_JUMP` from it, ``qnear`` is the answer."""
+    own solution more than :data:`TAUGHT_JUMP` from it, ``qnear`` is the answer. So it is
+    when the model has no solution at all while it puts ``qnear`` that close: a waypoint
+    taught with the arm stretched out (PolyScope's upright home) lies a fraction of a
+    millimetre beyond the nominal model's reach."""
     arm = _arm(rt, node)
     target = posemath.to_matrix(_pose(rt, node, x, "x"))
     near = arm.joints_at(rt.time) if qnear is None else _numbers(rt, node, qnear, 6, "qnear")
     offset = arm.tcp if isinstance(tcp, str) else _pose(rt, node, tcp, "tcp")
     _number(rt, node, maxPositionError, "maxPositionError")
     _number(rt, node, maxOrientationError, "maxOrientationError")
-    solution = arm.kinematics.ik(target, near, tcp=offset)
-    if qnear is not None and np.max(np.abs(solution - near)) > TAUGHT_JUMP:
-        there = arm.kinematics.fk(near, tcp=offset)
-        turn = there[:3, :3].T @ target[:3, :3]
-        angle = float(np.arccos(np.clip((np.trace(turn) - 1) / 2, -1.0, 1.0)))
-        if np.linalg.norm(there[:3, 3] - target[:3, 3]) <= TAUGHT_POSITION and \
-                angle <= TAUGHT_ORIENTATION and bool(np.all(near >= arm.kinematics.q_min)) \
-                and bool(np.all(near <= arm.kinematics.q_max)):
+    try:
+        solution = arm.kinematics.ik(target, near, tcp=offset)
+    except KinematicsError:
+        if qnear is not None and _taught_there(arm.kinematics, near, target, offset):
             return np.asarray(near, dtype=float)
+        raise
+    if qnear is not None and np.max(np.abs(solution - near)) > TAUGHT_JUMP and \
+            _taught_there(arm.kinematics, near, target, offset):
+        return np.asarray(near, dtype=float)
     return solution
+
+
+def _taught_there(model, near: np.ndarray, target: np.ndarray, offset) -> bool:
+    """Whether joints ``near`` (rad, inside the model's limits) put the TCP ``offset`` within
+    :data:`TAUGHT_POSITION` and :data:`TAUGHT_ORIENTATION` of ``target`` (a 4x4 pose) on
+    ``model``: the arm's own joints for a pose its calibration computed."""
+    there = model.fk(near, tcp=offset)
+    turn = there[:3, :3].T @ target[:3, :3]
+    angle = float(np.arccos(np.clip((np.trace(turn) - 1) / 2, -1.0, 1.0)))
+    return bool(np.linalg.norm(there[:3, 3] - target[:3, 3]) <= TAUGHT_POSITION
+                and angle <= TAUGHT_ORIENTATION and np.all(near >= model.q_min)
+                and np.all(near <= model.q_max))
 
 
 @implements("get_inverse_kin")
