@@ -440,3 +440,23 @@ def test_a_fragment_of_a_polyscope_program_is_taught_too(tmp_path, capsys):
     assert "context of" in report["context"]
     (finding,) = [f for f in report["findings"] if f["code"] == "URS301"]
     assert finding["severity"] == "warning" and "on the assumed ur5e" in finding["message"]
+
+
+@pytest.mark.parametrize(("z", "severity"), [(1.079483178718, "warning"), (1.09, "error")])
+def test_a_target_a_fraction_of_a_millimetre_beyond_the_nominal_reach_is_a_warning(
+        tmp_path, capsys, z, severity):
+    # an upright home taught on the arm: its calibration put the pose 0.3 mm beyond the
+    # nominal UR5e's reach; 1 cm beyond stays an error
+    text = ("def prog():\n"
+            f"  global Home_p=p[-.001703142952, -.233433365732, {z}, -.009004197313, "
+            "-2.218443849278, 2.216349783219]\n"
+            "  movej([0, -1.2, 1.2, -1.5708, -1.5708, 0])\n"
+            "  movel(Home_p, a=1.2, v=0.25)\n"
+            "end\n")
+    path = tmp_path / "home.script"
+    path.write_text(text)
+    main(["check", str(path), "--json", "--robot", "ur5e", "--no-self-collision"])
+    report = json.loads(capsys.readouterr().out)
+    (reach,) = [f for f in report["findings"] if f["code"] == "URS301"]
+    assert reach["severity"] == severity and reach["line"] == 4
+    assert ("the arm's calibration decides" in reach["message"]) == (severity == "warning")

@@ -517,6 +517,37 @@ def qualify(report, inference: Inference) -> None:
     report.findings = qualified
 
 
+NOMINAL_ACCURACY = 0.005
+"""How far (m) a real arm's TCP may lie from where the nominal DH table puts it: a factory
+calibration moves it by 1-7 mm (the residuals of waypoint pairs taught on real arms, see
+:func:`infer`). A target out of the nominal model's reach by less than this is within the
+arm's own reach or not as its calibration decides."""
+
+_SHORT_OF_REACH = re.compile(r"just out of reach|out of reach(?: of the \S+)? by ([\d.]+) mm")
+
+
+def within_nominal_accuracy(report) -> None:
+    """Errors that a target is out of reach (URS301) by less than :data:`NOMINAL_ACCURACY`,
+    on the nominal model (not the arm's calibration), become warnings that say so: a
+    waypoint taught with the arm stretched out is where the arm was, a fraction of a
+    millimetre beyond the nominal reach. Farther out stays an error."""
+    kept = []
+    for finding in report.findings:
+        if finding.severity == "error" and finding.code == "URS301":
+            match = _SHORT_OF_REACH.search(finding.message)
+            if match is not None and (match.group(1) is None
+                                      or float(match.group(1)) < NOMINAL_ACCURACY * 1000):
+                finding = replace(
+                    finding, severity="warning",
+                    message=f"{finding.message}, within the {NOMINAL_ACCURACY * 1000:g} mm by "
+                    "which a real arm differs from the nominal model: the arm's calibration "
+                    "decides (the check stopped at this move)",
+                    hint="check on the arm's calibration: urdsl check the PolyScope program "
+                    "(.urp) beside this file")
+        kept.append(finding)
+    report.findings = kept
+
+
 def apply(options: CheckOptions, inference: Inference, tcp_given: bool) -> CheckOptions:
     """``options`` with the inferred robot and start joints (and the installation's TCP as the
     TCP before the program sets one, unless ``--tcp`` was given)."""
