@@ -381,8 +381,12 @@ def test_an_export_is_checked_on_the_arm_of_the_program_beside_it(tmp_path, caps
     assert main(["check", str(export), "--robot", "ur5e", "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert "calibration of arm.urp's <kinematics>" in report["context"]
-    assert main(["check", str(export), "--robot", "ur5e", "--json", "--nominal"]) == 1
-    assert any(f["code"] == "URS301" for f in json.loads(capsys.readouterr().out)["findings"])
+    # on the nominal model it is 1.5 mm out of reach: within a calibration's millimetres, so
+    # a warning that the arm's calibration decides, not an error
+    assert main(["check", str(export), "--robot", "ur5e", "--json", "--nominal"]) == 0
+    (reach,) = [f for f in json.loads(capsys.readouterr().out)["findings"]
+                if f["code"] == "URS301"]
+    assert reach["severity"] == "warning" and "calibration decides" in reach["message"]
 
 
 def test_a_polyscope_1_program_is_urdsls_limit_not_the_programs_mistake(tmp_path, capsys):
@@ -547,3 +551,23 @@ def test_what_a_urcaps_function_gives_is_unknown_not_none(tmp_path, capsys):
     assert not [f for f in report["findings"] if f["severity"] == "error"]
     assert "functions defined by code urdsl cannot generate, taken as devices: p_rel" in \
         report["context"]
+
+
+@pytest.mark.parametrize(("named", "severity"), [(True, "error"), (False, "warning")])
+def test_limits_a_taught_waypoint_lies_beyond_in_a_borrowed_installation(cell, capsys, named,
+                                                                          severity):
+    # the cell's waypoints were taught above z = 0.3 m: an installation with a ceiling there
+    # was not in force when they were taught. A program that names no installation (a sample
+    # program copied into a cell's folder) is checked with the one beside it, and such a
+    # ceiling is a warning that says so; the installation the program names keeps it an error
+    _with_safety(cell, _safety(plane="[0.0, 0.0, -1.0]"))
+    if not named:
+        text = cell.read_text(encoding="utf-8")
+        cell.write_text(text.replace(' installation="cell" installationRelativePath="cell"', ""),
+                        encoding="utf-8")
+    main(["check", str(cell), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    planes = [f for f in report["findings"] if f["code"] == "URS308"]
+    assert planes and {f["severity"] for f in planes} == {severity}
+    assert all(("was taught beyond this limit of cell.installation" in f["message"])
+               == (severity == "warning") for f in planes)

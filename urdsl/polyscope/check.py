@@ -26,7 +26,7 @@ import numpy as np
 
 from ..script import nodes as n
 from ..script.diagnostics import Diagnostic
-from .compile import Compiled
+from .compile import Compiled, names_installation
 from .installation import Installation
 from .urp import Node, Program
 
@@ -382,7 +382,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     from ..script.diagnostics import ScriptError
     from ..script.parser import parse
     from ..verify.findings import Finding
-    from ..verify.infer import apply, infer
+    from ..verify.infer import apply, infer, waypoint_pairs
     from ..verify.run import check_text, check_tree
 
     generated = generate(path)
@@ -446,8 +446,16 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         file_options.calibration = calibration
         notes.append(f"on this very arm: the {calibration.model} calibration of the program's "
                      "<kinematics>")
+    joints_open = file_options.q_min is None and file_options.q_max is None
+    planes_open = not file_options.safety_planes
     if generated.installation is not None and generated.installation.safety is not None:
         notes.extend(installation_defaults(file_options, generated.installation))
+    # limits taken from an installation that the program does not name as its own
+    borrowed = generated.installation is not None and not (
+        generated.program.installation
+        and names_installation(generated.program, str(generated.installation.path)))
+    borrowed_joints = borrowed and joints_open and file_options.q_min is not None
+    borrowed_planes = borrowed and planes_open and bool(file_options.safety_planes)
     file_options.unknown_globals = urcap_values(generated, module)
     if file_options.unknown_globals:
         notes.append("unknown values (URCap nodes' results, names of a missing "
@@ -462,6 +470,11 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     urcaps = {number for number, _node in generated.urcap_nodes()}
     report = check_tree(with_urcap_time(module, urcaps), generated.filename, file_options)
     report.inferred = inference
+    if borrowed_joints or borrowed_planes:
+        report.findings = taught_beyond(
+            report.findings, waypoint_pairs(module), file_options,
+            Path(str(generated.installation.path)).name, joints=borrowed_joints,
+            planes=borrowed_planes)
     if tcp_unknown:
         report.findings = tcp_dependent(report.findings, len(tcps))
     report.findings = node_findings(generated, report.findings)
@@ -488,6 +501,52 @@ def taught_tcps(program: Program) -> list[tuple[float, ...]]:
             if offset is not None and len(offset) == 6:
                 seen.setdefault(tuple(round(v, 4) for v in offset), tuple(offset))
     return list(seen.values())
+
+
+def taught_beyond(findings: list, pairs, options, installation: str, *, joints: bool,
+                  planes: bool) -> list:
+    """Errors about an installation's joint position limits (URS303, with ``joints``) and
+    safety planes (URS308, with ``planes``) that one of the program's taught waypoints
+    (``pairs``: :class:`~urdsl.verify.infer.WaypointPair`) lies beyond, where the program does
+    not name that installation as its own: the arm stood at the waypoint when it was taught,
+    so that limit was not in force then, and the installation beside the program is not the
+    one it was taught with. They are warnings that say so; the limits the taught waypoints
+    keep stay errors."""
+    from ..verify.checks import JOINTS, SAFETY_PLANE_TOLERANCE
+
+    beyond: dict[str, str] = {}  # a finding's cause -> the waypoint taught beyond its limit
+    for pair in pairs:
+        q = np.asarray(pair.joints, dtype=float)
+        if joints:
+            for joint in range(6):
+                if q[joint] > options.q_max[joint] + 1e-6:
+                    beyond.setdefault(f"{JOINTS[joint]} upper", pair.name)
+                if q[joint] < options.q_min[joint] - 1e-6:
+                    beyond.setdefault(f"{JOINTS[joint]} lower", pair.name)
+        if planes:
+            where = np.asarray(pair.pose[:3], dtype=float)
+            for plane in options.safety_planes:
+                normal = np.asarray(plane.normal, dtype=float)
+                normal = normal / np.linalg.norm(normal)
+                if -(where @ normal + float(plane.distance)) > SAFETY_PLANE_TOLERANCE:
+                    beyond.setdefault(f"plane {plane.name}", pair.name)
+    if not beyond:
+        return findings
+    out = []
+    for finding in findings:
+        cause = finding.cause or ""
+        if finding.code == "URS308" and " passes the safety plane " in cause:
+            cause = "plane " + cause.split(" passes the safety plane ", 1)[1]  # TCP or elbow
+        waypoint = beyond.get(cause) if finding.severity == "error" and \
+            finding.code in ("URS303", "URS308") else None
+        if waypoint is not None:
+            finding = replace(finding, severity="warning", message=(
+                f"{finding.message}; the program's waypoint {waypoint} was taught beyond this "
+                f"limit of {installation}, which the program does not name as its own: it was "
+                "taught under other safety settings"),
+                hint="check the program with the installation it runs with")
+        out.append(finding)
+    return out
 
 
 def tcp_dependent(findings: list, count: int) -> list:
