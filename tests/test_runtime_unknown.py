@@ -595,3 +595,54 @@ def test_a_stopping_branch_in_a_thread_still_waits_for_the_move():
             "kill t\n")
     report = check_text(text, "until.script")
     assert len(report.moves) == 2 and report.moves[1].duration > 0.5
+
+
+PLC_SPIN = """\
+while True:
+  global state = read_port_register(200)
+  global flag = 0
+  thread work():
+    movej([0.3, -1.5708, 1.5708, -1.5708, -1.5708, 0])
+    flag = 1
+  end
+  if state == 1:
+    global handle = run work()
+    while flag == 0:
+      if not(state == 1):
+        kill handle
+        flag = 2
+      else:
+        sync()
+      end
+    end
+  else:
+    flag = 2
+  end
+end
+"""
+
+
+def test_a_plc_loop_that_waits_for_no_state_still_spins_when_the_plc_is_idle():
+    # PolyScope's continuously checked If on a PLC register (its branch kills the thread it
+    # runs): while the register holds a value no branch waits for (0 at power-up), the loop
+    # spins without time; the branch that stops the arm fires for a working PLC, and an
+    # idle one (reads at rest) leaves the loop spinning, as on the controller
+    from urdsl.verify.run import check_text
+
+    report = check_text(PLC_SPIN, "plc.script")
+    (spin,) = [f for f in report.findings if f.severity == "error"]
+    assert spin.code == "URS207" and spin.span.line == 1
+    assert report.moves  # the working PLC's first order was followed
+
+
+@pytest.mark.parametrize(("test", "holds"), [
+    ("reg", False), ("not reg", True), ("not (reg)", True), ("state == 1", False),
+    ("state == 0", True), ("state != 0", False), ("0 == state", True),
+    ("reg == False", True), ("not reg and not other", True), ("reg or not other", True),
+    ("not (reg or other)", True), ("reg and not other", False),
+])
+def test_an_idle_device_reads_at_rest(test, holds):
+    from urdsl.runtime.unknown import idle_truth
+
+    (statement,) = parse(f"if {test}:\n  x = 1\nend\n", "t.script").body
+    assert idle_truth(statement.test) is holds

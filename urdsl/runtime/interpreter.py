@@ -38,6 +38,7 @@ from .unknown import (
     UNKNOWN_LOOP_PASSES,
     ends_program,
     first_unknown,
+    idle_truth,
     polls_devices,
     stops_motion,
     unknown_call,
@@ -981,6 +982,8 @@ class _Compiler:
         taken = ("it takes this branch for the loop's first "
                  f"{IDLE_AFTER_PASSES} passes, then skips it (an idle device)"
                  if polling is not None else "it takes this branch")
+        taken_idle = (f"it takes this branch, also after the loop's first {IDLE_AFTER_PASSES} "
+                      "passes (an idle device reads at rest: False, 0)")
 
         def run(frame):
             source = None  # the device reply a test depended on: the rest is shaped
@@ -994,7 +997,11 @@ class _Compiler:
                     # follow a working device: not into an error branch (it ends the
                     # program), not against the reply the program expects, else in
                     working = take = not ending and value.lean is not False
-                    if take and stopping:
+                    idle = polling is not None and polling[0] > IDLE_AFTER_PASSES
+                    if idle:
+                        # the device has gone idle: its reads are at rest (False, 0)
+                        take = not ending and idle_truth(test_node)
+                    elif take and stopping:
                         # a sensor that stops a move (PolyScope's Until: tool contact, an
                         # input) fires once the move has come as far as it can go
                         # fires once the move has come as far as it can (the arm at rest)
@@ -1008,15 +1015,14 @@ class _Compiler:
                             seen[1] += 1
                         free_at = getattr(rt.robot, "free_at", rt.time)
                         take = seen[1] >= 2 and free_at <= rt.time + 1e-9
-                    elif take and polling is not None and polling[0] > IDLE_AFTER_PASSES:
-                        take = False  # the device has gone idle: nothing to report
                     rt.warn_once(
                         f"this condition depends on {value.source}, which is unknown "
                         "offline; the check follows a working device: "
                         + ("it skips this branch, which ends the program" if ending
                            else "it takes this branch once the move it stops has come as "
                            "far as it can" if stopping and value.lean is not False
-                           else taken if working
+                           else (taken_idle if polling is not None and idle_truth(test_node)
+                                 else taken) if working
                            else "it skips this branch (a working device's reply does not "
                            "lead here)"),
                         test_node, value)

@@ -24,8 +24,9 @@ names the read and its line), never with an error:
 * ``if``/``elif`` on an unknown condition takes the branch unless the branch ends the program
   (``halt``, a ``popup``, a protective stop): an error branch is what a failing device causes;
   in a loop that polls (:func:`polls_devices`: it takes time only in such branches) the
-  device reports something for :data:`IDLE_AFTER_PASSES` passes and is then idle, so that a
-  loop that spins while nothing happens is found;
+  device reports something for :data:`IDLE_AFTER_PASSES` passes and is then idle, its reads
+  at rest (``False``, 0: :func:`idle_truth`), so that a loop that spins while nothing happens
+  is found, and one that waits while nothing happens (``if not ready: sleep(1)``) is not;
 * ``while`` on an unknown condition runs at most :data:`UNKNOWN_LOOP_PASSES` passes and then
   leaves the loop, as a wait loop does when the device answers;
 * a move or a builtin with an unknown argument is not checked (noted once); an unchecked move
@@ -49,7 +50,7 @@ from .values import ListValue, PoseValue, StructValue, Unknown, has_unknown
 
 __all__ = [
     "DEVICE_REPLY_TIME", "IDLE_AFTER_PASSES", "OPERATOR_REPLY_TIME", "UNCHECKED_MOVE_TIME",
-    "UNKNOWN_LOOP_PASSES", "polls_devices",
+    "UNKNOWN_LOOP_PASSES", "polls_devices", "idle_truth",
     "DEVICE_READS", "OPERATOR_PROMPTS", "ends_program", "stops_motion", "unknown_from",
     "describe",
 ]
@@ -189,6 +190,41 @@ def polls_devices(body: Any) -> bool:
                 if name in BLOCKING_CALLS or lookup(name) is None:
                     return False
     return branches
+
+
+def idle_truth(test: Any) -> bool:
+    """Whether the condition ``test`` holds while the devices it reads are idle (a polling
+    loop's device after :data:`IDLE_AFTER_PASSES` passes): an idle device reads as at rest,
+    ``False`` or 0, so ``not ready`` holds and ``ready``, ``state == 1`` do not; a loop that
+    tests ``if reg: ...`` and ``if not reg: sleep(...)`` takes the second while nothing
+    happens, as on the controller, and does not spin. Judged from the test's form: ``not``,
+    ``and``, ``or``, ``xor`` and parentheses, a comparison with 0 or ``False`` by ``==`` or
+    ``!=``; anything else does not hold."""
+    kind = type(test)
+    if kind is n.Paren:
+        return idle_truth(test.expr)
+    if kind is n.UnaryOp and test.op in ("not", "!"):
+        return not idle_truth(test.operand)
+    if kind is n.BinOp:
+        if test.op == "and":
+            return idle_truth(test.left) and idle_truth(test.right)
+        if test.op == "or":
+            return idle_truth(test.left) or idle_truth(test.right)
+        if test.op == "xor":
+            return idle_truth(test.left) != idle_truth(test.right)
+        if test.op in ("==", "!="):
+            rest = [side for side in (test.left, test.right) if _at_rest(side)]
+            if rest:
+                return test.op == "=="
+    return False
+
+
+def _at_rest(node: Any) -> bool:
+    """Whether ``node`` is the literal 0 or ``False`` (what an idle device reads)."""
+    while type(node) is n.Paren:
+        node = node.expr
+    return (type(node) is n.Number and node.value == 0) or \
+        (type(node) is n.Bool and node.value is False)
 
 
 def first_unknown(values: Any, named: dict | None = None) -> Unknown | None:
