@@ -1003,11 +1003,10 @@ class _Compiler:
                         take = not ending and idle_truth(test_node)
                     elif take and stopping:
                         # a sensor that stops a move (PolyScope's Until: tool contact, an
-                        # input) fires once the move has come as far as it can go
-                        # fires once the move has come as far as it can (the arm at rest)
-                        # and robot time has passed since it was first tested; a loop that
-                        # tests it again without time passing (no move to wait for) sees it
-                        # fire on its second test, as it would not spin on the robot
+                        # input) fires once the move has come as far as it can go (the arm
+                        # at rest) and robot time has passed since it was first tested; a
+                        # loop that tests it again without time passing (no move to wait
+                        # for) sees it fire on its second test
                         seen = first_seen.setdefault(index, [rt.time, 0])
                         if rt.time > seen[0]:
                             seen[1] = 2
