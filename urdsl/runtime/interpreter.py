@@ -982,6 +982,7 @@ class _Compiler:
         taken = ("it takes this branch for the loop's first "
                  f"{IDLE_AFTER_PASSES} passes, then skips it (an idle device)"
                  if polling is not None else "it takes this branch")
+        at_rest = [idle_truth(node.test)] + [idle_truth(b.test) for b in node.elifs]
         taken_idle = (f"it takes this branch, also after the loop's first {IDLE_AFTER_PASSES} "
                       "passes (an idle device reads at rest: False, 0)")
 
@@ -1000,7 +1001,7 @@ class _Compiler:
                     idle = polling is not None and polling[0] > IDLE_AFTER_PASSES
                     if idle:
                         # the device has gone idle: its reads are at rest (False, 0)
-                        take = not ending and idle_truth(test_node)
+                        take = not ending and at_rest[index]
                     elif take and stopping:
                         # a sensor that stops a move (PolyScope's Until: tool contact, an
                         # input) fires once the move has come as far as it can go (the arm
@@ -1020,7 +1021,7 @@ class _Compiler:
                         + ("it skips this branch, which ends the program" if ending
                            else "it takes this branch once the move it stops has come as "
                            "far as it can" if stopping and value.lean is not False
-                           else (taken_idle if polling is not None and idle_truth(test_node)
+                           else (taken_idle if polling is not None and at_rest[index]
                                  else taken) if working
                            else "it skips this branch (a working device's reply does not "
                            "lead here)"),

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..kinematics import KinematicsError
 from ..kinematics import pose as posemath
+from ..kinematics.models import NOMINAL_ACCURACY
 from .errors import ScriptRuntimeError
 from .registry import implements
 from .values import ListValue, PoseValue, Unknown, is_number, type_name
@@ -303,9 +304,10 @@ def _forward_kin(rt, node, q="current_joint_positions", tcp="active_tcp"):
     return _to_pose(arm.kinematics.fk(joints, tcp=offset))
 
 
-TAUGHT_POSITION = 0.005
+TAUGHT_POSITION = NOMINAL_ACCURACY
 """How far (m) the model puts a given ``qnear`` from the pose asked, within which
-``get_inverse_kin`` takes ``qnear`` as the arm's own solution (see :func:`_inverse`)."""
+``get_inverse_kin`` takes ``qnear`` as the arm's own solution (see :func:`_inverse`): the
+nominal model's accuracy."""
 TAUGHT_ORIENTATION = 0.01
 """The same bound on the orientation (rad)."""
 TAUGHT_JUMP = 0.05

@@ -332,9 +332,8 @@ def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
             velocity[first] = (positions[first + 1] - positions[first]) / trace.dt if after \
                 else 0.0
         speed = np.linalg.norm(velocity, axis=1)
-    over = speed > limit * (1 + 1e-6)
-    if len(index) == len(trace.times):
-        over[_carried(trace, over)] = False
+    over = speed > limit * (1 + 1e-6)  # every sample (stride 1): one row a sample
+    over[_carried(trace, over)] = False
     findings = []
     for segment, sample in _per_segment(trace, over):
         peak = float(np.max(speed[(trace.segment == segment) & over]))

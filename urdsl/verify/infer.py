@@ -517,20 +517,17 @@ def qualify(report, inference: Inference) -> None:
     report.findings = qualified
 
 
-NOMINAL_ACCURACY = 0.005
-"""How far (m) a real arm's TCP may lie from where the nominal DH table puts it: a factory
-calibration moves it by 1-7 mm (the residuals of waypoint pairs taught on real arms, see
-:func:`infer`). A target out of the nominal model's reach by less than this is within the
-arm's own reach or not as its calibration decides."""
-
 _SHORT_OF_REACH = re.compile(r"just out of reach|out of reach(?: of the \S+)? by ([\d.]+) mm")
 
 
 def within_nominal_accuracy(report) -> None:
-    """Errors that a target is out of reach (URS301) by less than :data:`NOMINAL_ACCURACY`,
+    """Errors that a target is out of reach (URS301) by less than
+    :data:`~urdsl.kinematics.models.NOMINAL_ACCURACY`,
     on the nominal model (not the arm's calibration), become warnings that say so: a
     waypoint taught with the arm stretched out is where the arm was, a fraction of a
     millimetre beyond the nominal reach. Farther out stays an error."""
+    from ..kinematics.models import NOMINAL_ACCURACY
+
     kept = []
     for finding in report.findings:
         if finding.severity == "error" and finding.code == "URS301":
