@@ -64,8 +64,29 @@ def test_rotation_near_zero_is_exact():
 
 @settings(max_examples=200, deadline=None)
 @given(poses, poses)
-def test_pose_add_undoes_pose_sub(a, b):
-    assert same_transform(pose.pose_add(pose.pose_sub(a, b), b), a)
+def test_a_relative_waypoint_started_at_from_ends_at_to(a, b):
+    """PolyScope's relative waypoint: pose_add(where the arm is, pose_sub(to, from))."""
+    assert same_transform(pose.pose_add(b, pose.pose_sub(a, b)), a)
+
+
+@settings(max_examples=200, deadline=None)
+@given(poses, poses, st.floats(-3.0, 3.0), st.floats(-3.0, 3.0))
+def test_pose_add_undoes_pose_sub_for_positions_and_turns_about_one_axis(a, b, turn_a, turn_b):
+    """The UR forum's pose_add(pose_sub(a, b), b) == a: the positions always, the rotations
+    when they commute."""
+    assert np.allclose(pose.pose_add(pose.pose_sub(a, b), b)[:3], np.asarray(a)[:3], atol=1e-9)
+    axis = np.array([0.6, 0.0, 0.8])
+    a2 = np.concatenate([np.asarray(a)[:3], turn_a * axis])
+    b2 = np.concatenate([np.asarray(b)[:3], turn_b * axis])
+    assert same_transform(pose.pose_add(pose.pose_sub(a2, b2), b2), a2)
+
+
+def test_pose_sub_is_the_change_in_the_from_tool_frame():
+    """A tool turned -90 deg about its own z axis: the change is that turn, whatever the
+    from pose's orientation (here the tool pointing down, as PolyScope's default)."""
+    down = [0.4, -0.1, 0.3, 0.0, math.pi, 0.0]
+    turned = pose.pose_trans(down, [0, 0, 0, 0, 0, -math.pi / 2])
+    assert np.allclose(pose.pose_sub(turned, down), [0, 0, 0, 0, 0, -math.pi / 2], atol=1e-9)
 
 
 @settings(max_examples=200, deadline=None)

@@ -268,12 +268,21 @@ def pose_add(p_1, p_2) -> np.ndarray:
 
 
 def pose_sub(p_to, p_from) -> np.ndarray:
-    """``pose_sub(p_to, p_from)``: ``P = P_to − P_from``, ``R = R_to·R_fromᵀ``.
+    """``pose_sub(p_to, p_from)``: ``P = P_to − P_from``, ``R = R_fromᵀ·R_to`` (m, rotation
+    vector).
 
-    The inverse of :func:`pose_add`: ``pose_add(pose_sub(a, b), b) == a``.
+    The rotation is the change from ``p_from`` to ``p_to`` in ``p_from``'s tool frame, so that
+    PolyScope's relative waypoint, ``pose_add(get_target_tcp_pose(), pose_sub(to, from))``,
+    started at ``from`` ends at ``to``: ``pose_add(b, pose_sub(a, b)) == a``. The manual gives
+    no formula for ``pose_sub`` [U]; this order is the one that reproduces the joints PolyScope
+    stored for the waypoints taught after such moves in a real program (o2ac
+    ``bearing_orient_totb.script``: 9 of 9 within 0.01 rad, against 3 of 9, the other six a full
+    wrist-3 turn off, with ``R_to·R_fromᵀ``). A UR forum answer's
+    ``pose_add(pose_sub(a, b), b) == a`` holds for the positions, and for the rotations when
+    they commute (turns about one axis).
     """
     a, b = _array(p_to, 6, "p_to"), _array(p_from, 6, "p_from")
-    rotation = rotvec_to_matrix(a[..., 3:]) @ np.swapaxes(rotvec_to_matrix(b[..., 3:]), -1, -2)
+    rotation = np.swapaxes(rotvec_to_matrix(b[..., 3:]), -1, -2) @ rotvec_to_matrix(a[..., 3:])
     return np.concatenate([a[..., :3] - b[..., :3], matrix_to_rotvec(rotation)], axis=-1)
 
 
