@@ -311,3 +311,11 @@ def test_warnings_in_code_a_urcap_wrote_are_counted_in_one_note_errors_stay():
     assert "2 finding(s) (URS112) in the code Gripper wrote" in found[0].message
     quiet = lint_text(text, "export.script", build_settings(ignore=["URS122"]))
     assert [d.code for d in quiet] == ["URS102", "URS112"]
+
+
+def test_polyscope_s_own_jump_to_label_is_not_an_unknown_name():
+    """PolyScope writes ``jump_to_label(N)`` before the Robot Program (a 5.x export of o2ac):
+    what PolyScope itself writes is no error."""
+    text = ('def program():\n  jump_to_label(3)\n  $ 1 "Robot Program"\n  $ 2 "MoveJ"\n'
+            '  $ 3 "home" "breakAfter"\n  movej([0, -1.57, 1.57, -1.57, -1.57, 0])\nend\n')
+    assert _codes(text) == []
