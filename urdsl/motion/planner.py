@@ -257,13 +257,17 @@ class MotionPlanner:
         solutions, miss = model.ik_all_many(targets, tcp=pending[0].tcp)
         chosen, found = continue_branch(model, solutions, self._q_end, pending[0].tcp)
         previous = self._q_end.copy()
+        turns = np.zeros(6)  # whole turns the path added to each joint so far
         for index, segment in enumerate(pending):
             if not found[index]:
                 self._drop_from(segment)
                 distance = float(np.min(miss[index]))
                 raise UnreachableTarget(segment, distance)
             segment.q_start = previous
-            segment.q_end = previous = chosen[index]
+            end = chosen[index] + turns
+            along = continuous_end(model, segment, previous, end)
+            turns += along - end
+            segment.q_end = previous = along
         self._q_end = previous.copy()
 
     def _drop_from(self, segment: Segment) -> None:
@@ -571,6 +575,9 @@ class MotionPlanner:
                                     span, params, pose_from, pose)
         if via is not None:
             segment.via = via[:3, 3].copy()
+        if not self.lazy_ik:
+            segment.q_end = continuous_end(self.kinematics, segment, segment.q_start,
+                                           segment.q_end)
         return self._add(segment, now)
 
     def movec(self, via: np.ndarray, pose: np.ndarray, a: float, v: float, r: float,
@@ -774,6 +781,46 @@ def continue_branch(model, solutions: np.ndarray, q_first: np.ndarray, tcp=None
         branch = _matching_branch(solutions[row], previous)
         row += 1
     return chosen, found
+
+
+TURN_CHECK = np.pi / 3
+"""A Cartesian move whose tool turns by more than this (rad), or one of whose joints the
+chosen end turns by more than half a turn less this, has its end's whole turns checked along
+its path (:func:`continuous_end`)."""
+
+PATH_SAMPLES = 16
+"""Points on a Cartesian move's path at which :func:`continuous_end` follows the joints: a
+tool turn of at most 180° gives at most about 11° between points, well within half a turn."""
+
+
+def continuous_end(model, segment: Segment, q_from: np.ndarray, end: np.ndarray) -> np.ndarray:
+    """``end`` (rad, the move's target solution with each joint at the whole turn nearest
+    ``q_from``), turned by the whole turns the joints make when they follow the path from
+    ``q_from`` continuously on the same IK branch.
+
+    Nearest is wrong when a joint travels more than half a turn: a movel that turns the tool
+    174° (o2ac ``flip_endcap``) turns wrist 3 by 183° one way, and its nearest end lay 177°
+    the other way; the trace then followed the path and jumped a full turn at the end (a
+    false URS302 and a 10.98 rad/s URS304). Moves that turn the tool little are left as
+    they are; a path that leaves the reach or the branch keeps ``end`` (the trace shows it)."""
+    q_from = np.asarray(q_from, dtype=float)
+    end = np.asarray(end, dtype=float)
+    if not hasattr(model, "ik_all_many") or segment.kind not in ("movel", "movep", "movec"):
+        return end
+    rotation = segment.pose_start[:3, :3].T @ segment.pose_end[:3, :3]
+    turned = float(np.arccos(np.clip((np.trace(rotation) - 1.0) / 2.0, -1.0, 1.0)))
+    if turned <= TURN_CHECK and float(np.max(np.abs(end - q_from))) <= np.pi - TURN_CHECK \
+            and segment.kind != "movec":
+        return end
+    fractions = np.arange(1, PATH_SAMPLES + 1) / PATH_SAMPLES
+    solutions, _ = model.ik_all_many(segment.path_poses(fractions), tcp=segment.tcp)
+    path, found = continue_branch(model, solutions, q_from, segment.tcp)
+    if not found.all():
+        return end
+    turns = np.rint((path[-1] - end) / (2.0 * np.pi))
+    if not np.allclose(path[-1], end + 2.0 * np.pi * turns, atol=1e-6):
+        return end  # the path changes branch: the trace reports it
+    return end + 2.0 * np.pi * turns
 
 
 def _branch_of(model, q: np.ndarray, tcp) -> int | None:
