@@ -38,3 +38,32 @@ def test_the_move_ends_where_the_joints_get_along_the_path():
         planner.movel(robot.fk(START + TURN), 0.5, 0.05, 0.0, 0.0, None, 0.0)
         planner.resolve()
         assert np.allclose(planner.segments[-1].q_end, START + TURN, atol=1e-6)
+
+
+def _turn_in_place(args: str):
+    """A movel that only turns the tool 2.5 rad about its own axis, with ``args``."""
+    robot = Robot.model("ur5e")
+    here = from_matrix(robot.fk(START))
+    from urdsl.kinematics import pose as posemath
+
+    there = posemath.pose_trans(here, [0, 0, 0, 0, 0, 2.5])
+    text = ("def turn():\n  movel(p[" + ", ".join(f"{v:.9f}" for v in there) + f"], {args})\n"
+            "end\n")
+    options = CheckOptions(robot="ur5e", start_joints=tuple(START), timeout=None)
+    return [f for f in check_text(text, "turn.script", options=options).findings
+            if f.code == "URS304"]
+
+
+def test_a_wrist_over_its_limit_only_by_the_undocumented_turn_rate_is_a_warning():
+    """At v = 1 m/s a movel that only turns the tool is timed at 4 rad/s (the rate a user
+    measured, which UR does not document): wrist 3 over 3.14 rad/s by that rate is a
+    warning that says so, not an error."""
+    found = _turn_in_place("a=1.2, v=1.0")
+    assert [f.severity for f in found] == ["warning"]
+    assert "UR does not document" in found[0].message
+
+
+def test_a_time_the_program_asks_for_stays_an_error():
+    """The same turn in t = 0.8 s is what the program asks for: an error."""
+    found = _turn_in_place("a=1.2, v=1.0, t=0.8")
+    assert [f.severity for f in found] == ["error"]

@@ -204,8 +204,8 @@ def test_a_speed_a_move_ends_with_is_not_the_next_moves():
     qd[4, 5] = 7.0     # the movej's first sample: half of the movel's last step
     qd[5:, 5] = 1.0
     source = Source("movel(a)\nmovej(b)\n", "t.script")
-    segments = [SimpleNamespace(kind="movel", span=Span(source, 0, 8)),
-                SimpleNamespace(kind="movej", span=Span(source, 9, 17))]
+    segments = [SimpleNamespace(kind="movel", span=Span(source, 0, 8), params={}),
+                SimpleNamespace(kind="movej", span=Span(source, 9, 17), params={})]
     trace = SimpleNamespace(qd=qd, times=np.arange(8) * 0.002, segments=segments,
                             segment=np.array([0, 0, 0, 0, 1, 1, 1, 1]))
     (finding,) = joint_speeds(trace, limits)

@@ -418,11 +418,16 @@ class MotionPlanner:
                     params["until"] = True  # checked up to where it could stop
                     if beyond is not None:
                         self.warnings.append(self._search_warning(target, beyond, span, now))
+        turn_rule = v_rot is None and kind in ("movel", "movep")
         if v_rot is None:
             v_rot = ROTATION_PER_METRE * v
         if a_rot is None:
             a_rot = ROTATION_PER_METRE * a
         profile = line_profile(pose_from, pose, v, a, t, v_rot, a_rot)
+        length = float(np.linalg.norm(pose[:3, 3] - pose_from[:3, 3]))
+        if turn_rule and t <= 0 and \
+                profile.duration > Trapezoid.plan(length, v, a).duration + 1e-9:
+            params["turn_timed"] = True  # timed by its tool turn at ROTATION_PER_METRE·v [U]
         end = self._add_cartesian(kind, profile, pose_from, pose, r, span, params, now)
         if params.get("until"):
             # where the arm ends depends on the condition

@@ -14,7 +14,7 @@ one decorated function ``check(ctx) -> list[Finding]`` (and its test).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -165,13 +165,27 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
             inside &= ~exclude
         inside[carried] = False
         peak = float(np.max(np.abs(trace.qd[inside, joint])))
-        findings.append(Finding.of(
+        finding = Finding.of(
             "URS304",
             f"{JOINTS[joint]} joint turns at {peak:.2f} rad/s, over its limit of "
             f"{limits[joint]:.2f} rad/s",
             _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
-            cause=JOINTS[joint]))
+            cause=JOINTS[joint])
+        if segment >= 0 and trace.segments[segment].params.get("turn_timed") \
+                and peak <= TURN_TIMED_MARGIN * limits[joint]:
+            finding = replace(finding, severity="warning", message=(
+                f"{finding.message}; this {trace.segments[segment].kind} mostly turns the "
+                "tool, and its time is that turn's at 4·v rad/s, a rate UR does not document "
+                "(a user's measurement): the controller may turn the tool slower"))
+        findings.append(finding)
     return findings
+
+
+TURN_TIMED_MARGIN = 2.0
+'''A joint speed over its limit by at most this factor, on a movel or movep whose time is set
+by its tool turn (:data:`urdsl.motion.planner.ROTATION_PER_METRE`, [U]), is a URS304 warning:
+it follows from that undocumented rate. Faster (a path near a singularity: 30 rad/s in
+project 135) stays an error.'''
 
 
 def _carried(trace: Trace, over: np.ndarray) -> np.ndarray:
