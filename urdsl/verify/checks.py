@@ -602,7 +602,10 @@ faster than its limit, with the joint and its peak speed. A linear move near a s
 where the joints must turn fast for a slow TCP, causes it (the robot speeds up and stops with
 a joint limit violation [U: UR distributor Zacobria's notes on singularities]), and so does a
 movej whose time t is too short. A movej with a v over a joint's top speed is not: it is
-timed at the fastest speed the joints allow [U], and 'urdsl lint' warns about the v (URS110).""",
+timed at the fastest speed the joints allow [U], and 'urdsl lint' warns about the v (URS110).
+A movel or movep that mostly turns the tool is timed by its turn at 4·v rad/s, a rate a user
+measured and UR does not document [U]: a joint over its limit by at most 2x on such a move is
+a warning that says so (the controller may turn the tool slower).""",
     example=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], t=0.2)",
     fixed=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], t=2.0)",
 )
