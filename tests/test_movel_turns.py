@@ -67,3 +67,26 @@ def test_a_time_the_program_asks_for_stays_an_error():
     """The same turn in t = 0.8 s is what the program asks for: an error."""
     found = _turn_in_place("a=1.2, v=1.0, t=0.8")
     assert [f.severity for f in found] == ["error"]
+
+
+def test_a_speed_on_a_move_whose_path_fails_stays_an_error():
+    """On a move whose path leaves the workspace or jumps (URS302), a speed over the limit is
+    that failure's, not the turn rate's: it stays an error even when the move is timed by its
+    tool turn."""
+    from types import SimpleNamespace
+
+    from urdsl.script.nodes import Source, Span
+    from urdsl.verify.checks import joint_speeds
+
+    limits = np.full(6, 3.14)
+    qd = np.zeros((6, 6))
+    qd[1:5, 2] = 4.2  # the elbow over its limit, by less than 2x
+    source = Source("movel(a)\n", "t.script")
+    segments = [SimpleNamespace(kind="movel", span=Span(source, 0, 8),
+                                params={"turn_timed": True})]
+    trace = SimpleNamespace(qd=qd, times=np.arange(6) * 0.002, segments=segments,
+                            segment=np.zeros(6, dtype=int))
+    assert [f.severity for f in joint_speeds(trace, limits)] == ["warning"]
+    failed = np.zeros(6, dtype=bool)
+    failed[4:] = True  # URS302 reported the path's failure at the move's end
+    assert [f.severity for f in joint_speeds(trace, limits, exclude=failed)] == ["error"]

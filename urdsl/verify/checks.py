@@ -171,8 +171,9 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
             f"{limits[joint]:.2f} rad/s",
             _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
             cause=JOINTS[joint])
+        broken = exclude is not None and bool(exclude[trace.segment == segment].any())
         if segment >= 0 and trace.segments[segment].params.get("turn_timed") \
-                and peak <= TURN_TIMED_MARGIN * limits[joint]:
+                and peak <= TURN_TIMED_MARGIN * limits[joint] and not broken:
             finding = replace(finding, severity="warning", message=(
                 f"{finding.message}; this {trace.segments[segment].kind} mostly turns the "
                 "tool, and its time is that turn's at 4·v rad/s, a rate UR does not document "
@@ -185,7 +186,8 @@ TURN_TIMED_MARGIN = 2.0
 '''A joint speed over its limit by at most this factor, on a movel or movep whose time is set
 by its tool turn (:data:`urdsl.motion.planner.ROTATION_PER_METRE`, [U]), is a URS304 warning:
 it follows from that undocumented rate. Faster (a path near a singularity: 30 rad/s in
-project 135) stays an error.'''
+project 135), and any speed on a move whose path fails (URS302: it leaves the workspace or
+jumps), stay errors.'''
 
 
 def _carried(trace: Trace, over: np.ndarray) -> np.ndarray:
