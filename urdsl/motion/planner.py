@@ -806,8 +806,9 @@ def continuous_end(model, segment: Segment, q_from: np.ndarray, end: np.ndarray)
     Nearest is wrong when a joint travels more than half a turn: a movel that turns the tool
     174° (o2ac ``flip_endcap``) turns wrist 3 by 183° one way, and its nearest end lay 177°
     the other way; the trace then followed the path and jumped a full turn at the end (a
-    false URS302 and a 10.98 rad/s URS304). Moves that turn the tool little are left as
-    they are; a path that leaves the reach or the branch keeps ``end`` (the trace shows it)."""
+    false URS302 and a 10.98 rad/s URS304). Straight lines that turn the tool little, with no
+    joint near half a turn, are left as they are (an arc is always followed); a path that
+    leaves the reach or the branch keeps ``end`` (the trace shows it)."""
     q_from = np.asarray(q_from, dtype=float)
     end = np.asarray(end, dtype=float)
     if not hasattr(model, "ik_all_many") or segment.kind not in ("movel", "movep", "movec"):
