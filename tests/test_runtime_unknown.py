@@ -218,15 +218,23 @@ end
 """
 
 
+def spinning(text: str, line: int):
+    """The check's report of ``text``, whose one error is a loop without physical time
+    (URS207) at ``line``."""
+    from urdsl.verify.run import check_text
+
+    report = check_text(text, "spin.script")
+    (spin,) = [f for f in report.findings if f.severity == "error"]
+    assert spin.code == "URS207" and spin.span.line == line
+    return report
+
+
 def test_a_loop_that_acts_only_when_pushed_spins_when_nobody_pushes():
     # it moves while the operator pushes the arm, and loops without physical time when
     # nobody does: the check follows a working sensor for a few passes, then an idle one
     from urdsl.runtime.unknown import IDLE_AFTER_PASSES
-    from urdsl.verify.run import check_text
 
-    report = check_text(POLLING, "push.script")
-    (spin,) = [f for f in report.findings if f.severity == "error"]
-    assert spin.code == "URS207" and spin.span.line == 2
+    report = spinning(POLLING, 2)
     (note,) = [f for f in report.findings if f.span.line == 4]
     assert f"for the loop's first {IDLE_AFTER_PASSES} passes, then skips it" in note.message
     assert len(report.moves) == 1 + IDLE_AFTER_PASSES  # the pushes of the first passes
@@ -627,11 +635,7 @@ def test_a_plc_loop_that_waits_for_no_state_still_spins_when_the_plc_is_idle():
     # runs): while the register holds a value no branch waits for (0 at power-up), the loop
     # spins without time; the branch that stops the arm fires for a working PLC, and an
     # idle one (reads at rest) leaves the loop spinning, as on the controller
-    from urdsl.verify.run import check_text
-
-    report = check_text(PLC_SPIN, "plc.script")
-    (spin,) = [f for f in report.findings if f.severity == "error"]
-    assert spin.code == "URS207" and spin.span.line == 1
+    report = spinning(PLC_SPIN, 1)
     assert report.moves  # the working PLC's first order was followed
 
 

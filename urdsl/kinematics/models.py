@@ -48,12 +48,12 @@ JOINT_NAMES = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
 """The six joints of every UR arm, from the base out, as PolyScope names them (the URDF of
 the robot description calls them ``shoulder_pan_joint`` … ``wrist_3_joint``)."""
 
-#: The twist angles α_i [rad] shared by every UR arm.
 NOMINAL_ACCURACY = 0.005
 """How far (m) a real arm's TCP may lie from where the nominal DH table puts it: a factory
 calibration moves it by 1-7 mm (the residuals of waypoint pairs taught on real arms, see
 :func:`urdsl.verify.infer.infer`)."""
 
+#: The twist angles α_i [rad] shared by every UR arm.
 DH_ALPHA = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
 
 _TWO_PI = 2.0 * math.pi

@@ -512,7 +512,7 @@ def taught_beyond(findings: list, pairs, options, installation: str, *, joints: 
     so that limit was not in force then, and the installation beside the program is not the
     one it was taught with. They are warnings that say so; the limits the taught waypoints
     keep stay errors."""
-    from ..verify.checks import JOINTS, SAFETY_PLANE_TOLERANCE
+    from ..verify.checks import JOINTS, SAFETY_PLANE_TOLERANCE, past_plane
 
     beyond: dict[str, str] = {}  # a finding's cause -> the waypoint taught beyond its limit
     for pair in pairs:
@@ -524,11 +524,8 @@ def taught_beyond(findings: list, pairs, options, installation: str, *, joints: 
                 if q[joint] < options.q_min[joint] - 1e-6:
                     beyond.setdefault(f"{JOINTS[joint]} lower", pair.name)
         if planes:
-            where = np.asarray(pair.pose[:3], dtype=float)
             for plane in options.safety_planes:
-                normal = np.asarray(plane.normal, dtype=float)
-                normal = normal / np.linalg.norm(normal)
-                if -(where @ normal + float(plane.distance)) > SAFETY_PLANE_TOLERANCE:
+                if past_plane(pair.pose[:3], plane) > SAFETY_PLANE_TOLERANCE:
                     beyond.setdefault(f"plane {plane.name}", pair.name)
     if not beyond:
         return findings

@@ -479,6 +479,14 @@ link shapes may overlap, :data:`SELF_OVERLAP_TOLERANCE`): a
 waypoint taught on the plane's boundary is where the arm was."""
 
 
+def past_plane(points: np.ndarray, plane) -> np.ndarray:
+    """How far (m) ``points`` (..., 3) lie beyond a safety plane (``normal·x + distance < 0``
+    is its forbidden side; its normal need not be a unit vector): positive beyond it."""
+    normal = np.asarray(plane.normal, dtype=float)
+    normal = normal / np.linalg.norm(normal)
+    return -(np.asarray(points, dtype=float) @ normal + float(plane.distance))
+
+
 def safety_planes(trace: Trace, robot, planes, step: float = 0.02) -> list[Finding]:
     """URS308: the TCP, and the elbow where a plane restricts it, passes beyond a safety plane
     of the installation (``normal·x + distance < 0``), checked every ``step`` s of robot time
@@ -502,12 +510,10 @@ def safety_planes(trace: Trace, robot, planes, step: float = 0.02) -> list[Findi
     depth = np.zeros(len(index))
     what = np.empty(len(index), dtype=object)
     for plane in planes:
-        normal = np.asarray(plane.normal, dtype=float)
-        normal = normal / np.linalg.norm(normal)
         points = [("TCP", tcp)] + ([("elbow", elbow)] if plane.elbow and elbow is not None
                                    else [])
         for part, where in points:
-            past = -(where @ normal + float(plane.distance))
+            past = past_plane(where, plane)
             new = (past > SAFETY_PLANE_TOLERANCE) & ~beyond
             beyond |= new
             depth[new] = past[new]
