@@ -269,7 +269,9 @@ def test_blend_radius_over_half_a_neighbouring_segment():
 
 @pytest.mark.parametrize("at", [1, 32767, 32768, 32769, 40000 - 1])
 def test_a_jump_is_found_wherever_it_lies_in_a_long_trace(at):
-    """path_continuity works in blocks of samples: a jump on a block boundary counts too."""
+    """path_continuity works in blocks of samples: a jump on a block boundary counts too. The
+    move after the jump is not the arm's motion (the controller stops there): the other
+    checks leave it out, but keep what comes before the knot interval that draws the jump."""
     from types import SimpleNamespace
 
     import numpy as np
@@ -287,7 +289,7 @@ def test_a_jump_is_found_wherever_it_lies_in_a_long_trace(at):
     found = path_continuity(trace, np.full(6, 3.14))
     (finding,) = found.findings
     assert f"t={at * dt:.3f} s" in finding.message and "wrist 1" in finding.message
-    assert found.samples[at] and not found.samples[at + 3 if at + 3 < count else at - 3]
+    assert found.samples[at:].all() and not found.samples[:max(at - 20, 0)].any()
 
 
 # ---- issue 12, item 5: motion semantics found wrong on real programs -------------------------
@@ -413,7 +415,9 @@ def test_the_course_movel_from_a_singular_pose_is_still_found():
     mistakes = Path(__file__).parent.parent / "programs" / "mistakes"
     path = mistakes / "course_movel_from_singular.script"
     report = check(path.read_text(encoding="utf-8"))
-    assert {"URS302", "URS304"} <= set(report.codes())
+    # the arm stops where the path fails: no joint speed is reported for the trace after it,
+    # the singularities that make it fail are
+    assert {"URS302", "URS307"} <= set(report.codes())
     assert {f.span.line for f in report.findings if f.severity == "error"} == {20}
 
 

@@ -426,6 +426,22 @@ def test_a_hand_written_script_is_checked_on_an_assumed_model(tmp_path, capsys):
     assert [f["severity"] for f in report["findings"] if f["code"] == "URS301"] == ["error"]
 
 
+@pytest.mark.parametrize(("y", "severity"), [(-0.12, "warning"), (-0.05, "error")])
+def test_a_path_no_ur_model_can_follow_stays_an_error(tmp_path, capsys, y, severity):
+    # a tool-down line past the base's axis: 0.12 m from it, inside the UR5e's shoulder
+    # offset (0.133 m) but not the UR5's (0.109 m), is a warning on the assumed UR5e; 0.05 m
+    # from it no UR model can follow, and the path error stays one, as does the joint speed
+    # on the way there (a speed on the first line is a warning, if there is one)
+    text = (f"movej(get_inverse_kin(p[-0.4, {y}, 0.35, 0, 3.1416, 0]))\n"
+            f"movel(p[0.4, {y}, 0.35, 0, 3.1416, 0], a=1.2, v=0.25)\n")
+    report = _check_json(tmp_path, capsys, text)
+    (finding,) = [f for f in report["findings"] if f["code"] == "URS302"]
+    assert finding["severity"] == severity
+    assert ("no UR model can follow it" in finding["message"]) == (severity == "error")
+    speeds = {f["severity"] for f in report["findings"] if f["code"] == "URS304"}
+    assert speeds == ({"error"} if severity == "error" else speeds - {"error"})
+
+
 def test_a_fragment_of_a_polyscope_program_is_taught_too(tmp_path, capsys):
     # a script file a PolyScope program includes (it uses the program's `speed`): its moves
     # were taught on the program's arm, which is not known here

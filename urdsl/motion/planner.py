@@ -43,7 +43,8 @@ from .drift import Drift, drift_error
 from .profiles import Trapezoid
 
 __all__ = ["Segment", "MotionPlanner", "MotionWarning", "KinematicModel", "JOINT_SPACE",
-           "UnreachableTarget", "line_profile", "ROTATION_PER_METRE", "continue_branch"]
+           "UnreachableTarget", "line_profile", "ROTATION_PER_METRE", "continue_branch",
+           "branch_path"]
 
 BLENDABLE_INTO = frozenset({"movej", "movel", "movep", "movec"})
 """Moves the previous move may blend into (servoj and speedj start from rest)."""
@@ -827,6 +828,36 @@ def continuous_end(model, segment: Segment, q_from: np.ndarray, end: np.ndarray)
     if not np.allclose(path[-1], end + 2.0 * np.pi * turns, atol=1e-6):
         return end  # the path changes branch: the trace reports it
     return end + 2.0 * np.pi * turns
+
+
+def branch_path(model, segment: Segment, fractions: np.ndarray) -> np.ndarray | None:
+    """The joints (N, 6, rad) of a straight-line or circular move at path ``fractions``,
+    followed continuously from its start on the IK branch it starts on, with no regard to
+    the joint limits; NaN from the first point where that branch ends (out of reach) or
+    jumps (a singularity). None for joint moves, a singular start or a model without
+    analytic solutions.
+
+    Inverse kinematics keeps every point of a path inside the limits, so where this path
+    runs out of them (wrist 3 wound to -350° and then turned on) the trace jumps to another
+    branch; the controller stops the arm at the limit instead (a joint position limit
+    violation, [U] as the URS303 rule says)."""
+    if not hasattr(model, "ik_all_many") or segment.kind not in ("movel", "movep", "movec"):
+        return None
+    from ..kinematics.ik import choose_sequence
+
+    fractions = np.asarray(fractions, dtype=float)
+    branch = _branch_of(model, segment.q_start, segment.tcp)
+    if branch is None or len(fractions) == 0:
+        return None
+    solutions, _ = model.ik_all_many(segment.path_poses(fractions), tcp=segment.tcp)
+    endless = np.full(6, np.inf)
+    path, found = choose_sequence(solutions[:, branch:branch + 1], segment.q_start,
+                                  -endless, endless)
+    steps = np.abs(np.diff(np.vstack([segment.q_start, path]), axis=0))
+    broken = np.flatnonzero(~found | ~(steps <= STOP_JUMP).all(axis=1))
+    if len(broken):
+        path[int(broken[0]):] = np.nan
+    return path
 
 
 def _branch_of(model, q: np.ndarray, tcp) -> int | None:

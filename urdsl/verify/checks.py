@@ -22,7 +22,7 @@ import numpy as np
 from .._threads import shared_pool
 from ..kinematics.models import JOINT_NAMES
 from ..motion.planner import JOINT_SPACE
-from ..motion.trace import Trace
+from ..motion.trace import KNOT_TIME, Trace
 from ..rules import Rule, register
 from .findings import Finding
 
@@ -40,14 +40,18 @@ JOINTS = JOINT_NAMES
 class TraceContext:
     """What a trace check reads: the sampled ``trace``, the ``planner`` that made it (its
     segments), the ``robot`` model, the user's ``options`` and ``excluded``: (N,) bool, the
-    samples around jumps and unreachable stretches that other checks leave out (set by the
-    URS302 check, which runs first)."""
+    samples around jumps and unreachable stretches, and after the point where a move fails,
+    that other checks leave out (set by the URS302 check, which runs first)."""
 
     trace: Trace
     planner: Any
     robot: Any
     options: CheckOptions
     excluded: np.ndarray | None = None
+    path_limits: list[Finding] = field(default_factory=list)
+    """URS303 findings of the URS302 check: paths that run a joint into its limit."""
+    everywhere: dict[int, float] = field(default_factory=dict)
+    """Moves whose path no UR model can follow (see :attr:`Continuity.everywhere`)."""
     deadline: float | None = None
     """``time.monotonic()`` after which a long check stops where it got to (None: never)."""
     partial: dict[str, float] = field(default_factory=dict)
@@ -146,10 +150,12 @@ def joint_limits(trace: Trace, lower: np.ndarray, upper: np.ndarray,
     return findings
 
 
-def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = None
-                 ) -> list[Finding]:
+def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = None,
+                 everywhere: dict[int, float] | None = None) -> list[Finding]:
     """URS304: joint speeds above the model's limits (rad/s); samples in ``exclude`` (jumps
-    already reported by :func:`path_continuity`) are left out."""
+    already reported by :func:`path_continuity`) are left out. A speed on the way to where a
+    path leaves every UR model's workspace (``everywhere``: move → robot time, s) holds on
+    every model: the joints speed up without bound as the arm nears that edge."""
     bound = limits * (1 + 1e-6)
     over = _rows_where(trace.qd, lambda qd: np.abs(qd) > bound)
     if exclude is not None:
@@ -178,6 +184,10 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
                 f"{finding.message}; this {trace.segments[segment].kind} mostly turns the "
                 "tool, and its time is that turn's at 4·v rad/s, a rate UR does not document "
                 "(a user's measurement): the controller may turn the tool slower"))
+        if everywhere and segment in everywhere and trace.times[sample] <= everywhere[segment]:
+            finding = replace(finding, cause=f"{JOINTS[joint]}, {EVERY_MODEL}", message=(
+                f"{finding.message}, on the way to where the path leaves every UR model's "
+                "workspace (URS302)"))
         findings.append(finding)
     return findings
 
@@ -251,6 +261,17 @@ class Continuity:
 
     findings: list[Finding]
     samples: np.ndarray
+    limits: list[Finding] = field(default_factory=list)
+    """URS303: moves whose path runs a joint into its limit (reported by that check)."""
+    everywhere: dict[int, float] = field(default_factory=dict)
+    """Moves whose path leaves the workspace of every UR model → the robot time (s) where
+    it leaves the assumed model's."""
+
+
+EVERY_MODEL = "beyond every UR model's workspace"
+"""The cause of a URS302 whose path no UR model can follow, and the end of that of a URS304
+on the way there: they hold whichever arm runs the program (see
+:func:`urdsl.verify.infer.qualify`)."""
 
 
 JUMP_MIN = 0.25
@@ -259,12 +280,26 @@ the fastest joint speed of any UR (π rad/s) a joint moves 0.006 rad in a 2 ms s
 0.025 rad in an 8 ms step; a change of branch moves a joint by about π."""
 
 
-def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
+def path_continuity(trace: Trace, speed_limits: np.ndarray, model=None,
+                    every_model: bool = False) -> Continuity:
     """URS302: a TCP path (movel/movep/movec) that leaves the workspace between reachable
-    ends, or whose joints jump because inverse kinematics must change its branch."""
+    ends, or whose joints jump because inverse kinematics must change its branch; and, with
+    the kinematic ``model``, URS303 where the jump is a joint running into its limit
+    (:func:`urdsl.motion.planner.limit_on_path`).
+
+    The controller stops the arm where such a move fails. What the trace draws after that
+    point — the rest of the move on another branch, and the jump back to where the next move
+    starts — is motion the arm never makes: those samples go into the ``samples`` the other
+    checks leave out, and the jump back is not a failure of the next move.
+
+    With ``every_model`` (the arm's model is only assumed) a path that leaves the workspace
+    is also tried on every UR model: where none can follow it, the finding's cause says so
+    (:data:`EVERY_MODEL`), and so does that of a joint speed on the way there
+    (``Continuity.everywhere``)."""
     count = len(trace.times)
-    flagged = np.zeros(count, dtype=bool)
-    findings = []
+    findings: list[Finding] = []
+    limits: list[Finding] = []
+    everywhere: dict[int, float] = {}
     threshold = np.maximum(JUMP_MIN, 10.0 * speed_limits * trace.dt)
     jumps = np.zeros(count, dtype=bool)
     block = 32768
@@ -275,37 +310,157 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray) -> Continuity:
         (step > threshold).any(axis=1, out=jumps[start + 1:stop + 1])
 
     list(shared_pool().map(rows, range(0, count - 1, block)))
-    reported: set[int] = set()
-    for segment, sample in _per_segment(trace, trace.unreachable):
-        reported.add(segment)
+    bad = jumps | trace.unreachable
+    failed = np.zeros(count, dtype=bool)  # after the point where a move fails
+    for segment, first in _per_segment(trace, bad):
+        if segment < 0:
+            continue
+        low = int(np.searchsorted(trace.segment, segment, side="left"))
+        high = int(np.searchsorted(trace.segment, segment, side="right"))
+        if failed[first]:  # the trace coming back from an earlier move's failure
+            rest = np.flatnonzero(bad[first:high] & ~failed[first:high])
+            if len(rest) == 0:
+                continue
+            first += int(rest[0])
         move = trace.segments[segment]
-        inside = np.flatnonzero(trace.unreachable & (trace.segment == segment))
+        previous = trace.segments[segment - 1] if segment > 0 else None
+        start, limit = _failure(trace, move, previous, low, high, first, model)
+        if limit is not None:
+            sample, joint, bound = limit
+            fraction = float(move.profile.position(trace.times[sample] - move.start)
+                             / max(move.profile.distance, 1e-12))
+            side = "upper" if bound == float(model.q_max[joint]) else "lower"
+            limits.append(Finding.of(
+                "URS303",
+                f"the {move.kind} path takes the {JOINTS[joint]} joint to its limit of "
+                f"{np.degrees(bound):.1f}° at {100 * fraction:.0f}% of the way "
+                f"(t={trace.times[sample]:.3f} s): the controller stops the arm there",
+                _span(trace, segment), float(trace.times[sample]),
+                f"turn the {JOINTS[joint]} joint back with a movej before this move, or "
+                "split the move", cause=f"{JOINTS[joint]} {side}"))
+        else:
+            finding = _continuity_finding(trace, segment, first, jumps, threshold)
+            if every_model and finding.cause == "reach" and _beyond_every_model(trace, segment):
+                finding = replace(finding, cause=EVERY_MODEL,
+                                  message=f"{finding.message}; no UR model can follow it")
+                everywhere[segment] = finding.time
+            findings.append(finding)
+        failed[start:high] = True
+        after = np.flatnonzero(~bad[high:])  # the jump back to the next move's start
+        failed[high:high + (int(after[0]) if len(after) else count - high)] = True
+    near = bad | failed
+    flagged = near.copy()
+    for shift in (1, 2):  # central differences spread a jump to the neighbours
+        flagged[shift:] |= near[:-shift]
+        flagged[:-shift] |= near[shift:]
+    return Continuity(findings, flagged, limits, everywhere)
+
+
+def _continuity_finding(trace: Trace, segment: int, sample: int, jumps: np.ndarray,
+                        threshold: np.ndarray) -> Finding:
+    """URS302 for the move ``segment`` that fails at ``sample``: its path leaves the
+    workspace (some sample of it is out of reach) or its joints jump there."""
+    move = trace.segments[segment]
+    inside = np.flatnonzero(trace.unreachable & (trace.segment == segment))
+    if len(inside):
         fraction = (trace.times[inside] - move.start) / max(move.duration, 1e-12)
-        findings.append(Finding.of(
+        return Finding.of(
             "URS302",
             f"the {move.kind} path leaves the robot's workspace between "
             f"{100 * fraction.min():.0f}% and {100 * fraction.max():.0f}% of the way "
-            f"(t={trace.times[sample]:.3f} s), although both ends are reachable",
-            _span(trace, segment), float(trace.times[sample]),
-            "go round the unreachable region with a waypoint, or use movej", cause="reach"))
-    for segment, sample in _per_segment(trace, jumps):
-        if segment in reported or segment < 0:
-            continue
-        move = trace.segments[segment]
-        step = np.abs(trace.q[sample] - trace.q[sample - 1])
-        joint = int(np.argmax(step / threshold))
-        findings.append(Finding.of(
-            "URS302",
-            f"the {move.kind} path needs a change of IK solution: the {JOINTS[joint]} joint "
-            f"jumps by {np.degrees(step[joint]):.0f}° at "
-            f"t={trace.times[sample]:.3f} s, which the robot cannot do on a straight line",
-            _span(trace, segment), float(trace.times[sample]),
-            "split the move, or reach the end with movej", cause=f"jump {JOINTS[joint]}"))
-    bad = jumps | trace.unreachable
-    for shift in (-2, -1, 1, 2):  # central differences spread a jump to the neighbours
-        flagged |= np.roll(bad, shift)
-    flagged |= bad
-    return Continuity(findings, flagged)
+            f"(t={trace.times[inside[0]]:.3f} s), although both ends are reachable",
+            _span(trace, segment), float(trace.times[inside[0]]),
+            "go round the unreachable region with a waypoint, or use movej", cause="reach")
+    step = np.abs(trace.q[sample] - trace.q[sample - 1])
+    joint = int(np.argmax(step / threshold))
+    return Finding.of(
+        "URS302",
+        f"the {move.kind} path needs a change of IK solution: the {JOINTS[joint]} joint "
+        f"jumps by {np.degrees(step[joint]):.0f}° at "
+        f"t={trace.times[sample]:.3f} s, which the robot cannot do on a straight line",
+        _span(trace, segment), float(trace.times[sample]),
+        "split the move, or reach the end with movej", cause=f"jump {JOINTS[joint]}")
+
+
+DEPARTURE = 0.05
+"""Joint difference (rad, 2.9°) at which the trace of a failing move has left the path its
+joints take on the IK branch it starts on. Away from singularities the trace's cubics are
+within a micro-radian of that path (:data:`urdsl.motion.trace.KNOT_TIME`); near one, where
+the joints swing at tens of rad/s, measured up to 0.006 rad (project 135); a jump to another
+branch moves a joint by a large fraction of a turn. The trace has left the path from where
+that difference starts to grow towards it (down to :data:`DEPARTURE_FLOOR`)."""
+
+DEPARTURE_FLOOR = 1e-5
+"""Joint difference (rad) below which the trace of a failing move is still on its path."""
+
+
+BEYOND_SAMPLES = 256
+"""Points of a path, evenly spaced, at which :func:`_beyond_every_model` tries each model,
+besides the samples where the assumed model could not follow it."""
+
+
+def _beyond_every_model(trace: Trace, segment: int) -> bool:
+    """Whether some point of the path of the Cartesian move ``segment`` lies outside the
+    workspace of every UR model with the move's TCP, whatever the joint limits (a straight
+    line that passes the base's vertical axis closer than any arm's shoulder offset)."""
+    from ..kinematics import MODELS, Robot
+
+    move = trace.segments[segment]
+    inside = np.flatnonzero(trace.unreachable & (trace.segment == segment))
+    local = np.clip(trace.times[inside] - move.start, 0.0, move.duration)
+    covered = move.profile.position(local) / max(move.profile.distance, 1e-12)
+    poses = move.path_poses(np.concatenate([np.linspace(0.0, 1.0, BEYOND_SAMPLES), covered]))
+    for name in MODELS:
+        solutions, _ = Robot.model(name).ik_all_many(poses, tcp=move.tcp)
+        if not np.isnan(solutions).all(axis=(1, 2)).any():
+            return False  # this model reaches every point
+    return True
+
+
+def _failure(trace: Trace, move, previous, low: int, high: int, first: int, model
+             ) -> tuple[int, tuple[int, int, float] | None]:
+    """Where the Cartesian ``move`` (samples ``low`` to ``high`` − 1 of the trace, flagged
+    first at ``first``) fails: the sample from which its trace is no longer the arm's motion,
+    and ``(sample, joint, bound in rad)`` when the reason is a joint running into its limit
+    (:func:`urdsl.motion.planner.branch_path`), else None.
+
+    A jump between two knots of the trace is drawn over the samples between them (up to
+    :data:`urdsl.motion.trace.KNOT_TIME`, or 8 mm of a slow path): the trace leaves the
+    branch before the jump is flagged. Samples in a blend from ``previous`` (the move
+    before) are not compared: both moves add up there."""
+    fallback = max(low, first - int(np.ceil(KNOT_TIME / trace.dt))), None
+    if model is None or move.kind in JOINT_SPACE or move.profile.distance <= 0.0:
+        return fallback
+    from ..motion.planner import branch_path
+
+    local = np.clip(trace.times[low:high] - move.start, 0.0, move.duration)
+    path = branch_path(model, move, move.profile.position(local) / move.profile.distance)
+    if path is None:
+        return fallback
+    valid = int(np.argmax(np.isnan(path).any(axis=1))) if np.isnan(path).any() \
+        else len(path)
+    blended = 0 if previous is None else \
+        int(np.searchsorted(trace.times[low:high], previous.end, side="left"))
+    apart = np.abs(trace.q[low + blended:low + valid] - path[blended:valid]).max(axis=1) \
+        if valid > blended else np.zeros(0)
+    left = np.flatnonzero(apart > DEPARTURE)
+    departure = first
+    if len(left):
+        row = int(left[0])
+        while row > 0 and DEPARTURE_FLOOR < apart[row - 1] < apart[row]:
+            row -= 1  # back to where the difference starts to grow
+        departure = low + blended + row
+    departure = min(departure, first)
+    low_limit = np.asarray(model.q_min, dtype=float)
+    high_limit = np.asarray(model.q_max, dtype=float)
+    outside = (path[:valid] < low_limit - 1e-9) | (path[:valid] > high_limit + 1e-9)
+    rows = np.flatnonzero(outside.any(axis=1))
+    if len(rows) == 0 or low + int(rows[0]) < departure:
+        return departure, None
+    row = int(rows[0])
+    joint = int(np.argmax(outside[row]))
+    bound = high_limit[joint] if path[row, joint] > high_limit[joint] else low_limit[joint]
+    return departure, (low + row, joint, float(bound))
 
 
 def _tcp_positions(trace: Trace, robot, stride: int = 1) -> tuple[np.ndarray, np.ndarray]:
@@ -329,10 +484,12 @@ def _tcp_group_of_samples(trace: Trace, index: np.ndarray) -> tuple[np.ndarray, 
     return np.append(group_of_move, group_of_move[:1])[trace.segment[index]], tcps
 
 
-def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
+def tcp_speed(trace: Trace, robot, limit: float, exclude: np.ndarray | None = None
+              ) -> list[Finding]:
     """URS306: the TCP moves faster than the user's limit (m/s), e.g. 0.25 m/s in a
     collaborative cell. Where the program changed its TCP (``set_tcp``) between two samples,
-    the TCP point jumps without the arm moving: each side is differentiated on its own."""
+    the TCP point jumps without the arm moving: each side is differentiated on its own.
+    Samples in ``exclude`` are left out."""
     positions, index = _tcp_positions(trace, robot)
     if len(positions) < 2:
         speed = np.zeros(len(positions))
@@ -349,6 +506,8 @@ def tcp_speed(trace: Trace, robot, limit: float) -> list[Finding]:
                 else 0.0
         speed = np.linalg.norm(velocity, axis=1)
     over = speed > limit * (1 + 1e-6)  # every sample (stride 1): one row a sample
+    if exclude is not None:
+        over &= ~exclude
     over[_carried(trace, over)] = False
     findings = []
     for segment, sample in _per_segment(trace, over):
@@ -423,13 +582,15 @@ the cell file are the user's own shapes: any overlap with them is reported."""
 
 def collisions(trace: Trace, robot, cell, step: float = 0.02,
                self_collision: bool = True, deadline: float | None = None,
-               partial: dict[str, float] | None = None) -> list[Finding]:
+               partial: dict[str, float] | None = None,
+               exclude: np.ndarray | None = None) -> list[Finding]:
     """URS308: the arm hits the cell's obstacles (floor, boxes, cylinders, planes) or itself,
     checked every ``step`` s of robot time while it moves, or further apart where it cannot
     come into contact in between (see :meth:`CollisionModel.sweep`). ``cell`` is a path of a
     cell TOML or a ready :class:`urdsl.kinematics.collision.CollisionModel` (None: no
     obstacles). With a ``deadline`` (``time.monotonic()``) the sweep stops once it has
-    passed; ``partial["collisions"]`` then holds the robot time (s) checked up to."""
+    passed; ``partial["collisions"]`` then holds the robot time (s) checked up to. Samples
+    in ``exclude`` are left out."""
     if cell is None and not self_collision:
         return []
     from ..kinematics.collision import LINKS, CollisionModel
@@ -458,6 +619,8 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
             colliding[i] = False  # within what the approximate link shapes can tell
     hit = np.zeros(len(trace.times), dtype=bool)
     hit[index] = colliding
+    if exclude is not None:
+        hit &= ~exclude
     position = {int(sample): i for i, sample in enumerate(index)}
     findings = []
     for segment, sample in _per_segment(trace, hit):
@@ -487,11 +650,13 @@ def past_plane(points: np.ndarray, plane) -> np.ndarray:
     return -(np.asarray(points, dtype=float) @ normal + float(plane.distance))
 
 
-def safety_planes(trace: Trace, robot, planes, step: float = 0.02) -> list[Finding]:
+def safety_planes(trace: Trace, robot, planes, step: float = 0.02,
+                  exclude: np.ndarray | None = None) -> list[Finding]:
     """URS308: the TCP, and the elbow where a plane restricts it, passes beyond a safety plane
     of the installation (``normal·x + distance < 0``), checked every ``step`` s of robot time
-    from the first move on. The controller's safety system watches these points of the arm
-    (and the tool's spheres), not its links: a forearm that reaches over a plane is allowed."""
+    from the first move on, but not at samples in ``exclude``. The controller's safety
+    system watches these points of the arm (and the tool's spheres), not its links: a
+    forearm that reaches over a plane is allowed."""
     if not planes or not trace.segments:
         return []
     from ..kinematics import Robot
@@ -520,6 +685,8 @@ def safety_planes(trace: Trace, robot, planes, step: float = 0.02) -> list[Findi
             what[new] = f"the {part} passes the safety plane {plane.name}"
     hit = np.zeros(len(trace.times), dtype=bool)
     hit[index[beyond]] = True
+    if exclude is not None:
+        hit &= ~exclude
     position = {int(sample): i for i, sample in enumerate(index)}
     findings = []
     for segment, sample in _per_segment(trace, hit):
@@ -547,16 +714,22 @@ Both ends of a straight-line (or circular) move are reachable, but a point betwe
 not, or the joints would have to jump to another inverse-kinematics solution on the way.
 The controller computes the path in Cartesian space and stops the program with a protective
 stop when it cannot follow it. urdsl samples the path at the controller rate and reports the
-move with the fraction of the way where it fails, or the joint that jumps. Samples around
-the failure are left out of the other checks.""",
+move with the fraction of the way where it fails, or the joint that jumps. The rest of the
+move after that point, and the way back to where the next move starts, are motion the arm
+never makes: the checks of joint limits, speeds, TCP speed and collisions leave them out
+(singularity warnings do not: a singular pose is often why the move fails). Where the
+continuous solution runs a joint into its limit, the finding is URS303.""",
     example="movej(get_inverse_kin(p[0.35, -0.2, 0.3, 0, 3.1416, 0]))\n"
             "movel(p[-0.35, 0.2, 0.3, 0, 3.1416, 0])  # through the base's axis",
     fixed="movej(get_inverse_kin(p[0.35, -0.2, 0.3, 0, 3.1416, 0]))\n"
           "movej(get_inverse_kin(p[-0.35, 0.2, 0.3, 0, 3.1416, 0]))",
 )
 def _continuity(ctx: TraceContext) -> list[Finding]:
-    result = path_continuity(ctx.trace, np.asarray(ctx.robot.qd_max))
+    result = path_continuity(ctx.trace, np.asarray(ctx.robot.qd_max), ctx.planner.kinematics,
+                             every_model=ctx.options.robot_assumed)
     ctx.excluded = result.samples
+    ctx.path_limits = result.limits
+    ctx.everywhere = result.everywhere
     return result.findings
 
 
@@ -567,7 +740,10 @@ def _continuity(ctx: TraceContext) -> list[Finding]:
 Every UR joint turns at most ±360° (±2π rad) from zero (the UR3/UR3e wrist 3 without
 limit); a cell may set tighter limits in the safety configuration (urdsl check --q-min,
 --q-max). A movej target outside them, or a linear move whose inverse kinematics lead a
-joint there, stops the robot. The finding names the joint, the angle and the limit.""",
+joint there, stops the robot. On a straight line the joints follow one solution
+continuously; where that runs a joint into the model's limit (wrist 3 wound to -350° by an
+earlier move, then turned on), the finding says how far along the move the arm stops [U].
+The finding names the joint, the angle and the limit.""",
     example=f"{_READY}\nmovej([0, -1.9, 1.9, -1.57, -1.57, 6.5])",
     fixed=f"{_READY}\nmovej([0, -1.9, 1.9, -1.57, -1.57, 0.2168])  # 6.5 - 2*pi",
 )
@@ -575,7 +751,10 @@ def _joint_limits(ctx: TraceContext) -> list[Finding]:
     options, robot = ctx.options, ctx.robot
     q_min = np.asarray(options.q_min if options.q_min is not None else robot.q_min)
     q_max = np.asarray(options.q_max if options.q_max is not None else robot.q_max)
-    return joint_limits(ctx.trace, q_min, q_max, _unknown_starts(ctx))
+    unknown = _unknown_starts(ctx)
+    if ctx.excluded is not None:
+        unknown = ctx.excluded if unknown is None else unknown | ctx.excluded
+    return ctx.path_limits + joint_limits(ctx.trace, q_min, q_max, unknown)
 
 
 def _unknown_starts(ctx: TraceContext) -> np.ndarray | None:
@@ -622,7 +801,7 @@ def _joint_speeds(ctx: TraceContext) -> list[Finding]:
     limit = getattr(ctx.options, "joint_speed_limit", None)
     if limit is not None:  # the installation's safety limits, lower than the arm's
         qd_max = np.minimum(qd_max, np.asarray(limit, dtype=float))
-    return joint_speeds(ctx.trace, qd_max, exclude=ctx.excluded)
+    return joint_speeds(ctx.trace, qd_max, exclude=ctx.excluded, everywhere=ctx.everywhere)
 
 
 @trace_check(
@@ -658,7 +837,7 @@ with its peak TCP speed.""",
     applies=lambda options: options.tcp_speed_limit is not None,
 )
 def _tcp_speed(ctx: TraceContext) -> list[Finding]:
-    return tcp_speed(ctx.trace, ctx.robot, ctx.options.tcp_speed_limit)
+    return tcp_speed(ctx.trace, ctx.robot, ctx.options.tcp_speed_limit, ctx.excluded)
 
 
 @trace_check(
@@ -696,8 +875,9 @@ cell.toml) and against each other. The finding names the colliding pair and the 
 def _collisions(ctx: TraceContext) -> list[Finding]:
     options = ctx.options
     return collisions(ctx.trace, ctx.robot, options.cell, options.collision_step,
-                      options.self_collision, ctx.deadline, ctx.partial) + \
-        safety_planes(ctx.trace, ctx.robot, options.safety_planes, options.collision_step)
+                      options.self_collision, ctx.deadline, ctx.partial, ctx.excluded) + \
+        safety_planes(ctx.trace, ctx.robot, options.safety_planes, options.collision_step,
+                      ctx.excluded)
 
 
 @trace_check(

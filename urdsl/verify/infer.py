@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..script import nodes as n
+from .checks import EVERY_MODEL
 from .run import DEFAULT_START, DRIFT, CheckOptions
 
 __all__ = ["WaypointPair", "Inference", "waypoint_pairs", "static_tcp", "static_tcps",
@@ -486,7 +487,8 @@ def qualify(report, inference: Inference) -> None:
     findings that hold only for the assumed model (``MODEL_DEPENDENT``) are not certain: they
     become warnings that say so (a program written for a UR10 is not wrong because a UR5e
     cannot reach its poses). A target that no UR model reaches (farther from the shoulder
-    than the longest arm's reach plus the TCP) stays an error."""
+    than the longest arm's reach plus the TCP), and a path that none can follow
+    (:data:`urdsl.verify.checks.EVERY_MODEL`), stay errors."""
     if inference.robot_source != "default":
         return
     why = ("the robot this program was taught on is not known" if inference.polyscope
@@ -496,8 +498,8 @@ def qualify(report, inference: Inference) -> None:
     tcp_length = float(np.linalg.norm(inference.tcp[:3])) if inference.tcp else 0.0
     qualified = []
     for finding in report.findings:
-        if finding.cause == DRIFT:  # judged on the widest UR model already
-            qualified.append(finding)
+        if finding.cause == DRIFT or (finding.cause or "").endswith(EVERY_MODEL):
+            qualified.append(finding)  # judged on every UR model already
             continue
         if finding.severity == "error" and finding.code in MODEL_DEPENDENT:
             match = _POSITION.search(finding.message) if finding.code == "URS301" else None
