@@ -277,3 +277,24 @@ def test_sweep_finds_what_checking_every_sample_finds():
     np.testing.assert_array_equal(result.distance, dense.distance[index])
     at_rest = np.repeat(HOME[None], 500, axis=0)
     assert len(model.sweep(at_rest)[0]) == 1   # nothing moves: one check
+
+
+def test_a_statement_that_folds_the_arm_onto_itself_is_one_finding_however_the_pairs_differ():
+    """A loop's second pass folds the arm at other link pairs (project 135 program3:53): the
+    same problem, reported once; hitting the cell's obstacles is another cause."""
+    from urdsl.verify.checks import _collision_cause
+    from urdsl.verify.findings import Finding
+    from urdsl.verify.report import Report
+
+    first = [("shoulder", "forearm"), ("shoulder", "wrist_1"), ("upper_arm", "wrist_1")]
+    second = [("shoulder", "forearm"), ("upper_arm", "wrist_1")]
+    table = [("forearm", "table"), ("wrist_3", "table")]
+    assert _collision_cause(first, LINKS) == _collision_cause(second, LINKS) == "self"
+    assert _collision_cause(table, LINKS) == "obstacle table"
+    report = Report("p.script", "ur5")
+    report.findings = [
+        Finding.of("URS308", f"collision {n}", time=t, cause=_collision_cause(pairs, LINKS))
+        for n, t, pairs in ((1, 1.0, first), (2, 21.0, second), (3, 22.0, table))]
+    report.sort()
+    assert [f.message for f in report.findings] == [
+        "collision 1 (2 times, first at t=1.000 s)", "collision 3"]

@@ -632,8 +632,17 @@ def collisions(trace: Trace, robot, cell, step: float = 0.02,
             "URS308", f"collision: {what} (overlap {depth * 1000:.0f} mm) at "
             f"t={trace.times[sample]:.3f} s",
             _span(trace, segment), float(trace.times[sample]),
-            "move around the obstacle with an extra waypoint", cause=what))
+            "move around the obstacle with an extra waypoint",
+            cause=_collision_cause(pairs, LINKS)))
     return findings
+
+
+def _collision_cause(pairs, links) -> str:
+    """What a collision hits, as one cause per statement: the cell's obstacles by name, or
+    the arm itself — a loop's later pass that folds the arm onto itself at other link pairs
+    (the path differs by a millimetre) is the same problem, reported once."""
+    obstacles = sorted({name for pair in pairs for name in pair if name not in links})
+    return "obstacle " + ", ".join(obstacles) if obstacles else "self"
 
 
 SAFETY_PLANE_TOLERANCE = 0.005
