@@ -178,12 +178,17 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
             _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
             cause=JOINTS[joint])
         broken = exclude is not None and bool(exclude[trace.segment == segment].any())
-        if segment >= 0 and trace.segments[segment].params.get("turn_timed") \
-                and peak <= TURN_TIMED_MARGIN * limits[joint] and not broken:
+        move = trace.segments[segment] if segment >= 0 else None
+        if move is not None and move.kind in SCALED_KINDS and not broken \
+                and peak <= SCALED_MARGIN * limits[joint] and not move.params.get("t", 0) > 0:
             finding = replace(finding, severity="warning", message=(
-                f"{finding.message}; this {trace.segments[segment].kind} mostly turns the "
-                "tool, and its time is that turn's at 4·v rad/s, a rate UR does not document "
-                "(a user's measurement): the controller may turn the tool slower"))
+                f"{finding.message}; this {move.kind} mostly turns the tool, and its time is "
+                "that turn's at 4·v rad/s, a rate UR does not document (a user's "
+                "measurement): the controller may turn the tool slower"
+                if move.params.get("turn_timed") else
+                f"{finding.message}; the controller slows a program's moves so that no joint "
+                f"exceeds its speed limit (UR user manual, safety joint limits): this "
+                f"{move.kind} takes longer than planned"))
         if everywhere and segment in everywhere and trace.times[sample] <= everywhere[segment]:
             finding = replace(finding, cause=f"{JOINTS[joint]}, {EVERY_MODEL}", message=(
                 f"{finding.message}, on the way to where the path leaves every UR model's "
@@ -192,12 +197,21 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
     return findings
 
 
-TURN_TIMED_MARGIN = 2.0
-'''A joint speed over its limit by at most this factor, on a movel or movep whose time is set
-by its tool turn (:data:`urdsl.motion.planner.ROTATION_PER_METRE`, [U]), is a URS304 warning:
-it follows from that undocumented rate. Faster (a path near a singularity: 30 rad/s in
-project 135), and any speed on a move whose path fails (URS302: it leaves the workspace or
-jumps), stay errors.'''
+SCALED_MARGIN = 2.0
+'''A joint speed over its limit by at most this factor on a movej, movel, movep or movec is a
+URS304 warning: the controller slows a running program so that no joint exceeds its speed
+limit, and stops it only when one does (CB3 user manual 3.4, safety "Joint Limits": "the speed
+of the robot arm is automatically adjusted in order to not exceed any of the entered values";
+the e-Series' the same [U]), so such a move takes longer rather than stopping. On a movel or
+movep timed by its tool turn (:data:`urdsl.motion.planner.ROTATION_PER_METRE`, [U]) the speed
+may also come from that undocumented rate. These stay errors: a speed over this factor (a
+path near a singularity, where the joints speed up without bound: 30 rad/s in project 135, and
+UR's distributor notes say the arm stops [U]), a move whose time ``t`` the program gives
+(whether the controller stretches a given time is not documented [U]), servo and speed
+commands, and any speed on a move whose path fails (URS302/URS303).'''
+
+SCALED_KINDS = frozenset({"movej", "movel", "movep", "movec"})
+"""Moves whose speed the controller's trajectory generator scales (:data:`SCALED_MARGIN`)."""
 
 
 def _carried(trace: Trace, over: np.ndarray) -> np.ndarray:
@@ -799,9 +813,12 @@ where the joints must turn fast for a slow TCP, causes it (the robot speeds up a
 a joint limit violation [U: UR distributor Zacobria's notes on singularities]), and so does a
 movej whose time t is too short. A movej with a v over a joint's top speed is not: it is
 timed at the fastest speed the joints allow [U], and 'urdsl lint' warns about the v (URS110).
-A movel or movep that mostly turns the tool is timed by its turn at 4·v rad/s, a rate a user
-measured and UR does not document [U]: a joint over its limit by at most 2x on such a move is
-a warning that says so (the controller may turn the tool slower).""",
+The controller slows a running program so that no joint exceeds its speed limit (the user
+manual's safety joint limits): a joint over its limit by at most 2x on a movej, movel, movep
+or movec is a warning that the move takes longer than planned, unless the program gives its
+time t. Faster, near a singularity, the arm stops. A movel or movep that mostly turns the
+tool is timed by its turn at 4·v rad/s, a rate a user measured and UR does not document [U]:
+its warning says so.""",
     example=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], t=0.2)",
     fixed=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], t=2.0)",
 )

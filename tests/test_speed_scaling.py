@@ -1,0 +1,67 @@
+"""A joint over its speed limit on an ordinary move (issue 12): the controller slows a running
+program so that no joint exceeds its limit, and stops it only when one does (CB3 user manual,
+safety "Joint Limits"). Up to 2x over, the move takes longer: a URS304 warning that says so
+(project 126's UR10 rack loop at v=1 m/s, CA-Giken TEST_SUB_106). Faster — near a singularity,
+where the joints speed up without bound — a time the program gives, servo commands and a move
+whose path fails stay errors."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from urdsl.kinematics import Robot
+from urdsl.kinematics.pose import from_matrix
+from urdsl.script.nodes import Source, Span
+from urdsl.verify.checks import joint_speeds
+from urdsl.verify.run import CheckOptions, check_text
+
+START = np.array([0.0, -1.2, 1.6, -1.97, -1.5708, 0.0])
+
+
+def _sweep(v: float, t: float = 0.0) -> list:
+    """A UR10 movel that swings the base 1 rad on a chord at ``v`` m/s (``t`` s if given)."""
+    pose = from_matrix(Robot.model("ur10").fk(START + np.array([1.0, 0, 0, 0, 0, 0])))
+    args = f"a=10, v={v}" + (f", t={t}" if t else "")
+    text = ("def sweep():\n  movel(p[" + ", ".join(f"{x:.9f}" for x in pose) + f"], {args})\n"
+            "end\n")
+    options = CheckOptions(robot="ur10", start_joints=tuple(START), timeout=None)
+    return [f for f in check_text(text, "sweep.script", options=options).findings
+            if f.code == "URS304"]
+
+
+def test_a_fast_movel_a_little_over_a_joint_limit_is_a_warning_that_it_takes_longer():
+    found = _sweep(2.0)
+    assert [(f.severity, f.message.split(" joint")[0]) for f in found] == [("warning", "base")]
+    assert "takes longer than planned" in found[0].message
+
+
+def test_a_time_the_program_gives_stays_an_error():
+    found = _sweep(2.0, t=0.35)
+    assert [f.severity for f in found] == ["error"]
+
+
+def _speeds(kind: str, factor: float, **params) -> list[str]:
+    limits = np.full(6, 3.14)
+    qd = np.zeros((6, 6))
+    qd[1:5, 0] = 3.14 * factor
+    source = Source("movel(a)\n", "t.script")
+    segments = [SimpleNamespace(kind=kind, span=Span(source, 0, 8), params=params)]
+    trace = SimpleNamespace(qd=qd, times=np.arange(6) * 0.002, segments=segments,
+                            segment=np.zeros(6, dtype=int))
+    return [f.severity for f in joint_speeds(trace, limits)]
+
+
+@pytest.mark.parametrize(("kind", "factor", "params", "severity"), [
+    ("movel", 1.5, {}, "warning"),
+    ("movej", 1.9, {"t": 0.0}, "warning"),
+    ("movec", 1.2, {}, "warning"),
+    ("movel", 2.5, {}, "error"),          # near a singularity: the arm stops
+    ("movej", 1.5, {"t": 0.4}, "error"),  # the time the program asks for
+    ("servoj", 1.5, {"t": 0.008}, "error"),
+    ("speedj", 1.5, {}, "error"),
+])
+def test_which_speeds_the_controller_slows(kind, factor, params, severity):
+    assert _speeds(kind, factor, **params) == [severity]
