@@ -7,6 +7,7 @@ and URS304)."""
 from __future__ import annotations
 
 import numpy as np
+from _one_move import one_movel
 
 from urdsl.kinematics import Robot
 from urdsl.kinematics.pose import from_matrix
@@ -47,11 +48,7 @@ def _turn_in_place(args: str):
     from urdsl.kinematics import pose as posemath
 
     there = posemath.pose_trans(here, [0, 0, 0, 0, 0, 2.5])
-    text = ("def turn():\n  movel(p[" + ", ".join(f"{v:.9f}" for v in there) + f"], {args})\n"
-            "end\n")
-    options = CheckOptions(robot="ur5e", start_joints=tuple(START), timeout=None)
-    return [f for f in check_text(text, "turn.script", options=options).findings
-            if f.code == "URS304"]
+    return [f for f in one_movel("ur5e", START, there, args) if f.code == "URS304"]
 
 
 def test_a_wrist_over_its_limit_only_by_the_undocumented_turn_rate_is_a_warning():

@@ -11,12 +11,12 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _one_move import one_movel
 
 from urdsl.kinematics import Robot
 from urdsl.kinematics.pose import from_matrix
 from urdsl.script.nodes import Source, Span
 from urdsl.verify.checks import joint_speeds
-from urdsl.verify.run import CheckOptions, check_text
 
 START = np.array([0.0, -1.2, 1.6, -1.97, -1.5708, 0.0])
 
@@ -25,11 +25,7 @@ def _sweep(v: float, t: float = 0.0) -> list:
     """A UR10 movel that swings the base 1 rad on a chord at ``v`` m/s (``t`` s if given)."""
     pose = from_matrix(Robot.model("ur10").fk(START + np.array([1.0, 0, 0, 0, 0, 0])))
     args = f"a=10, v={v}" + (f", t={t}" if t else "")
-    text = ("def sweep():\n  movel(p[" + ", ".join(f"{x:.9f}" for x in pose) + f"], {args})\n"
-            "end\n")
-    options = CheckOptions(robot="ur10", start_joints=tuple(START), timeout=None)
-    return [f for f in check_text(text, "sweep.script", options=options).findings
-            if f.code == "URS304"]
+    return [f for f in one_movel("ur10", START, pose, args) if f.code == "URS304"]
 
 
 def test_a_fast_movel_a_little_over_a_joint_limit_is_a_warning_that_it_takes_longer():
