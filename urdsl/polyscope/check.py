@@ -382,7 +382,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     from ..script.diagnostics import ScriptError
     from ..script.parser import parse
     from ..verify.findings import Finding
-    from ..verify.infer import apply, infer, waypoint_pairs
+    from ..verify.infer import apply, infer, qualify, waypoint_pairs, within_nominal_accuracy
     from ..verify.run import check_text, check_tree
 
     generated = generate(path)
@@ -438,6 +438,12 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
                 f"{v:.6g}" for v in tcps[0]) + "], the installation's active TCP is p["
                 + ", ".join(f"{v:.6g}" for v in active) + "]: the active TCP goes to the taught "
                 "poses, so the arm's joints are not those taught")
+            if inference.start_source == "inferred":
+                # PolyScope brings the arm to the first move's target as the active TCP
+                # reaches it, not to the joints taught with the other TCP
+                file_options = dataclasses.replace(file_options, start_unknown=True)
+                notes.append("where the arm starts is not known (not the first waypoint's "
+                             "taught joints): the first move is not checked")
     if cell_path and file_options.robot != options.robot:
         from .._cli import load_cell
 
@@ -477,6 +483,11 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
             planes=borrowed_planes)
     if tcp_unknown:
         report.findings = tcp_dependent(report.findings, len(tcps))
+    # as for a script: on a model only assumed, what depends on it is a warning; a target
+    # a fraction of a millimetre beyond the nominal reach, the arm's calibration decides
+    qualify(report, inference)
+    if file_options.calibration is None:
+        within_nominal_accuracy(report)
     report.findings = node_findings(generated, report.findings)
     source = module.span.source
     for diagnostic in urcap_diagnostics(generated):

@@ -111,6 +111,12 @@ def _installation_for(program: Program, path: str | Path,
         if named is not None and named.is_file():
             candidate = named
             break
+    if candidate is None and program.installation:
+        candidate = _named_above(folder, program.installation)
+        if candidate is not None:
+            warn(f"{path}: the installation it names is not beside it; compiled with "
+                 f"{candidate}, the one of that name in a folder above (PolyScope saved the "
+                 "program beside it, in a folder the program has since been moved out of)")
     if candidate is None:
         candidate = find_installation(path)
         if candidate is not None and not names_installation(program, str(candidate)):
@@ -128,6 +134,25 @@ def _installation_for(program: Program, path: str | Path,
     except InstallationError as error:
         warn(f"{error}; compiled without it")
         return None
+
+
+INSTALLATION_LEVELS = 3
+"""How many folders above a program :func:`_installation_for` looks for the installation it
+names, when it is not beside it: PolyScope users sort programs into subfolders of the
+programs folder, whose installation stays at its top."""
+
+
+def _named_above(folder: Path, name: str) -> Path | None:
+    """``NAME.installation`` in one of the :data:`INSTALLATION_LEVELS` folders above
+    ``folder``, the nearest first, not above a repository's top (a folder holding ``.git``)."""
+    for _level in range(INSTALLATION_LEVELS):
+        if (folder / ".git").exists() or folder.parent == folder:
+            return None
+        folder = folder.parent
+        candidate = folder / f"{name}.installation"
+        if candidate.is_file():
+            return candidate
+    return None
 
 
 def load(path: str | Path, warn: Callable[[str], None] = _warn) -> tuple[Program, Compiled]:

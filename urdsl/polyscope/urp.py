@@ -567,6 +567,14 @@ def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None
         node.fields["params_attrs"] = dict(params.attrib)
     for tag, prefix in (("position", ""), ("relativeFromPosition", "from_")):
         _read_position(reader, element.find(tag), node.fields, prefix)
+    flange = element.find("outputFlangePose")
+    if "tcp_offset" not in node.fields and flange is not None and "pose" in node.fields:
+        # PolyScope 3 keeps no TCP offset with a waypoint, but the flange pose beside the
+        # TCP pose: the offset is the TCP pose seen from the flange
+        offset = _offset_between(_floats(reader.resolve(flange).get("pose")),
+                                 node.fields["pose"])
+        if offset is not None:
+            node.fields["tcp_offset"] = offset
     base = element.find("BaseToFeature")
     if base is not None:
         node.fields["base_to_feature"] = _floats(reader.resolve(base).get("pose"))
@@ -574,6 +582,19 @@ def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None
     if variable is not None:
         node.fields["variable"] = reader.variable_name(variable)
 
+
+
+def _offset_between(flange: list[float] | None, tcp: list[float]) -> list[float] | None:
+    """The pose (m, rad) of ``tcp`` in the frame of ``flange`` (both poses in Base, six
+    values), or None when either is not a pose."""
+    import numpy as np
+
+    from ..kinematics.pose import from_matrix, to_matrix
+
+    if flange is None or len(flange) != 6 or len(tcp) != 6:
+        return None
+    offset = from_matrix(np.linalg.inv(to_matrix(flange)) @ to_matrix(tcp))
+    return [round(float(v), 9) + 0.0 for v in offset]  # + 0.0: no -0.0
 
 
 def _read_position(reader, position, fields: dict, prefix: str) -> None:
