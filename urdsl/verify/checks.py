@@ -310,7 +310,7 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray, model=None,
     """URS302: a TCP path (movel/movep/movec) that leaves the workspace between reachable
     ends, or whose joints jump because inverse kinematics must change its branch; and, with
     the kinematic ``model``, URS303 where the jump is a joint running into its limit
-    (:func:`urdsl.motion.planner.limit_on_path`).
+    (:func:`urdsl.motion.planner.branch_path`).
 
     The controller stops the arm where such a move fails. What the trace draws after that
     point — the rest of the move on another branch, and the jump back to where the next move
@@ -373,14 +373,25 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray, model=None,
                 everywhere[segment] = finding.time
             findings.append(finding)
         failed[start:high] = True
-        after = np.flatnonzero(~bad[high:])  # the jump back to the next move's start
-        failed[high:high + (int(after[0]) if len(after) else count - high)] = True
+        failed[high:_end_of_run(bad, high)] = True  # the jump back to the next move's start
     near = bad | failed
     flagged = near.copy()
     for shift in (1, 2):  # central differences spread a jump to the neighbours
         flagged[shift:] |= near[:-shift]
         flagged[:-shift] |= near[shift:]
     return Continuity(findings, flagged, limits, everywhere)
+
+
+def _end_of_run(flags: np.ndarray, start: int, chunk: int = 4096) -> int:
+    """The first index from ``start`` on where ``flags`` is False (its length if none), in
+    time proportional to the run's length."""
+    stop = start
+    while stop < len(flags):
+        clear = np.flatnonzero(~flags[stop:stop + chunk])
+        if len(clear):
+            return stop + int(clear[0])
+        stop += chunk
+    return len(flags)
 
 
 def _continuity_finding(trace: Trace, segment: int, sample: int, jumps: np.ndarray,
