@@ -839,8 +839,8 @@ def branch_path(model, segment: Segment, fractions: np.ndarray) -> np.ndarray | 
 
     Inverse kinematics keeps every point of a path inside the limits, so where this path
     runs out of them (wrist 3 wound to -350° and then turned on) the trace jumps to another
-    branch; the controller stops the arm at the limit instead (a joint position limit
-    violation, [U] as the URS303 rule says)."""
+    branch; the controller aborts the program there instead (CB3 user manual, Joint Limits;
+    that it does not switch solutions is [U])."""
     if not hasattr(model, "ik_all_many") or segment.kind not in ("movel", "movep", "movec"):
         return None
     from ..kinematics.ik import choose_sequence

@@ -212,6 +212,13 @@ SCALED_KINDS = frozenset({"movej", "movel", "movep", "movec"})
 """Moves whose speed the controller's trajectory generator scales (:data:`SCALED_MARGIN`)."""
 
 
+def _samples_of(trace: Trace, segment: int) -> slice:
+    """The samples of move ``segment`` (a sample belongs to the latest move started, so a
+    move's samples are one run of the trace)."""
+    return slice(int(np.searchsorted(trace.segment, segment, side="left")),
+                 int(np.searchsorted(trace.segment, segment, side="right")))
+
+
 def _slowed(trace: Trace, segment: int, ratio: float, exclude: np.ndarray | None):
     """The move ``segment`` when the controller slows it rather than stop at a speed
     ``ratio`` times a limit (:data:`SCALED_MARGIN`); else None."""
@@ -220,7 +227,7 @@ def _slowed(trace: Trace, segment: int, ratio: float, exclude: np.ndarray | None
     move = trace.segments[segment]
     if move.kind not in SCALED_KINDS or move.params.get("t", 0) > 0:
         return None
-    if exclude is not None and bool(exclude[trace.segment == segment].any()):
+    if exclude is not None and bool(exclude[_samples_of(trace, segment)].any()):
         return None  # the move's path fails: the speed is that failure's
     return move
 
@@ -340,8 +347,8 @@ def path_continuity(trace: Trace, speed_limits: np.ndarray, model=None,
     for segment, first in _per_segment(trace, bad):
         if segment < 0:
             continue
-        low = int(np.searchsorted(trace.segment, segment, side="left"))
-        high = int(np.searchsorted(trace.segment, segment, side="right"))
+        samples = _samples_of(trace, segment)
+        low, high = samples.start, samples.stop
         if failed[first]:  # the trace coming back from an earlier move's failure
             rest = np.flatnonzero(bad[first:high] & ~failed[first:high])
             if len(rest) == 0:
@@ -399,7 +406,8 @@ def _continuity_finding(trace: Trace, segment: int, sample: int, jumps: np.ndarr
     """URS302 for the move ``segment`` that fails at ``sample``: its path leaves the
     workspace (some sample of it is out of reach) or its joints jump there."""
     move = trace.segments[segment]
-    inside = np.flatnonzero(trace.unreachable & (trace.segment == segment))
+    samples = _samples_of(trace, segment)
+    inside = samples.start + np.flatnonzero(trace.unreachable[samples])
     if len(inside):
         fraction = (trace.times[inside] - move.start) / max(move.duration, 1e-12)
         return Finding.of(
@@ -444,7 +452,8 @@ def _beyond_every_model(trace: Trace, segment: int) -> bool:
     from ..kinematics import MODELS, Robot
 
     move = trace.segments[segment]
-    inside = np.flatnonzero(trace.unreachable & (trace.segment == segment))
+    samples = _samples_of(trace, segment)
+    inside = samples.start + np.flatnonzero(trace.unreachable[samples])
     local = np.clip(trace.times[inside] - move.start, 0.0, move.duration)
     covered = move.profile.position(local) / max(move.profile.distance, 1e-12)
     poses = move.path_poses(np.concatenate([np.linspace(0.0, 1.0, BEYOND_SAMPLES), covered]))
