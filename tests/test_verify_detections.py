@@ -556,6 +556,55 @@ def test_a_stoppable_move_to_a_target_out_of_reach_is_a_warning_not_an_error():
     assert move.duration > 0.5  # the line up to the edge of the workspace is still checked
 
 
+SEARCH_ACROSS_THE_BASE = """
+    movej(get_inverse_kin(p[0.4, 0.0, 0.3, 0, 3.1416, 0]), a=1.4, v=1.0)
+    global move_thread_flag_7=0
+    thread move_thread_7():
+      enter_critical
+      move_thread_flag_7 = 1
+      movel(p[-0.4, 0.0, 0.3, 0, 3.1416, 0], a=1.2, v=0.1)
+      move_thread_flag_7 = 2
+      exit_critical
+    end
+    move_thread_han_7 = run move_thread_7()
+    while (True):
+      if (tool_contact(direction=get_target_tcp_speed()) > 0):
+        kill move_thread_han_7
+        stopl(3.0)
+        break
+      end
+      if (move_thread_flag_7 > 1):
+        join move_thread_han_7
+        break
+      end
+      sync()
+    end
+    movel(p[-0.4, 0.05, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)
+    """
+
+
+def test_a_stoppable_line_the_arm_cannot_follow_to_its_target_is_a_warning():
+    # a Direction with "until distance" and "until tool contact": its target is reachable,
+    # but the straight line to it passes over the base, through the cylinder no wrist can
+    # enter. The arm gets there only if no contact stops it first (the move is made to
+    # touch something): a warning that says how far the line can be followed, the line
+    # checked up to before there, and the next move starts where the arm stopped (unknown)
+    report = check(SEARCH_ACROSS_THE_BASE)
+    assert not [f for f in report.findings if f.severity == "error"], report.render_text()
+    (finding,) = [f for f in report.findings if f.code == "URS210" and f.span.line == 6]
+    assert "can follow this line only" in finding.message and "of its 800 mm" in \
+        finding.message and "condition" in finding.message
+    (move,) = [m for m in report.moves if m.span.line == 6]
+    assert 0.0 < move.duration < 8.0  # not the whole 0.8 m at 0.1 m/s
+    # the next line, drawn from where the check left the arm, would cross the base too
+    (after,) = [f for f in report.findings if f.code == "URS210" and f.span.line == 23]
+    assert "after the move at line 6, which a condition stops" in after.message
+    # the same line without a condition fails where the arm cannot follow it
+    plain = check(SEARCH_ACROSS_THE_BASE.replace("kill move_thread_han_7", "sync()"))
+    assert any(f.code == "URS302" and f.span.line == 6 and f.severity == "error"
+               for f in plain.findings), plain.render_text()
+
+
 def test_the_same_waypoint_out_of_reach_without_a_condition_is_an_error():
     report = check("""
         movel(p[0.95, 0.2, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)

@@ -39,7 +39,11 @@ still checked. A stoppable move to a nearer target out of reach (a search past a
 an "Until" on a waypoint) is checked the same way, and its target is a URS210 warning rather
 than URS301: whether the arm gets to the workspace's edge depends on the condition
 (:meth:`urdsl.motion.planner.MotionPlanner._beyond_reach`). "Until
-distance" moves stop at a real, reachable destination and keep being checked to it. [U] The
+distance" moves stop at a real, reachable destination and keep being checked to it, unless
+the straight line there cannot be followed (it passes a singularity, or the cylinder over
+the base that no wrist enters): such a move is cut as a far one is, and a URS210 warning says
+how far the arm can follow it (seen: nedlecky/UR ``nut_table_handle``, a Direction of 25 mm
+"until distance" or tool contact from a nearly stretched arm). [U] The
 exact scripts of other PolyScope versions may differ; any thread killed under a condition
 counts. A move stopped by a ``stopl`` from a watcher thread, with no kill, is not recognised
 (whether such a ``stopl`` stops another thread's move is not documented).

@@ -412,13 +412,15 @@ class MotionPlanner:
         if span in self.stoppable:
             far = self._far(pose)
             beyond = None if far else self._beyond_reach(pose)
-            if far or beyond is not None:
-                target = pose
-                pose, stopped = self._until_out_of_reach(pose_from, pose)
-                if stopped:
-                    params["until"] = True  # checked up to where it could stop
-                    if beyond is not None:
-                        self.warnings.append(self._search_warning(target, beyond, span, now))
+            target = pose
+            pose, stopped, followed = self._until_out_of_reach(pose_from, pose)
+            if stopped:
+                params["until"] = True  # checked up to where it could stop
+                if beyond is not None:
+                    self.warnings.append(self._search_warning(target, beyond, span, now))
+                elif not far:
+                    self.warnings.append(self._broken_line_warning(
+                        _distance(target, pose_from), followed, span, now))
         turn_rule = v_rot is None and kind in ("movel", "movep")
         if v_rot is None:
             v_rot = ROTATION_PER_METRE * v
@@ -516,19 +518,34 @@ class MotionPlanner:
             "contact, an input) has not held before, which depends on the outside world; "
             "checked up to where the arm could follow the line", span, now)
 
+    @staticmethod
+    def _broken_line_warning(length: float, followed: float, span: Span, now: float
+                             ) -> MotionWarning:
+        """The URS210 note for a stoppable move to a reachable target whose straight line
+        (``length`` m) the arm can follow only ``followed`` m: where it goes on past a
+        singularity or out of the workspace, the controller would stop it; the condition
+        (tool contact on the part the move is made to touch) may stop it before."""
+        return MotionWarning(
+            "condition", f"the arm can follow this line only {1000 * followed:.0f} mm of its "
+            f"{1000 * length:.0f} mm (then it leaves the workspace or passes a singularity); "
+            "it gets there only if the condition that stops the move (tool contact, an input) "
+            "has not held before, which depends on the outside world: checked up to "
+            f"{1000 * STOP_MARGIN:.0f} mm before there, and where the arm stops is unknown",
+            span, now)
+
     def _until_out_of_reach(self, pose_from: np.ndarray, pose: np.ndarray
-                            ) -> tuple[np.ndarray, bool]:
+                            ) -> tuple[np.ndarray, bool, float]:
         """A straight line that a condition stops (a Direction node's move toward a point
         far away) goes at most as far as the arm can follow it: the pose (4x4) where the line
         leaves the workspace or its IK solution can no longer continue, less
-        :data:`STOP_MARGIN`; and whether the line was cut there. A line the arm can follow
-        to its end is kept."""
+        :data:`STOP_MARGIN`; whether the line was cut there; and how far (m) the arm can
+        follow it. A line the arm can follow to its end is kept."""
         from .geometry import slerp_rotations
         from .tracking import track
 
         length = _distance(pose, pose_from)
         if length < 1e-9:
-            return pose, False
+            return pose, False, 0.0
         q_from = self._q
         model, tcp = self.kinematics, self.tcp
 
@@ -551,7 +568,7 @@ class MotionPlanner:
         coarse = np.linspace(0.0, high, 257)[1:]
         good, q_coarse = continuous(coarse, q_from, 2.0 * STOP_JUMP)
         if good == len(coarse) and high == 1.0:
-            return pose, False
+            return pose, False, length
         if good == len(coarse):
             reached = high
         else:
@@ -562,11 +579,12 @@ class MotionPlanner:
             count, _ = continuous(fine, q_low, STOP_JUMP)
             if count > 0:
                 reached = float(fine[count - 1])
+        followed = reached * length
         reached = max(0.0, reached - STOP_MARGIN / length)
         cut = pose_from.copy()
         cut[:3, :3] = slerp_rotations(pose_from[:3, :3], pose[:3, :3], np.array([reached]))[0]
         cut[:3, 3] = pose_from[:3, 3] + reached * (pose[:3, 3] - pose_from[:3, 3])
-        return cut, True
+        return cut, True, followed
 
     def _add_cartesian(self, kind: str, profile: Trapezoid, pose_from: np.ndarray,
                        pose: np.ndarray, r: float, span: Span, params: dict, now: float,
