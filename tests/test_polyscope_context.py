@@ -124,3 +124,44 @@ def test_with_another_tcp_than_the_taught_one_the_start_is_not_the_taught_joints
     report, _ = _check(capsys, program)
     assert "the waypoints were taught with TCP p[0, 0, 0.19" in report["context"]
     assert "where the arm starts is not known" in report["context"]
+
+
+def _script_line(code: str) -> str:
+    return ('<Script type="Line"><expression>'
+            + "".join(f'<ExpressionChar character="{c}"/>' for c in code)
+            + "</expression></Script>")
+
+
+def test_a_subprogram_another_program_calls_is_checked_as_one_call(tmp_path, capsys):
+    # CA-Giken/docker-noetic-capc GD/SUB_7002.urp: a subprogram saved as a program ("Program
+    # Loops Forever" on), which MAIN.urp calls. On its own PolyScope would loop it, and the
+    # way back from its last move to its first crosses the base (URS302); called, it runs
+    # once, from wherever the caller left the arm
+    down = "0, 3.1416, 0"
+    moves = [f"movel(p[0.4, 0.1, 0.3, {down}], a=1.2, v=0.25)",
+             f"movel(p[0.4, -0.3, 0.3, {down}], a=1.2, v=0.25)",
+             f"movel(p[-0.4, -0.3, 0.3, {down}], a=1.2, v=0.25)"]
+    program = tmp_path / "SUB_7.urp"
+    program.write_text(
+        '<URProgram name="SUB_7" installation="default" createdIn="5.13.0" '
+        'lastSavedIn="5.13.0"><children><MainProgram runOnlyOnce="false"><children>'
+        + "".join(_script_line(move) for move in moves)
+        + "</children></MainProgram></children></URProgram>")
+    report, _ = _check(capsys, program, "--robot", "ur5e")
+    looped = [f for f in report["findings"] if f["severity"] == "error"]
+    first = report["moves"][0]["line"]
+    # the second pass's first move, from the last one's end
+    assert "URS302" in {f["code"] for f in looped} and {f["line"] for f in looped} == {first}
+    caller = tmp_path / "MAIN.urp"
+    caller.write_text(_program(
+        '<CallSubProgram><subprogram name="SUB_7" keepHidden="false" '
+        'keepSynchronizedWithDisk="true"><programFile>/programs/SUB_7.urp</programFile>'
+        '<children/></subprogram></CallSubProgram>'))
+    report, _ = _check(capsys, program, "--robot", "ur5e")
+    assert [f for f in report["findings"] if f["severity"] == "error"] == []
+    assert "a subprogram that MAIN.urp calls" in report["context"]
+    assert len(report["moves"]) == 3  # one pass
+    # a program that only names another file is no caller
+    caller.write_text(_program(_script_line('textmsg("SUB_7.urp")')))
+    report, _ = _check(capsys, program, "--robot", "ur5e")
+    assert "URS302" in {f["code"] for f in report["findings"] if f["severity"] == "error"}

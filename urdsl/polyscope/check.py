@@ -71,14 +71,15 @@ class Generated:
                       if node.kind == "Contributed")
 
 
-def generate(path: str | Path) -> Generated:
+def generate(path: str | Path, *, once: bool = False) -> Generated:
     """Read, compile and map the ``.urp`` at ``path``: a script line belongs to the node of
     the nearest marker above it whose block it is in (raises
     :class:`~urdsl.polyscope.urp.UrpError` or :class:`~urdsl.polyscope.compile.CompileError`,
-    messages naming the file and node)."""
+    messages naming the file and node). ``once``: the Robot Program runs one pass (see
+    :func:`~urdsl.polyscope.command.load_all`)."""
     from .command import load_all
 
-    program, installation, compiled = load_all(path)
+    program, installation, compiled = load_all(path, once=once)
     text = compiled.text
     waypoints = {node.name: node for root in program.top for node in root.walk()
                  if node.kind == "Waypoint" and node.name}
@@ -373,6 +374,53 @@ model's nominal ones for the calibration to be that model's (factory corrections
 flange by a few millimetres at most)."""
 
 
+CALLER_SCAN_LIMIT = 500
+"""Most ``.urp`` files beside a program that :func:`calling_programs` reads."""
+
+_PROGRAM_FILE = re.compile(rb"<programFile>([^<]*)</programFile>")
+
+
+def calling_programs(path: str | Path) -> list[str]:
+    """The names of the ``.urp`` programs beside ``path`` that call it as a subprogram: a
+    ``CallSubProgram`` or ``SubProgram`` node whose ``<programFile>`` names this file
+    (``/programs/GD/SUB_104.urp``; PolyScope keeps the subprogram's nodes in the caller and
+    syncs them with that file). Files that cannot be read are skipped; at most
+    :data:`CALLER_SCAN_LIMIT` files are read."""
+    import gzip
+    import zlib
+
+    target = Path(path)
+    name = target.name.lower()
+    found: list[str] = []
+    try:
+        siblings = sorted(p for p in target.parent.iterdir()
+                          if p.suffix.lower() == ".urp" and p.name != target.name)
+    except OSError:
+        return found
+    for sibling in siblings[:CALLER_SCAN_LIMIT]:
+        try:
+            data = sibling.read_bytes()
+            if data[:2] == b"\x1f\x8b":
+                data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error, gzip.BadGzipFile):
+            continue
+        for match in _PROGRAM_FILE.finditer(data):
+            file = match.group(1).decode("utf-8", "replace").strip()
+            if re.split(r"[\\/]", file)[-1].lower() == name:
+                found.append(sibling.name)
+                break
+    return found
+
+
+def _listed(names: list[str], most: int = 3) -> str:
+    """``a.urp``, ``a.urp and b.urp``, ``a.urp, b.urp and 2 more``."""
+    if len(names) == 1:
+        return names[0]
+    if len(names) <= most:
+        return ", ".join(names[:-1]) + " and " + names[-1]
+    return ", ".join(names[:most - 1]) + f" and {len(names) - most + 1} more"
+
+
 def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=None,
               nominal: bool = False, cell_path: str | None = None):
     """``urdsl check X.urp``: compile the program and check the script it generates on the
@@ -385,12 +433,18 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     from ..verify.infer import apply, infer, qualify, waypoint_pairs, within_nominal_accuracy
     from ..verify.run import check_text, check_tree
 
-    generated = generate(path)
+    callers = calling_programs(path)
+    generated = generate(path, once=bool(callers))
     try:
         module = parse(generated.text, generated.filename)
     except ScriptError:
         return check_text(generated.text, generated.filename, options=options)
     notes = [f"compiled from {path} (PolyScope {generated.program.saved_in or '?'})"]
+    if callers:
+        notes.append(f"a subprogram that {_listed(callers)} call{'s' if len(callers) == 1 else ''}"
+                     " (its <programFile>): checked as one call, one pass from where the "
+                     "caller leaves the arm, which is not known unless --start-joints gives it "
+                     "(the first move is not checked)")
     if generated.installation is None:
         named = generated.program.installation
         notes.append(f"no installation {named + '.installation ' if named else ''}beside the "
@@ -438,12 +492,16 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
                 f"{v:.6g}" for v in tcps[0]) + "], the installation's active TCP is p["
                 + ", ".join(f"{v:.6g}" for v in active) + "]: the active TCP goes to the taught "
                 "poses, so the arm's joints are not those taught")
-            if inference.start_source == "inferred":
+            if inference.start_source == "inferred" and not callers:
                 # PolyScope brings the arm to the first move's target as the active TCP
                 # reaches it, not to the joints taught with the other TCP
                 file_options = dataclasses.replace(file_options, start_unknown=True)
                 notes.append("where the arm starts is not known (not the first waypoint's "
                              "taught joints): the first move is not checked")
+    if callers and inference.start_source != "given":
+        # a call starts where the caller left the arm: PolyScope does not bring the arm to
+        # the subprogram's first waypoint as it does for a program started on its own
+        file_options = dataclasses.replace(file_options, start_unknown=True)
     if cell_path and file_options.robot != options.robot:
         from .._cli import load_cell
 

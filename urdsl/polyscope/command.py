@@ -163,10 +163,14 @@ def load(path: str | Path, warn: Callable[[str], None] = _warn) -> tuple[Program
     return program, compiled
 
 
-def load_all(path: str | Path, warn: Callable[[str], None] = _warn
+def load_all(path: str | Path, warn: Callable[[str], None] = _warn, *, once: bool = False
              ) -> tuple[Program, Installation | None, Compiled]:
-    """:func:`load`, also giving the installation read (None when there is none)."""
+    """:func:`load`, also giving the installation read (None when there is none). ``once``:
+    compile the Robot Program to run one pass, as PolyScope runs a subprogram that another
+    program calls, whatever its "Program Loops Forever" setting says."""
     program = read_urp(path)
+    if once and program.main is not None:
+        program.main.attrs["runOnlyOnce"] = "true"
     installation = _installation_for(program, path, warn)
     folder = Path(path).parent
     variables: list[tuple[str, str]] = []
