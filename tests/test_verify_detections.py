@@ -421,6 +421,41 @@ def test_the_course_movel_from_a_singular_pose_is_still_found():
     assert {f.span.line for f in report.findings if f.severity == "error"} == {20}
 
 
+def _across_the_base_twice(back: str) -> str:
+    down = "0, 3.1416, 0"
+    return textwrap.dedent(f"""\
+        movej(get_inverse_kin(p[0.4, 0.1, 0.3, {down}]), a=1.4, v=1.0)
+        i = 0
+        while i < 2:
+          movel(p[0.4, 0.1, 0.3, {down}], a=1.2, v=0.25)
+          movel(p[-0.4, 0.1, 0.3, {down}], a=1.2, v=0.25)
+          {back}
+          i = i + 1
+        end
+        """)
+
+
+def test_a_later_pass_after_a_failed_path_is_a_warning_unless_joints_are_given_again():
+    # line 5 crosses the cylinder over the base (URS302, where the controller stops the
+    # program); the check goes on, and the second pass's line 4 starts from line 6's end,
+    # across the base again. Line 4 ran cleanly before the failure: what it meets now
+    # follows from where the check went on after the failure (San28 Program1's wound
+    # wrist), a warning; after a movej to given joints the joints are the program's again
+    report = check(_across_the_base_twice("movel(p[-0.4, -0.1, 0.3, 0, 3.1416, 0], a=1.2, "
+                                          "v=0.25)"))
+    errors = {(f.code, f.span.line) for f in report.findings if f.severity == "error"}
+    assert ("URS302", 5) in errors and not any(line == 4 for _, line in errors), errors
+    (later,) = [f for f in report.findings if f.code == "URS302" and f.span.line == 4]
+    assert later.severity == "warning" and "after the path at line 5 failed" in later.message
+    from urdsl.kinematics import Robot
+
+    far = Robot.model("ur5e").ik([-0.4, -0.1, 0.3, 0, 3.1416, 0], [1.5, -1.2, 1.2, -1.5, -1.5, 0])
+    joints = ", ".join(f"{v:.6f}" for v in far)
+    report = check(_across_the_base_twice(f"movej([{joints}], a=1.4, v=1.0)"))
+    assert any(f.code == "URS302" and f.span.line == 4 and f.severity == "error"
+               for f in report.findings), report.render_text()
+
+
 # PolyScope's Direction node "until tool contact", as the e-Series writes it (shortened): a
 # thread moves toward a point 1000 m away; the main loop kills it and stops the arm when the
 # condition fires

@@ -373,15 +373,19 @@ class MotionPlanner:
     # ---- moves -----------------------------------------------------------------------------
 
     def movej(self, q: np.ndarray, a: float, v: float, t: float, r: float, span: Span,
-              now: float) -> float:
-        """Joint-space move to ``q`` (rad): ``a`` rad/s², ``v`` rad/s, ``t`` s, ``r`` m."""
+              now: float, solved: bool = False) -> float:
+        """Joint-space move to ``q`` (rad): ``a`` rad/s², ``v`` rad/s, ``t`` s, ``r`` m.
+        ``solved``: ``q`` is the IK solution of a pose target nearest to where the arm was
+        (kept in the segment's params: its joints depend on the moves before)."""
         q = np.asarray(q, dtype=float)
         q_from = self._q
         delta = np.abs(q - q_from)
         lead = int(np.argmax(delta))  # equal a, v for all joints: the longest way leads
         profile = Trapezoid.plan(float(delta[lead]), self._joint_speed(delta, lead, v), a, t)
-        return self._add(self._segment("movej", profile, q_from, q, r, span,
-                                       {"a": a, "v": v, "t": t, "lead": lead}), now)
+        params = {"a": a, "v": v, "t": t, "lead": lead}
+        if solved:
+            params["solved"] = True
+        return self._add(self._segment("movej", profile, q_from, q, r, span, params), now)
 
     def _joint_speed(self, delta: np.ndarray, lead: int, v: float) -> float:
         """The leading axis's speed (rad/s) for a movej asked for ``v``: at most what keeps

@@ -152,7 +152,9 @@ def _movej(rt, node, q, a=1.4, v=1.05, t=0, r=0):
     target = _joints_target(rt, node, q)
     a, v = _number(rt, node, a, "a"), _number(rt, node, v, "v")
     t, r = _number(rt, node, t, "t"), _number(rt, node, r, "r")
-    _plan(rt, node, lambda: arm.movej(target, a, v, t, r, node.span, rt.time))
+    solved = type(q) is PoseValue  # joints the IK chose near where the arm is
+    _plan(rt, node, lambda: arm.movej(target, a, v, t, r, node.span, rt.time,
+                                      solved=solved))
 
 
 def _linear(kind: str):

@@ -17,6 +17,7 @@ it got to and says so (URS313), and checks left undone are named.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -499,6 +500,39 @@ def _before_its_condition(findings: list[Finding], planner) -> list[Finding]:
     return out
 
 
+def _after_a_failed_path(findings: list[Finding], stops: list[Finding], planner
+                         ) -> list[Finding]:
+    """Errors about a move's way (:data:`PATH_CODES`, URS303) at a statement that had run
+    before the first path the arm could not follow (``stops``: URS302, a line into a joint
+    limit), first met after it: warnings. The controller stops the program at that path;
+    the check goes on from the failing move's target, with joints its own IK chose, so what
+    a later pass of an earlier statement meets depends on how the failure is mended (seen:
+    a wrist wound to its limit in a loop's second pass, San28-cardenas/RBTC_MANIPULACION).
+    Statements first run after the failure keep their errors (the move after a failing one
+    starts where the program wanted the arm), and so do findings after a ``movej`` to given
+    joints since the failure: the arm's joints are the program's again there."""
+    timed = [f for f in stops if f.severity == "error" and f.time is not None]
+    if not timed:
+        return findings
+    stop = min(timed, key=lambda f: f.time)
+    moment = float(stop.time)
+    before = {s.span for s in planner.segments if s.start < moment - 1e-9}
+    anchors = [s.end for s in planner.segments if s.kind == "movej" and s.start > moment
+               and not s.params.get("solved")]
+    anchored = min(anchors, default=math.inf)  # from here the joints are the program's
+    out = []
+    for finding in findings:
+        if finding.severity == "error" and finding.code in PATH_CODES | {"URS303"} \
+                and finding.time is not None and moment + 1e-9 < finding.time <= anchored \
+                and finding.span in before:
+            finding = replace(finding, severity="warning", message=(
+                f"{finding.message}; met only after the path at line {stop.span.line} failed "
+                f"(t={moment:.3f} s), where the controller stops the program: it follows from "
+                "where the check went on, which depends on how that failure is mended"))
+        out.append(finding)
+    return out
+
+
 def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: float | None,
                     span) -> list[Finding]:
     """The trace checks, in order; once ``deadline`` (``time.monotonic()``) has passed the
@@ -526,6 +560,8 @@ def _trace_findings(trace, planner, robot, options: CheckOptions, deadline: floa
         findings += check.run(ctx)
     findings = _from_unknown_start(findings, planner)
     findings = _before_its_condition(findings, planner)
+    findings = _after_a_failed_path(
+        findings, [f for f in findings if f.code == "URS302"] + ctx.path_limits, planner)
     for label, reached in ctx.partial.items():
         findings.append(Finding.of(
             "URS313", f"the check reached its wall-clock bound of {options.timeout:g} s; "
