@@ -74,7 +74,8 @@ def test_a_polyscope_3_waypoint_gives_its_tcp_by_its_flange_pose(tmp_path, capsy
     assert [f["code"] for f in report["findings"] if f["severity"] == "error"] == []
 
 
-def test_the_installation_a_program_names_may_be_in_a_folder_above(tmp_path, capsys):
+def test_the_installation_a_program_names_may_be_in_a_folder_above(tmp_path, capsys,
+                                                                   monkeypatch):
     # nedlecky/UR programs/g01_nut_handle/g01_home.urp names "default", which is
     # programs/default.installation: PolyScope saved the program in /programs
     (tmp_path / ".git").mkdir(exist_ok=True)
@@ -84,6 +85,9 @@ def test_the_installation_a_program_names_may_be_in_a_folder_above(tmp_path, cap
     program = programs / "sub" / "home.urp"
     program.write_text(_program('<Wait type="Sleep"><waitTime>0.1</waitTime></Wait>'))
     report, err = _check(capsys, program)
+    assert "no installation" not in report["context"] and "a folder above" in err
+    monkeypatch.chdir(program.parent)  # `urdsl check home.urp` in the program's folder
+    report, err = _check(capsys, Path(program.name))
     assert "no installation" not in report["context"] and "a folder above" in err
     # another name, or above the repository's top, is not the program's
     (programs / "default.installation").rename(programs / "other.installation")

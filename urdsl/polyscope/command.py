@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -144,7 +145,10 @@ programs folder, whose installation stays at its top."""
 
 def _named_above(folder: Path, name: str) -> Path | None:
     """``NAME.installation`` in one of the :data:`INSTALLATION_LEVELS` folders above
-    ``folder``, the nearest first, not above a repository's top (a folder holding ``.git``)."""
+    ``folder``, the nearest first, not above a repository's top (a folder holding ``.git``).
+    A relative ``folder`` (``.`` for ``urdsl check home.urp``) is taken from the working
+    folder."""
+    folder = Path(os.path.abspath(folder))
     for _level in range(INSTALLATION_LEVELS):
         if (folder / ".git").exists() or folder.parent == folder:
             return None
