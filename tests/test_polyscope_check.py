@@ -325,6 +325,27 @@ def test_a_feature_of_a_missing_installation_is_not_a_mistake_of_the_program(tmp
     assert "URS101 name 'Plane_3' is not defined [node" in capsys.readouterr().out
 
 
+def test_a_variable_waypoint_at_a_feature_of_a_missing_installation(tmp_path, capsys):
+    # ylkhayat/universal-robots-mixing (5.9.5): MoveJ to a Variable waypoint whose variable
+    # is a point feature of the installation, <variable featureName="Control_Standby"/>; the
+    # installation is not in the repository. The name is the installation's (a warning that
+    # says so, an unknown target the check does not move to), not the program's mistake
+    program = tmp_path / "standby.urp"
+    program.write_text(_program(
+        '<Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true" '
+        'positionType="CartesianPose"><feature class="GeomFeatureReference" '
+        'referencedName="Joint_0_name"/><children><Waypoint type="Variable" name="Waypoint" '
+        'kinematicsFlags="7"><motionParameters/><variable featureName="Control_Standby"/>'
+        '</Waypoint></children></Move>'))
+    assert main(["lint", str(program), "--format", "json"]) == 0
+    (found,) = json.loads(capsys.readouterr().out)
+    assert found["severity"] == "warning" and "'Control_Standby'" in found["message"]
+    assert "a feature of the installation default.installation" in found["message"]
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+
+
 def test_installation_variables_and_move_features_of_a_missing_installation(tmp_path, capsys):
     # an IncrementVariable Set of an installation variable and a MoveL in a feature both take
     # names from the installation; without it beside the program they are unknown values

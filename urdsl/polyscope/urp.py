@@ -506,10 +506,19 @@ class _Reader:
         return ("token", piece.get("name", ""))
 
     def variable_name(self, element: ElementTree.Element | None) -> str | None:
+        """The name of the variable ``element`` refers to. A ``featureName`` names a feature
+        of the installation made a variable there (seen: a Variable waypoint's
+        ``<variable featureName="Control_Standby"/>``, 5.9.5): it is recorded as one of the
+        installation's names the program refers to (:meth:`installation_names`)."""
         if element is None:
             return None
         target = self.resolve(element)
-        return target.get("name") or target.get("featureName")
+        if target.get("name"):
+            return target.get("name")
+        feature = target.get("featureName")
+        if feature:
+            self.feature_variables.add(feature)
+        return feature
 
 
 def _floats(text: str | None) -> tuple[float, ...]:
@@ -675,7 +684,7 @@ def _assignment(reader: _Reader, node: Node, element: ElementTree.Element) -> No
     variable = element.find("variable")
     if variable is not None:
         target = reader.resolve(variable)
-        node.name = target.get("name") or target.get("featureName")
+        node.name = reader.variable_name(variable)
         node.fields["persistent"] = target.get("prefersPersistentValue") == "true"
     node.fields["source"] = element.get("valueSource", "Expression")
     node.fields["message"] = element.get("message", "")
