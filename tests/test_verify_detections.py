@@ -676,6 +676,33 @@ def test_a_move_to_a_known_target_after_freedrive_is_checked_again():
     assert finding.span.line == 8
 
 
+def test_a_speed_move_from_an_unknown_position_leaves_it_unknown():
+    # an edge search (Philippschwind/Projektarbeit_UR_Robot, blind batch 23): a move to a
+    # taught point the project does not hold, then speedl until a force; two such searches
+    # must not read the same "known" pose, or the program's distance check halts the run and
+    # nothing after it is checked
+    report = check("""
+        def edge():
+          speedl([0.01, 0, 0, 0, 0, 0], 0.1, 0.05)
+          stopl(1)
+          return get_actual_tcp_pose()
+        end
+        movel(first_point, a=1.2, v=0.2)
+        p1 = edge()
+        movel(second_point, a=1.2, v=0.2)
+        p2 = edge()
+        if norm(p2[0] - p1[0]) < 0.01:
+          popup("too close", blocking=True)
+          halt
+        end
+        textmsg(after_the_check)
+        """)
+    undefined = {f.span.line for f in report.findings if f.code == "URS201"}
+    assert undefined == {6, 8, 14}, report.render_text()
+    (condition,) = [f for f in report.findings if f.code == "URS210" and f.span.line == 10]
+    assert "after the move at line 8 to an unknown target" in condition.message
+
+
 def test_where_a_direction_move_stops_is_unknown_until_a_move_to_a_known_target():
     # after "until tool contact" the arm is wherever the part was: a move relative to that
     # is not checked against the end of reach (a warning says why); a taught move makes the

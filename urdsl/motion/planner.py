@@ -648,8 +648,20 @@ class MotionPlanner:
         q_to = q_from + qd / lead * profile.distance
         segment = self._segment("speedj", profile, q_from, q_to, 0.0, span,
                                 {"a": a, "t": t, "qd": qd.tolist()})
+        unknown = self.unknown_at
         self._add(segment, now)
+        self._still_unknown(unknown)
         return segment.start + profile.duration - profile.t_acc
+
+    def _still_unknown(self, unknown: tuple[str, Span] | None) -> None:
+        """After a speed move (``speedj``/``speedl``) from where the arm's position is
+        unknown (``unknown``: :attr:`unknown_at` before it): a speed has no target, so the
+        arm is still somewhere unknown (seen: an edge search, ``speedl`` until a force,
+        after a move to a taught point the project does not hold; two such searches read
+        the same "known" pose and the program's distance check halted it)."""
+        if unknown is not None:
+            self.unknown_at = unknown
+            self.drift = None
 
     def speedl(self, xd: np.ndarray, a: float, t: float, span: Span, now: float) -> float:
         """Tool speed ``xd`` (m/s, rad/s in Base) like :meth:`speedj`, as a straight line."""
@@ -667,8 +679,10 @@ class MotionPlanner:
         pose[:3, 3] += xd[:3] * t
         pose[:3, :3] = rotvec_to_matrix(xd[3:] * t) @ pose_from[:3, :3]
         # speedl's rotational part is in rad/s and rad/s² as given (aRot defaults to a)
+        unknown = self.unknown_at
         end = self.movel(pose, a, max(linear, 1e-12), 0.0, 0.0, span, now, kind="speedl",
                          a_rot=a, v_rot=max(angular, 1e-12))
+        self._still_unknown(unknown)
         return end - min(speed / a, end - now)
 
     def stop(self, now: float) -> float:
