@@ -555,23 +555,21 @@ def test_stoppable_moves_are_those_in_a_thread_killed_under_a_condition():
     assert sorted(span.line for span in stoppable_moves(module)) == [2]
 
 
-def test_a_stoppable_move_to_a_target_out_of_reach_is_a_warning_not_an_error():
-    # "Until" on a waypoint, or a search move toward a point past a box wall, killed when an
-    # input or tool contact fires: its target is 20 cm beyond the reach of a UR5e. Whether
-    # the arm gets to the edge of its workspace depends on the outside world (the input),
-    # unknown offline: a warning that says so, and the line is checked up to that edge
-    report = check("""
+def _killed_under(condition: str, move: str) -> str:
+    """A move in a thread that the program kills when ``condition`` holds (the shape of
+    PolyScope's "Until" on a waypoint or Direction); the move is the block's fifth line."""
+    return textwrap.dedent(f"""\
         global move_thread_flag_7=0
         thread move_thread_7():
           enter_critical
           move_thread_flag_7 = 1
-          movel(p[0.95, 0.2, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)
+          {move}
           move_thread_flag_7 = 2
           exit_critical
         end
         move_thread_han_7 = run move_thread_7()
         while (True):
-          if (get_digital_in(0)):
+          if ({condition}):
             kill move_thread_han_7
             stopl(1.2)
             break
@@ -583,6 +581,15 @@ def test_a_stoppable_move_to_a_target_out_of_reach_is_a_warning_not_an_error():
           sync()
         end
         """)
+
+
+def test_a_stoppable_move_to_a_target_out_of_reach_is_a_warning_not_an_error():
+    # "Until" on a waypoint, or a search move toward a point past a box wall, killed when an
+    # input or tool contact fires: its target is 20 cm beyond the reach of a UR5e. Whether
+    # the arm gets to the edge of its workspace depends on the outside world (the input),
+    # unknown offline: a warning that says so, and the line is checked up to that edge
+    report = check(_killed_under("get_digital_in(0)",
+                                 "movel(p[0.95, 0.2, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)"))
     assert not {"URS301", "URS302"} & set(report.codes()), report.render_text()
     (finding,) = [f for f in report.findings if f.code == "URS210" and f.span.line == 5]
     assert finding.severity == "warning"
@@ -591,31 +598,11 @@ def test_a_stoppable_move_to_a_target_out_of_reach_is_a_warning_not_an_error():
     assert move.duration > 0.5  # the line up to the edge of the workspace is still checked
 
 
-SEARCH_ACROSS_THE_BASE = """
-    movej(get_inverse_kin(p[0.4, 0.0, 0.3, 0, 3.1416, 0]), a=1.4, v=1.0)
-    global move_thread_flag_7=0
-    thread move_thread_7():
-      enter_critical
-      move_thread_flag_7 = 1
-      movel(p[-0.4, 0.0, 0.3, 0, 3.1416, 0], a=1.2, v=0.1)
-      move_thread_flag_7 = 2
-      exit_critical
-    end
-    move_thread_han_7 = run move_thread_7()
-    while (True):
-      if (tool_contact(direction=get_target_tcp_speed()) > 0):
-        kill move_thread_han_7
-        stopl(3.0)
-        break
-      end
-      if (move_thread_flag_7 > 1):
-        join move_thread_han_7
-        break
-      end
-      sync()
-    end
-    movel(p[-0.4, 0.05, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)
-    """
+SEARCH_ACROSS_THE_BASE = (
+    "movej(get_inverse_kin(p[0.4, 0.0, 0.3, 0, 3.1416, 0]), a=1.4, v=1.0)\n"
+    + _killed_under("tool_contact(direction=get_target_tcp_speed()) > 0",
+                    "movel(p[-0.4, 0.0, 0.3, 0, 3.1416, 0], a=1.2, v=0.1)")
+    + "movel(p[-0.4, 0.05, 0.3, 0, 3.1416, 0], a=1.2, v=0.25)\n")
 
 
 def test_a_stoppable_line_the_arm_cannot_follow_to_its_target_is_a_warning():
