@@ -52,6 +52,10 @@ def test_a_fragment_without_host_gets_warnings_and_names_defined_nowhere_stay_er
                                             "file looks like a fragment")
     assert by_line[2]["severity"] == "error" and by_line[2]["code"] == "URS101"
     assert by_line[2]["message"] == "name 'approach_q' is not defined"
+    # names a Script-node file takes from its PolyScope program elsewhere (blind batch 23,
+    # Philippschwind's taught positions): the error stands, the hint says how to settle it
+    assert "if this file runs inside a PolyScope program (a Script node) and `approach_q` " \
+        "is a waypoint" in by_line[2]["hint"] and "--include PROGRAM.urp" in by_line[2]["hint"]
     assert by_line[3]["severity"] == "error" and by_line[3]["code"] == "URS102"
     assert "did you mean `textmsg`" in by_line[3]["hint"]
 

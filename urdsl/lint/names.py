@@ -109,6 +109,21 @@ def _elsewhere(ctx: LintContext, code: str, at: n.Node, use: str,
                                severity=found.severity, hint=found.hint)
 
 
+def _hostless(ctx: LintContext, name: str, hint: str | None) -> str | None:
+    """``hint`` for a name defined nowhere in the project, read by a fragment that no program
+    of the project includes (a Script-node file whose PolyScope program is elsewhere): that
+    program's waypoints, features and variables are the usual source of such names, and
+    linting with it settles the question (the error stands: run as it is, the controller
+    rejects the name)."""
+    project = ctx.project
+    if project is None or project.role != "fragment" or project.hosts:
+        return hint
+    where = (f"if this file runs inside a PolyScope program (a Script node) and `{name}` is "
+             "a waypoint, feature or variable of that program or its installation, lint it "
+             "with them (--include PROGRAM.urp, its .installation or .variables)")
+    return f"{hint}; {where}" if hint else where
+
+
 @rule(
     "URS101", "undefined-name", "error",
     "A name is read that no assignment, parameter or declaration visible here defines.",
@@ -170,6 +185,7 @@ def undefined_name(ctx: LintContext) -> Iterator[Diagnostic]:
                 hint = f"{name.id} is a builtin function: call it, {name.id}(...)"
             else:
                 hint = _suggest(name.id, _visible(ctx, scope) | set(keywords()))
+            hint = _hostless(ctx, name.id, hint)
             yield ctx.diagnostic("URS101", name, f"name '{name.id}' is not defined", hint)
         for run in scope.runs:
             if run.thread not in analysis.threads:
