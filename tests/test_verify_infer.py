@@ -476,3 +476,21 @@ def test_a_target_a_fraction_of_a_millimetre_beyond_the_nominal_reach_is_a_warni
     (reach,) = [f for f in report["findings"] if f["code"] == "URS301"]
     assert reach["severity"] == severity and reach["line"] == 4
     assert ("the arm's calibration decides" in reach["message"]) == (severity == "warning")
+
+
+@pytest.mark.parametrize("call", [
+    "movel(p[-1.1, -0.1, 0.3, 0, 3.14, 0], a=1.2, v=0.25)",  # solved with the move's batch
+    "movej(p[-1.1, -0.1, 0.3, 0, 3.14, 0], a=1.4, v=1.05)",  # solved when it runs
+    "x = get_inverse_kin(p[-1.1, -0.1, 0.3, 0, 3.14, 0])",
+])
+def test_an_unreachable_target_carries_where_it_lies(call):
+    # the assumed-model and nominal-accuracy rules read where a target lies and how far out
+    # from the finding itself, not from its message's text
+    from urdsl.verify.run import CheckOptions, check_text
+
+    report = check_text("movej([0, -1.5708, 1.5708, -1.5708, -1.5708, 0])\n" + call + "\n",
+                        "t.script", options=CheckOptions(robot="ur5e"))
+    (finding,) = [f for f in report.findings if f.code == "URS301"]
+    position, distance = finding.beyond
+    assert np.allclose(position, (-1.1, -0.1, 0.3), atol=1e-9)
+    assert 0.2 < distance < 0.4  # a UR5e reaches 0.85 m from its shoulder

@@ -10,8 +10,12 @@ class KinematicsError(ValueError):
 
     ``distance`` is set for an unreachable pose: how far (m) the pose lies outside the arm's
     reach (see :meth:`urdsl.kinematics.Robot.ik`); ``None`` for other failures.
+    ``position`` (x, y, z in m, Base) is set only for a pose beyond the arm's reach (not for
+    one reachable only outside the joint limits): where the target lies.
     """
 
-    def __init__(self, message: str, distance: float | None = None) -> None:
+    def __init__(self, message: str, distance: float | None = None,
+                 position: tuple[float, float, float] | None = None) -> None:
         super().__init__(message)
         self.distance = distance
+        self.position = position

@@ -406,7 +406,8 @@ class Robot:
             position = np.round(T[:3, 3], 4).tolist()
             raise KinematicsError(
                 f"pose at {position} m is out of reach of the {self.name} by "
-                f"{distance * 1000:.1f} mm", distance=distance)
+                f"{distance * 1000:.1f} mm", distance=distance,
+                position=tuple(float(v) for v in T[:3, 3]))
         chosen, found = _ik.choose_nearest(solutions[None], q_near[None], self.q_min,
                                            self.q_max)
         if not found[0]:

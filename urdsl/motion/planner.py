@@ -93,6 +93,7 @@ class UnreachableTarget(KinematicsError):
         self.span = segment.span
         self.time = segment.start
         self.distance = distance
+        self.position = tuple(float(v) for v in where) if distance > 0 else None
 
 
 @dataclass

@@ -27,7 +27,7 @@ from ..rules import Rule, register
 from ..script.diagnostics import Diagnostic, ScriptError
 from ..script.nodes import NO_SPAN, Span
 
-__all__ = ["ScriptRuntimeError", "CODES"]
+__all__ = ["ScriptRuntimeError", "CODES", "beyond_reach"]
 
 CODES = {
     "undefined": "URS201",
@@ -43,13 +43,28 @@ CODES = {
 
 
 class ScriptRuntimeError(ScriptError):
-    """A URScript program failed while running (the controller would stop it)."""
+    """A URScript program failed while running (the controller would stop it).
+
+    ``beyond``: for a failed inverse kinematics (``kind`` ``"ik"``) of a pose beyond the
+    arm's reach, where the pose lies and how far out, ``((x, y, z), distance)`` in m
+    (:func:`beyond_reach`); None otherwise."""
 
     def __init__(self, kind: str, message: str, span: Span = NO_SPAN, hint: str | None = None,
                  time: float | None = None) -> None:
         super().__init__(Diagnostic.at(span, message, code=CODES[kind], hint=hint), span)
         self.kind = kind
         self.time = time
+        self.beyond: tuple[tuple[float, float, float], float] | None = None
+
+
+def beyond_reach(error: Exception) -> tuple[tuple[float, float, float], float] | None:
+    """Where a kinematics error's pose lies and how far (m) beyond the arm's reach, when it
+    is one (a ``KinematicsError`` with a ``position``), else None."""
+    position = getattr(error, "position", None)
+    distance = getattr(error, "distance", None)
+    if position is None or distance is None:
+        return None
+    return (tuple(float(v) for v in position), float(distance))  # type: ignore[return-value]
 
 
 # ---- the rules (``urdsl rules URS2``) ----------------------------------------------------------

@@ -19,7 +19,7 @@ import numpy as np
 from ..kinematics import KinematicsError
 from ..kinematics import pose as posemath
 from ..kinematics.models import NOMINAL_ACCURACY
-from .errors import ScriptRuntimeError
+from .errors import ScriptRuntimeError, beyond_reach
 from .registry import implements
 from .values import ListValue, PoseValue, Unknown, is_number, type_name
 
@@ -50,9 +50,12 @@ def _ik_error(rt, node, error: KinematicsError):
     (when the planner found it later, in a batch), else at ``node``."""
     span = getattr(error, "span", None)
     if span is None:
-        return rt.error("ik", f"inverse kinematics failed: {error}", node, _IK_HINT)
-    return ScriptRuntimeError("ik", f"inverse kinematics failed: {error}", span, _IK_HINT,
-                              getattr(error, "time", rt.time))
+        failed = rt.error("ik", f"inverse kinematics failed: {error}", node, _IK_HINT)
+    else:
+        failed = ScriptRuntimeError("ik", f"inverse kinematics failed: {error}", span,
+                                    _IK_HINT, getattr(error, "time", rt.time))
+    failed.beyond = beyond_reach(error)
+    return failed
 
 
 _IK_HINT = "the pose is out of reach of this robot with the active TCP"
@@ -363,8 +366,10 @@ def _inverse_kin(rt, node, x, qnear=None, maxPositionError=1e-10,  # noqa: N803
     try:
         return _vector(_inverse(rt, node, x, qnear, maxPositionError, maxOrientationError, tcp))
     except KinematicsError as error:
-        raise rt.error("ik", f"get_inverse_kin found no solution: {error}", node,
-                       "test with get_inverse_kin_has_solution() first") from None
+        failed = rt.error("ik", f"get_inverse_kin found no solution: {error}", node,
+                          "test with get_inverse_kin_has_solution() first")
+        failed.beyond = beyond_reach(error)
+        raise failed from None
 
 
 @implements("get_inverse_kin_has_solution")

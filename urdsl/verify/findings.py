@@ -32,7 +32,8 @@ class Finding:
     ``cause`` tells findings of one rule at one statement apart (the joint, the singularity,
     the colliding pair); None: the message without its numbers does (:meth:`identity`).
     ``count`` is how many times the program ran into it (a statement in a loop); the
-    finding is the first of them.
+    finding is the first of them. ``beyond``: for a target beyond the arm's reach (URS301),
+    where it lies and how far out, ``((x, y, z), distance)`` in m.
     """
 
     code: str
@@ -43,6 +44,8 @@ class Finding:
     hint: str | None = None
     cause: str | None = field(default=None, compare=False)
     count: int = field(default=1, compare=False)
+    beyond: tuple[tuple[float, float, float], float] | None = field(default=None,
+                                                                    compare=False)
 
     @classmethod
     def of(cls, code: str, message: str, span: Span = NO_SPAN, time: float | None = None,

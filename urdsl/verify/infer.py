@@ -19,7 +19,6 @@ values override (and are then not inferred).
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -479,9 +478,6 @@ MODEL_DEPENDENT = frozenset({"URS301", "URS302", "URS303", "URS304", "URS305", "
 """Checks whose verdict depends on the arm's kinematics (reach, joint solutions, speeds,
 links), so on which UR model the program runs."""
 
-_POSITION = re.compile(r"at \[(-?[\d.]+), (-?[\d.]+), (-?[\d.]+)\] m")
-
-
 def qualify(report, inference: Inference) -> None:
     """When neither ``--robot`` nor the program's taught waypoints say which arm it runs on,
     findings that hold only for the assumed model (``MODEL_DEPENDENT``) are not certain: they
@@ -502,9 +498,9 @@ def qualify(report, inference: Inference) -> None:
             qualified.append(finding)  # judged on every UR model already
             continue
         if finding.severity == "error" and finding.code in MODEL_DEPENDENT:
-            match = _POSITION.search(finding.message) if finding.code == "URS301" else None
-            if match is not None:
-                point = np.array([float(v) for v in match.groups()])
+            beyond = finding.beyond if finding.code == "URS301" else None
+            if beyond is not None:
+                point = np.array(beyond[0])
                 reachable = any(
                     np.linalg.norm(point - (0.0, 0.0, spec.d1)) <= spec.reach + tcp_length
                     for spec in MODELS.values())
@@ -519,9 +515,6 @@ def qualify(report, inference: Inference) -> None:
     report.findings = qualified
 
 
-_SHORT_OF_REACH = re.compile(r"just out of reach|out of reach(?: of the \S+)? by ([\d.]+) mm")
-
-
 def within_nominal_accuracy(report) -> None:
     """Errors that a target is out of reach (URS301) by less than
     :data:`~urdsl.kinematics.models.NOMINAL_ACCURACY`,
@@ -533,9 +526,7 @@ def within_nominal_accuracy(report) -> None:
     kept = []
     for finding in report.findings:
         if finding.severity == "error" and finding.code == "URS301":
-            match = _SHORT_OF_REACH.search(finding.message)
-            if match is not None and (match.group(1) is None
-                                      or float(match.group(1)) < NOMINAL_ACCURACY * 1000):
+            if finding.beyond is not None and finding.beyond[1] < NOMINAL_ACCURACY:
                 finding = replace(
                     finding, severity="warning",
                     message=f"{finding.message}, within the {NOMINAL_ACCURACY * 1000:g} mm by "

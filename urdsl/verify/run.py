@@ -30,6 +30,7 @@ from ..motion.direction import stoppable_moves
 from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
 from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
+from ..runtime.errors import beyond_reach
 from ..runtime.values import Unknown
 from ..script import nodes as n
 from ..script.diagnostics import ScriptSyntaxError
@@ -223,6 +224,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
         result.error = ScriptRuntimeError("ik", f"inverse kinematics failed: {failure}",
                                           failure.span, "the pose is out of reach of this "
                                           "robot with the active TCP", failure.time)
+        result.error.beyond = beyond_reach(failure)
     if result.error is not None and result.error.kind == "ik":
         # a target solved in a batch may fail after the script ran on: the robot stops at
         # the move, so nothing after its start happens
@@ -374,8 +376,8 @@ def _runtime_finding(error) -> Finding:
         # a target that drifted out of every start's reach holds for every start (and, when
         # the model is only assumed, every model): the cause says so (see infer.qualify)
         cause = DRIFT if getattr(error, "drift", False) else None
-        return Finding.of("URS301", diagnostic.message, error.span, error.time,
-                          diagnostic.hint, cause)
+        return replace(Finding.of("URS301", diagnostic.message, error.span, error.time,
+                                  diagnostic.hint, cause), beyond=getattr(error, "beyond", None))
     return Finding(diagnostic.code, "error", diagnostic.message, error.span, error.time,
                    diagnostic.hint)
 
