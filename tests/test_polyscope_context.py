@@ -169,3 +169,22 @@ def test_a_subprogram_another_program_calls_is_checked_as_one_call(tmp_path, cap
     caller.write_text(_program(_script_line('textmsg("SUB_7.urp")')))
     report, _ = _check(capsys, program, "--robot", "ur5e")
     assert "URS302" in {f["code"] for f in report["findings"] if f["severity"] == "error"}
+
+
+def test_a_gzip_bomb_beside_a_program_is_read_only_so_far(tmp_path, monkeypatch):
+    # calling_programs reads the .urp files beside the program, which the user did not name:
+    # at most CALLER_XML_LIMIT bytes of each, however far the file would decompress
+    import gzip
+
+    from urdsl.polyscope import check
+
+    program = tmp_path / "SUB_1.urp"
+    program.write_text(_program(""))
+    bomb = b"<URProgram>" + b" " * 2_000_000 + b"<programFile>/programs/SUB_1.urp</programFile>"
+    (tmp_path / "big.urp").write_bytes(gzip.compress(bomb))
+    (tmp_path / "caller.urp").write_bytes(gzip.compress(
+        b"<URProgram><programFile>/programs/SUB_1.urp</programFile></URProgram>"))
+    (tmp_path / "broken.urp").write_bytes(b"\x1f\x8b not gzip")
+    assert check.calling_programs(program) == ["big.urp", "caller.urp"]
+    monkeypatch.setattr(check, "CALLER_XML_LIMIT", 1_000_000)
+    assert check.calling_programs(program) == ["caller.urp"]

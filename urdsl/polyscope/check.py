@@ -377,6 +377,11 @@ flange by a few millimetres at most)."""
 CALLER_SCAN_LIMIT = 500
 """Most ``.urp`` files beside a program that :func:`calling_programs` reads."""
 
+CALLER_XML_LIMIT = 64_000_000
+"""Most bytes of XML :func:`calling_programs` reads of one file beside the program (the
+largest real programs in the labelled set are a few megabytes): a file the user did not name
+is not decompressed without bound."""
+
 _PROGRAM_FILE = re.compile(rb"<programFile>([^<]*)</programFile>")
 
 
@@ -386,7 +391,6 @@ def calling_programs(path: str | Path) -> list[str]:
     (``/programs/GD/SUB_104.urp``; PolyScope keeps the subprogram's nodes in the caller and
     syncs them with that file). Files that cannot be read are skipped; at most
     :data:`CALLER_SCAN_LIMIT` files are read."""
-    import gzip
     import zlib
 
     target = Path(path)
@@ -399,10 +403,13 @@ def calling_programs(path: str | Path) -> list[str]:
         return found
     for sibling in siblings[:CALLER_SCAN_LIMIT]:
         try:
+            if sibling.stat().st_size > CALLER_XML_LIMIT:
+                continue
             data = sibling.read_bytes()
             if data[:2] == b"\x1f\x8b":
-                data = gzip.decompress(data)
-        except (OSError, EOFError, zlib.error, gzip.BadGzipFile):
+                data = zlib.decompressobj(16 + zlib.MAX_WBITS).decompress(
+                    data, CALLER_XML_LIMIT)  # the first CALLER_XML_LIMIT bytes at most
+        except (OSError, zlib.error):
             continue
         for match in _PROGRAM_FILE.finditer(data):
             file = match.group(1).decode("utf-8", "replace").strip()
