@@ -166,11 +166,13 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
     for segment, sample in _per_segment(trace, over):
         ratio = np.abs(trace.qd[sample]) / limits
         joint = int(np.argmax(ratio))
-        inside = trace.segment == segment
+        samples = _samples_of(trace, segment)  # the move's samples, not the whole trace
+        inside = np.ones(samples.stop - samples.start, dtype=bool)
         if exclude is not None:
-            inside &= ~exclude
-        inside[carried] = False
-        peak = float(np.max(np.abs(trace.qd[inside, joint])))
+            inside &= ~exclude[samples]
+        own = carried[(carried >= samples.start) & (carried < samples.stop)]
+        inside[own - samples.start] = False
+        peak = float(np.max(np.abs(trace.qd[samples][inside, joint])))
         finding = Finding.of(
             "URS304",
             f"{JOINTS[joint]} joint turns at {peak:.2f} rad/s, over its limit of "
@@ -559,7 +561,8 @@ def tcp_speed(trace: Trace, robot, limit: float, exclude: np.ndarray | None = No
     over[_carried(trace, over)] = False
     findings = []
     for segment, sample in _per_segment(trace, over):
-        peak = float(np.max(speed[(trace.segment == segment) & over]))
+        samples = _samples_of(trace, segment)
+        peak = float(np.max(speed[samples][over[samples]]))
         finding = Finding.of(
             "URS306", f"the TCP moves at {peak:.3f} m/s, over the cell's limit of {limit:g} m/s",
             _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
