@@ -167,3 +167,12 @@ def test_a_python_name_defined_in_another_file_is_no_habit(tmp_path, capsys):
     assert found[0]["severity"] == "warning"
     status, found = lint(capsys, str(tmp_path / "use.script"), "--no-project")
     assert [f["code"] for f in found] == ["URS119"]
+
+
+def test_names_are_joined_as_a_sentence_and_cut_after_most():
+    from urdsl.project.model import join_names
+
+    assert join_names(["a.urp"]) == "a.urp"
+    assert join_names(["a", "b", "c"]) == "a, b and c"
+    assert join_names(["a", "b", "c"], 3) == "a, b and c"
+    assert join_names(["a", "b", "c", "d", "e"], 3) == "a, b and 3 more"

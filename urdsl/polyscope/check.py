@@ -419,25 +419,17 @@ def calling_programs(path: str | Path) -> list[str]:
     return found
 
 
-def _listed(names: list[str], most: int = 3) -> str:
-    """``a.urp``, ``a.urp and b.urp``, ``a.urp, b.urp and 2 more``."""
-    if len(names) == 1:
-        return names[0]
-    if len(names) <= most:
-        return ", ".join(names[:-1]) + " and " + names[-1]
-    return ", ".join(names[:most - 1]) + f" and {len(names) - most + 1} more"
-
-
 def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=None,
               nominal: bool = False, cell_path: str | None = None):
     """``urdsl check X.urp``: compile the program and check the script it generates on the
     very arm (the program's ``<kinematics>`` as the calibration unless ``nominal``), with the
     installation's settings as defaults (see :func:`installation_defaults`) where ``options``
     leave them open. Raises UrpError/CompileError for a program that cannot be compiled."""
+    from ..project.model import join_names
     from ..script.diagnostics import ScriptError
     from ..script.parser import parse
     from ..verify.findings import Finding
-    from ..verify.infer import apply, infer, qualify, waypoint_pairs, within_nominal_accuracy
+    from ..verify.infer import apply, infer, qualify_report, waypoint_pairs
     from ..verify.run import check_text, check_tree
 
     callers = calling_programs(path)
@@ -448,7 +440,8 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         return check_text(generated.text, generated.filename, options=options)
     notes = [f"compiled from {path} (PolyScope {generated.program.saved_in or '?'})"]
     if callers:
-        notes.append(f"a subprogram that {_listed(callers)} call{'s' if len(callers) == 1 else ''}"
+        verb = "calls" if len(callers) == 1 else "call"
+        notes.append(f"a subprogram that {join_names(callers, 3)} {verb}"
                      " (its <programFile>): checked as one call, one pass from where the "
                      "caller leaves the arm, which is not known unless --start-joints gives it "
                      "(the first move is not checked)")
@@ -550,9 +543,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         report.findings = tcp_dependent(report.findings, len(tcps))
     # as for a script: on a model only assumed, what depends on it is a warning; a target
     # a fraction of a millimetre beyond the nominal reach, the arm's calibration decides
-    qualify(report, inference)
-    if file_options.calibration is None:
-        within_nominal_accuracy(report)
+    qualify_report(report, inference, calibrated=file_options.calibration is not None)
     report.findings = node_findings(generated, report.findings)
     source = module.span.source
     for diagnostic in urcap_diagnostics(generated):

@@ -211,7 +211,7 @@ class FileContext:
         other = self.near(definition.filename)
         where = f"{other}:{definition.line}"
         if self.hosts:
-            hosts = _join([self.near(h) for h in self.host_names])
+            hosts = join_names([self.near(h) for h in self.host_names])
             return Resolution(
                 definition, "info",
                 f"'{name}' is defined in {where}, which {hosts} does not include",
@@ -231,7 +231,10 @@ class FileContext:
             "--include (or [tool.urdsl] include in pyproject.toml)")
 
 
-def _join(names: list[str]) -> str:
+def join_names(names: list[str], most: int | None = None) -> str:
+    """``a``, ``a and b``, ``a, b and c``; with ``most``, beyond it ``a, b and 2 more``."""
+    if most is not None and len(names) > most:
+        names = [*names[:most - 1], f"{len(names) - most + 1} more"]
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 

@@ -263,7 +263,7 @@ def _check_script(source, args: argparse.Namespace, options):
     from ..project.check import in_context
     from ..script.diagnostics import ScriptError
     from ..script.parser import parse
-    from .infer import apply, infer, qualify, within_nominal_accuracy
+    from .infer import apply, infer, qualify_report
     from .run import check_text, check_tree
 
     started = time.monotonic()  # the wall-clock bound covers the parse and inference too
@@ -298,9 +298,7 @@ def _check_script(source, args: argparse.Namespace, options):
     calibrated = None if args.nominal else _export_calibration(source.path, file_options)
     report = check_tree(module, source.name, file_options, started=started)
     report.inferred = inference
-    qualify(report, inference)
-    if file_options.calibration is None:
-        within_nominal_accuracy(report)
+    qualify_report(report, inference, calibrated=file_options.calibration is not None)
     notes = [context.note] if context is not None and context.note else []
     if calibrated:
         notes.append(calibrated)

@@ -515,6 +515,15 @@ def qualify(report, inference: Inference) -> None:
     report.findings = qualified
 
 
+def qualify_report(report, inference: Inference, calibrated: bool) -> None:
+    """What the check of a script or a ``.urp`` assumed, said in its findings' severities:
+    :func:`qualify` (the model assumed), and unless the check ran on the arm's own
+    calibration (``calibrated``), :func:`within_nominal_accuracy`."""
+    qualify(report, inference)
+    if not calibrated:
+        within_nominal_accuracy(report)
+
+
 def within_nominal_accuracy(report) -> None:
     """Errors that a target is out of reach (URS301) by less than
     :data:`~urdsl.kinematics.models.NOMINAL_ACCURACY`,
