@@ -596,13 +596,11 @@ def _waypoint(reader: _Reader, node: Node, element: ElementTree.Element) -> None
 def _offset_between(flange: list[float] | None, tcp: list[float]) -> list[float] | None:
     """The pose (m, rad) of ``tcp`` in the frame of ``flange`` (both poses in Base, six
     values), or None when either is not a pose."""
-    import numpy as np
-
-    from ..kinematics.pose import from_matrix, to_matrix
+    from ..kinematics.pose import pose_inv, pose_trans
 
     if flange is None or len(flange) != 6 or len(tcp) != 6:
         return None
-    offset = from_matrix(np.linalg.inv(to_matrix(flange)) @ to_matrix(tcp))
+    offset = pose_trans(pose_inv(flange), tcp)  # URScript's pose_trans(pose_inv(f), t)
     return [round(float(v), 9) + 0.0 for v in offset]  # + 0.0: no -0.0
 
 
