@@ -11,6 +11,8 @@ import shutil
 from pathlib import Path
 
 import pytest
+from _urp import chars as _chars
+from _urp import program as _program
 
 from urdsl.cli import main
 from urdsl.polyscope.check import calibration_of, generate
@@ -18,16 +20,6 @@ from urdsl.polyscope.urp import read_urp
 from urdsl.runtime.unknown import DEVICE_REPLY_TIME
 
 DATA = Path(__file__).parent / "data" / "polyscope"
-
-
-def _program(children: str, kinematics: str = "") -> str:
-    return (f'<URProgram name="t" installation="default" createdIn="5.11.1" '
-            f'lastSavedIn="5.11.1">{kinematics}<children><MainProgram runOnlyOnce="true">'
-            f'<children>{children}</children></MainProgram></children></URProgram>')
-
-
-def _chars(text: str) -> str:
-    return "".join(f'<ExpressionChar character="{c}"/>' for c in text)
 
 
 URCAP = ('<Contributed strategyClass="com.example.Grip" strategyProgramNodeType="Grip" '

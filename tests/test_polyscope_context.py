@@ -10,6 +10,8 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+from _urp import program as _program
+from _urp import script_line as _script_line
 
 from urdsl.cli import main
 from urdsl.kinematics import Robot
@@ -27,13 +29,6 @@ UR5E_KINEMATICS = ('<kinematics><deltaTheta value="0, 0, 0, 0, 0, 0"/>'
                    '<alpha value="1.5707963267948966, 0, 0, 1.5707963267948966, '
                    '-1.5707963267948966, 0"/></kinematics>')
 """A nominal UR5e's calibration, as PolyScope 5 writes one into every program."""
-
-
-def _program(children: str, installation: str = "default", version: str = "5.11.1",
-             kinematics: str = "") -> str:
-    return (f'<URProgram name="t" installation="{installation}" createdIn="{version}" '
-            f'lastSavedIn="{version}">{kinematics}<children><MainProgram runOnlyOnce="true">'
-            f'<children>{children}</children></MainProgram></children></URProgram>')
 
 
 def _values(values) -> str:
@@ -100,10 +95,8 @@ def test_on_a_model_nothing_names_a_urps_model_findings_are_warnings(tmp_path, c
     # checked on the assumed UR5e: a pose 1.1 m out, which a UR10 reaches, is a warning
     # that says so, as for a script; with --robot it is an error
     program = tmp_path / "far.urp"
-    program.write_text(_program('<Script type="Line"><expression>' + "".join(
-        f'<ExpressionChar character="{c}"/>'
-        for c in "movel(p[-1.1, -0.1, 0.3, 0, 3.14, 0], a=1.2, v=0.25)")
-        + "</expression></Script>"))
+    program.write_text(_program(_script_line(
+        "movel(p[-1.1, -0.1, 0.3, 0, 3.14, 0], a=1.2, v=0.25)")))
     report, _ = _check(capsys, program)
     (reach,) = [f for f in report["findings"] if f["code"] == "URS301"]
     assert reach["severity"] == "warning" and "on the assumed ur5e" in reach["message"]
@@ -130,12 +123,6 @@ def test_with_another_tcp_than_the_taught_one_the_start_is_not_the_taught_joints
     assert "where the arm starts is not known" in report["context"]
 
 
-def _script_line(code: str) -> str:
-    return ('<Script type="Line"><expression>'
-            + "".join(f'<ExpressionChar character="{c}"/>' for c in code)
-            + "</expression></Script>")
-
-
 def test_a_subprogram_another_program_calls_is_checked_as_one_call(tmp_path, capsys):
     # CA-Giken/docker-noetic-capc GD/SUB_7002.urp: a subprogram saved as a program ("Program
     # Loops Forever" on), which MAIN.urp calls. On its own PolyScope would loop it, and the
@@ -146,11 +133,8 @@ def test_a_subprogram_another_program_calls_is_checked_as_one_call(tmp_path, cap
              f"movel(p[0.4, -0.3, 0.3, {down}], a=1.2, v=0.25)",
              f"movel(p[-0.4, -0.3, 0.3, {down}], a=1.2, v=0.25)"]
     program = tmp_path / "SUB_7.urp"
-    program.write_text(
-        '<URProgram name="SUB_7" installation="default" createdIn="5.13.0" '
-        'lastSavedIn="5.13.0"><children><MainProgram runOnlyOnce="false"><children>'
-        + "".join(_script_line(move) for move in moves)
-        + "</children></MainProgram></children></URProgram>")
+    program.write_text(_program("".join(_script_line(move) for move in moves),
+                                name="SUB_7", version="5.13.0", loops=True))
     report, _ = _check(capsys, program, "--robot", "ur5e")
     looped = [f for f in report["findings"] if f["severity"] == "error"]
     first = report["moves"][0]["line"]
