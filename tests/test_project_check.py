@@ -516,3 +516,30 @@ def test_a_subprogram_saved_as_its_own_program_is_checked_in_its_callers_context
     # a program that names no such subprogram is no caller: the name stays undefined
     (tmp_path / "MAIN.urp").write_bytes(_urp_calling("SUB_OTHER", suppressed))
     assert check(capsys, str(tmp_path / "SUB_A.script"))[0] == 1
+
+
+def test_a_fragment_no_program_includes_keeps_its_error_with_a_hint(tmp_path, capsys):
+    # a Script-node file whose PolyScope program is not in the repository (blind batch 23,
+    # Philippschwind's taught positions): the name stays an error, and the hint says how to
+    # check the file with the program that defines it
+    (tmp_path / "frag").mkdir()
+    job = tmp_path / "frag" / "job.script"
+    job.write_text('movej(approach_q, a=1.0, v=0.2)\ntextmsg("done")\n')
+    status, report = check(capsys, str(job))
+    assert status == 1
+    [finding] = report["findings"]
+    assert (finding["code"], finding["severity"]) == ("URS201", "error")
+    assert "`approach_q` is a waypoint, feature or variable of that program" in finding["hint"]
+    assert "check it with them (--include PROGRAM.urp" in finding["hint"]
+    assert report["context"].startswith("a fragment that no program of the project includes")
+    # following the hint settles it
+    (tmp_path / "prog").mkdir()
+    variables = tmp_path / "prog" / "cell.variables"
+    variables.write_text("approach_q=[0.0, -1.57, 1.57, -1.57, -1.57, 0.0]\n")
+    status, report = check(capsys, "--include", str(variables), str(job))
+    assert status == 0 and len(report["moves"]) == 1
+    # a complete program lacking the name gets no such hint: nothing else runs it
+    job.write_text("def job():\n  movej(approach_q, a=1.0, v=0.2)\nend\njob()\n")
+    status, report = check(capsys, str(job))
+    assert status == 1 and "PolyScope program" not in report["findings"][0]["hint"]
+    assert report["context"] is None

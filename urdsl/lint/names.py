@@ -6,6 +6,7 @@ from __future__ import annotations
 import difflib
 from collections.abc import Iterator
 
+from ..project.model import from_missing_program
 from ..script import nodes as n
 from ..script.builtins import catalog, lookup, methods
 from ..script.diagnostics import Diagnostic
@@ -111,16 +112,11 @@ def _elsewhere(ctx: LintContext, code: str, at: n.Node, use: str,
 
 def _hostless(ctx: LintContext, name: str, hint: str | None) -> str | None:
     """``hint`` for a name defined nowhere in the project, read by a fragment that no program
-    of the project includes (a Script-node file whose PolyScope program is elsewhere): that
-    program's waypoints, features and variables are the usual source of such names, and
-    linting with it settles the question (the error stands: run as it is, the controller
-    rejects the name)."""
+    of the project includes, with :func:`urdsl.project.model.from_missing_program` after it."""
     project = ctx.project
-    if project is None or project.role != "fragment" or project.hosts:
+    if project is None or not project.hostless:
         return hint
-    where = (f"if this file runs inside a PolyScope program (a Script node) and `{name}` is "
-             "a waypoint, feature or variable of that program or its installation, lint it "
-             "with them (--include PROGRAM.urp, its .installation or .variables)")
+    where = from_missing_program(name, "lint")
     return f"{hint}; {where}" if hint else where
 
 

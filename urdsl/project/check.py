@@ -30,12 +30,14 @@ _MAX_DEFINITIONS = 10_000
 @dataclass(frozen=True)
 class CheckContext:
     """The tree to run (the file's own, with the definitions it needs in front), the
-    definitions added, and a sentence for the report."""
+    definitions added, and a sentence for the report. ``hostless``: the file is a fragment
+    that no program of the project includes (:attr:`FileContext.hostless`)."""
 
     module: n.Module
     definitions: tuple[Definition, ...]
     hosts: tuple[str, ...]
     note: str
+    hostless: bool = False
 
 
 def needed_names(module: n.Module) -> tuple[set[str], set[str], set[str]]:
@@ -150,11 +152,14 @@ def in_context(path: str | Path, text: str, module: n.Module, filename: str | No
                include: tuple[str | Path, ...] | list = (), use_config: bool = True,
                project: Project | None = None) -> CheckContext | None:
     """``module`` (parsed from ``text``, the file at ``path``) with the definitions it needs
-    from its project in front, or None when it needs none that the project has."""
+    from its project in front, or None when it needs none that the project has (unless it
+    is a fragment that no program of the project includes and needs names, which the
+    report then explains)."""
     project = project or Project.discover(path, include, use_config)
     context = project.context(path, text, filename)
     chosen, without_value = _collect(context, module)
-    if not chosen and not without_value:
+    if not chosen and not without_value and not (context.hostless
+                                                 and any(needed_names(module))):
         return None
     variables = [d for d in chosen if d.kind == "installation variable"]
     assignments = [d for d in chosen if d.kind == "global"]
@@ -179,6 +184,8 @@ def in_context(path: str | Path, text: str, module: n.Module, filename: str | No
         note = f"checked with definitions from {', '.join(files)}"
     else:
         note = "checked alone"
+    if context.hostless:
+        note = f"a fragment that no program of the project includes, {note}"
     if chosen:
         note += f" ({len(chosen)} definition(s): {', '.join(d.name for d in chosen[:8])}" + \
             (", ..." if len(chosen) > 8 else "") + ")"
@@ -186,7 +193,7 @@ def in_context(path: str | Path, text: str, module: n.Module, filename: str | No
         note += ("; the project gives " + ", ".join(dict.fromkeys(without_value)) + " a value "
                  "only inside a function or loop or in a file that does not include this one, "
                  "from values not known before this file runs")
-    return CheckContext(combined, tuple(chosen), hosts, note)
+    return CheckContext(combined, tuple(chosen), hosts, note, context.hostless)
 
 
 def _given_later(statement: n.Stmt | None, name: str, resolvable) -> n.Stmt | None:

@@ -135,6 +135,16 @@ class Resolution:
 _READ_KINDS = frozenset(("global", "installation variable"))
 
 
+def from_missing_program(name: str, command: str) -> str:
+    """The hint for ``name``, defined nowhere in the project, read by a hostless fragment
+    (:attr:`FileContext.hostless`): the PolyScope program that runs the file is the usual
+    source of such names, and ``urdsl COMMAND`` with it settles the question (the error
+    stands: run as it is, the controller rejects the name)."""
+    return (f"if this file runs inside a PolyScope program (a Script node) and `{name}` is "
+            "a waypoint, feature or variable of that program or its installation, "
+            f"{command} it with them (--include PROGRAM.urp, its .installation or .variables)")
+
+
 @dataclass
 class FileContext:
     """One file seen from its project: its role, its hosts and every definition elsewhere."""
@@ -148,6 +158,12 @@ class FileContext:
     def role(self) -> str:
         """``"fragment"`` (included by a host, or no program of its own) or ``"host"``."""
         return "host" if self.file.is_host and not self.hosts else "fragment"
+
+    @property
+    def hostless(self) -> bool:
+        """A fragment that no program of the project includes (a Script-node file whose
+        PolyScope program is not in the project)."""
+        return self.role == "fragment" and not self.hosts
 
     @property
     def host_names(self) -> list[str]:

@@ -47,7 +47,8 @@ class ScriptRuntimeError(ScriptError):
 
     ``beyond``: for a failed inverse kinematics (``kind`` ``"ik"``) of a pose beyond the
     arm's reach, where the pose lies and how far out, ``((x, y, z), distance)`` in m
-    (:func:`beyond_reach`); None otherwise."""
+    (:func:`beyond_reach`); None otherwise. ``name``: for a name or function that nothing
+    defined (``kind`` ``"undefined"``), that name; None otherwise."""
 
     def __init__(self, kind: str, message: str, span: Span = NO_SPAN, hint: str | None = None,
                  time: float | None = None) -> None:
@@ -55,6 +56,7 @@ class ScriptRuntimeError(ScriptError):
         self.kind = kind
         self.time = time
         self.beyond: tuple[tuple[float, float, float], float] | None = None
+        self.name: str | None = None
 
 
 def beyond_reach(error: Exception) -> tuple[tuple[float, float, float], float] | None:

@@ -654,6 +654,7 @@ class Interpreter:
         program, or, when the run goes on past such names (the verifier), the error recorded
         once per name and an unknown value in its place."""
         error = self.error("undefined", f"{what} '{name}' is not defined", node, hint)
+        error.name = name
         if not self.config.go_on_after_undefined:
             raise error
         if name not in self.undefined:

@@ -291,6 +291,7 @@ def _check_script(source, args: argparse.Namespace, options):
                       start_joints=args.start_joints or args.start_joints_deg, tcp=args.tcp,
                       default_robot=options.robot)
     file_options = apply(options, inference, tcp_given=args.tcp is not None)
+    file_options.hostless = context is not None and context.hostless
     if args.cell and file_options.robot != options.robot:
         file_options.cell = load_cell(file_options.robot, args.cell)
     if context is not None and context.hosts:

@@ -29,6 +29,7 @@ from .._gc import gc_paused
 from ..motion.direction import stoppable_moves
 from ..motion.planner import MotionPlanner
 from ..motion.trace import sample
+from ..project.model import from_missing_program
 from ..runtime import Environment, Interpreter, RuntimeConfig, ScriptRuntimeError
 from ..runtime.errors import beyond_reach
 from ..runtime.values import Unknown
@@ -141,6 +142,10 @@ class CheckOptions:
     unknown_globals: dict[str, str] = field(default_factory=dict)
     """Globals the program reads that something outside it defines (a URCap node's code):
     name → where the value comes from; each holds an unknown value."""
+    hostless: bool = False
+    """Whether the file is a fragment that no program of its project includes (a Script-node
+    file whose PolyScope program is elsewhere, :attr:`urdsl.project.FileContext.hostless`):
+    a name defined nowhere is still an error, with a hint that the program may define it."""
     progress: Progress | None = field(default=None, repr=False, compare=False)
     """Where the check records its phase (see :class:`Progress`), or None."""
 
@@ -233,9 +238,12 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
         report.events = [e for e in result.events if e.time <= result.error.time]
     for error in result.undefined:  # the run went on with the value unknown
         finding = _runtime_finding(error)
-        went_on = "the check went on with its value unknown (what depends on it is not checked)"
-        hint = f"{finding.hint}; {went_on}" if finding.hint else went_on
-        report.findings.append(replace(finding, hint=hint))
+        hints = [finding.hint] if finding.hint else []
+        if options.hostless and error.name is not None:
+            hints.append(from_missing_program(error.name, "check"))
+        hints.append("the check went on with its value unknown (what depends on it is not "
+                     "checked)")
+        report.findings.append(replace(finding, hint="; ".join(hints)))
     if result.error is not None:
         report.findings.append(_runtime_finding(result.error))
     for warning in planner.warnings:  # Overlapping Blends, or a stoppable move's far target
