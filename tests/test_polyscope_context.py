@@ -157,7 +157,7 @@ def test_a_subprogram_another_program_calls_is_checked_as_one_call(tmp_path, cap
 
 def test_a_gzip_bomb_beside_a_program_is_read_only_so_far(tmp_path, monkeypatch):
     # calling_programs reads the .urp files beside the program, which the user did not name:
-    # at most CALLER_XML_LIMIT bytes of each, however far the file would decompress
+    # one that would decompress to more than CALLER_XML_LIMIT bytes is skipped, read no further
     import gzip
 
     from urdsl.polyscope import check

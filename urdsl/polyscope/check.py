@@ -379,8 +379,7 @@ CALLER_SCAN_LIMIT = 500
 
 CALLER_XML_LIMIT = 64_000_000
 """Most bytes of XML :func:`calling_programs` reads of one file beside the program (the
-largest real programs in the labelled set are a few megabytes): a file the user did not name
-is not decompressed without bound."""
+largest real programs in the labelled set are a few megabytes): a larger file is skipped."""
 
 _PROGRAM_FILE = re.compile(rb"<programFile>([^<]*)</programFile>")
 
@@ -391,7 +390,7 @@ def calling_programs(path: str | Path) -> list[str]:
     (``/programs/GD/SUB_104.urp``; PolyScope keeps the subprogram's nodes in the caller and
     syncs them with that file). Files that cannot be read are skipped; at most
     :data:`CALLER_SCAN_LIMIT` files are read."""
-    import zlib
+    from .gz import InflateError, inflate
 
     target = Path(path)
     name = target.name.lower()
@@ -405,11 +404,8 @@ def calling_programs(path: str | Path) -> list[str]:
         try:
             if sibling.stat().st_size > CALLER_XML_LIMIT:
                 continue
-            data = sibling.read_bytes()
-            if data[:2] == b"\x1f\x8b":
-                data = zlib.decompressobj(16 + zlib.MAX_WBITS).decompress(
-                    data, CALLER_XML_LIMIT)  # the first CALLER_XML_LIMIT bytes at most
-        except (OSError, zlib.error):
+            data = inflate(sibling.read_bytes(), CALLER_XML_LIMIT)
+        except (OSError, InflateError):
             continue
         for match in _PROGRAM_FILE.finditer(data):
             file = match.group(1).decode("utf-8", "replace").strip()

@@ -28,14 +28,11 @@ Marker labels are the English ones; PolyScope writes them in the language it run
 from __future__ import annotations
 
 import dataclasses
-import gzip
 import math
 import posixpath
 import re
-import zlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from xml.etree import ElementTree
 
 import numpy as np
 
@@ -82,6 +79,7 @@ from ..script.printer import format as print_tree
 from .installation import Installation
 from .preamble import _call, _num, _stmt, _version, payload_statements, preamble
 from .urp import Expression, Kinematics, Node, Program
+from .variables import parse_variables_file
 
 __all__ = ["CompileError", "Compiled", "FileReader", "compile_program", "names_installation",
            "parse_variables", "script_file_candidates", "waypoint_pose"]
@@ -493,29 +491,12 @@ def script_file_candidates(program: Program, file: str) -> list[str]:
 
 
 def parse_variables(data: bytes) -> list[tuple[str, str]]:
-    """The installation variables of a ``.variables`` file (Java properties: ``name=value``
-    lines, ``#`` comments; gzip-compressed or plain) in file order."""
-    if data[:2] == b"\x1f\x8b":
-        try:
-            data = gzip.decompress(data)
-        except (OSError, EOFError, zlib.error):
-            return []
-    text = data.decode("utf-8", "replace")
-    if text.lstrip().startswith("<"):  # PolyScope 5.x later: XML
-        try:
-            root = ElementTree.fromstring(text)
-        except ElementTree.ParseError:
-            return []
-        return [(v.get("name", ""), v.get("value", "")) for v in root.iter("variable")
-                if v.get("name")]
-    out = []
-    for line in text.splitlines():
-        line = line.strip()
-        if not line or line.startswith(("#", "!")) or "=" not in line:
-            continue
-        name, value = line.split("=", 1)
-        out.append((name.strip(), value.strip()))
-    return out
+    """The installation variables of a ``.variables`` file's bytes, ``(name, value as
+    written)`` in file order, as :func:`urdsl.polyscope.variables.parse_variables_file` reads
+    them (lines that are not ``name=value`` with a URScript value are left out: ``urdsl lint``
+    of the file reports them)."""
+    return [(variable.name, variable.text)
+            for variable in parse_variables_file(data, "<variables>").variables]
 
 
 class _Compiler:

@@ -24,13 +24,12 @@ A file that is not an installation, is truncated, corrupt or not XML raises
 
 from __future__ import annotations
 
-import gzip
-import io
 import math
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree
+
+from .gz import InflateError, inflate
 
 __all__ = ["Installation", "InstallationError", "Tcp", "Payload", "read_installation",
            "ModbusSignal", "Conveyor",
@@ -39,10 +38,6 @@ __all__ = ["Installation", "InstallationError", "Tcp", "Payload", "read_installa
 
 GRAVITY = 9.82
 """The gravity magnitude [m/s²] PolyScope writes in ``set_gravity``."""
-
-_MAX_SIZE = 64 * 1024 * 1024
-"""Largest decompressed installation accepted [bytes] (real ones are well under 1 MB)."""
-
 
 class InstallationError(Exception):
     """An installation file that cannot be read; the message names the file."""
@@ -308,17 +303,10 @@ def _number(text: str | None, what: str, path: str) -> float:
 
 
 def _decompress(data: bytes, path: str) -> bytes:
-    if data[:2] != b"\x1f\x8b":
-        return data
     try:
-        with gzip.GzipFile(fileobj=io.BytesIO(data)) as handle:
-            out = handle.read(_MAX_SIZE + 1)
-    except (OSError, EOFError, zlib.error) as error:
-        reason = "truncated" if isinstance(error, EOFError) else "corrupt"
-        raise InstallationError(path, f"the gzip data is {reason} ({error})") from None
-    if len(out) > _MAX_SIZE:
-        raise InstallationError(path, f"larger than {_MAX_SIZE // 2**20} MB uncompressed")
-    return out
+        return inflate(data)
+    except InflateError as error:
+        raise InstallationError(path, error.reason) from None
 
 
 def parse_installation(data: bytes, path: str = "<installation>") -> Installation:

@@ -27,12 +27,12 @@ accelerations in m/s² or rad/s², times in s.
 
 from __future__ import annotations
 
-import gzip
 import re
-import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.etree import ElementTree
+
+from .gz import InflateError, inflate, is_gzip
 
 __all__ = [
     "UrpError", "Expression", "Node", "Program", "read_urp", "parse_urp", "Kinematics",
@@ -217,13 +217,11 @@ class Program:
 
 
 def _decompress(data: bytes, path: str) -> bytes:
-    if data[:2] == b"\x1f\x8b":
-        try:
-            return gzip.decompress(data)
-        except (OSError, EOFError, zlib.error) as error:
-            raise UrpError(f"{path}: error: not a readable PolyScope program: the gzip data "
-                           f"is truncated or corrupt ({error})") from None
-    return data
+    try:
+        return inflate(data)
+    except InflateError as error:
+        raise UrpError(f"{path}: error: not a readable PolyScope program: "
+                       f"{error.reason}") from None
 
 
 def read_urp(path: str | Path) -> Program:
@@ -276,7 +274,7 @@ def is_text_file(path: str | Path) -> bool:
             head = handle.read(4096)
     except OSError:
         return False
-    if head.startswith(b"\x1f\x8b"):
+    if is_gzip(head):
         return False
     try:
         text = head.decode("utf-8")

@@ -17,18 +17,18 @@ kept.
 from __future__ import annotations
 
 import dataclasses
-import gzip
 import html
 import re
-import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..script import nodes as n
 from ..script.diagnostics import Diagnostic, ScriptError
 from ..script.parser import parse
+from .gz import InflateError, inflate
 
-__all__ = ["InstallationVariable", "VariablesFile", "parse_variables", "read_variables"]
+__all__ = ["InstallationVariable", "VariablesFile", "parse_variables", "parse_variables_file",
+           "read_variables"]
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _CODE = "URS001"
@@ -47,6 +47,12 @@ class InstallationVariable:
     @property
     def line(self) -> int:
         return self.span.line
+
+    @property
+    def text(self) -> str:
+        """The value as written (after Java's escapes and XML's entities are undone)."""
+        span = self.value.span
+        return span.source.text[span.start:span.end] if span.source is not None else ""
 
 
 @dataclass
@@ -212,16 +218,21 @@ def read_variables(path: str | Path) -> VariablesFile:
         data = path.read_bytes()
     except OSError as error:
         return _unreadable(path, f"cannot read {path}: {error.strerror}")
-    if data[:2] == b"\x1f\x8b":  # PolyScope often saves it gzip-compressed
-        try:
-            data = gzip.decompress(data)
-        except (OSError, EOFError, zlib.error) as error:
-            return _unreadable(path, f"{path} is a damaged gzip file: {error}")
+    return parse_variables_file(data, str(path))
+
+
+def parse_variables_file(data: bytes, filename: str = "<variables>") -> VariablesFile:
+    """The variables of a ``.variables`` file's bytes (gzip-compressed, as PolyScope often
+    saves it, or plain); a file that cannot be decompressed is one diagnostic."""
+    try:
+        data = inflate(data)
+    except InflateError as error:
+        return _unreadable(Path(filename), f"{filename} cannot be read: {error.reason}")
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         text = data.decode("latin-1")  # Java writes properties files in ISO 8859-1
-    return parse_variables(text, str(path))
+    return parse_variables(text, filename)
 
 
 def _unreadable(path: Path, message: str) -> VariablesFile:
