@@ -172,3 +172,24 @@ def test_a_gzip_bomb_beside_a_program_is_read_only_so_far(tmp_path, monkeypatch)
     assert check.calling_programs(program) == ["big.urp", "caller.urp"]
     monkeypatch.setattr(check, "CALLER_XML_LIMIT", 1_000_000)
     assert check.calling_programs(program) == ["caller.urp"]
+
+
+def test_the_programs_beside_a_folder_of_subprograms_are_read_once(tmp_path, monkeypatch):
+    # urdsl check of every program of a folder (CA-Giken keeps 80 in one): each file beside
+    # them is read once, not once per program checked; a file saved again is read again
+    from urdsl.polyscope import check, gz
+
+    reads = []
+    inflate = gz.inflate
+    monkeypatch.setattr(gz, "inflate", lambda data, limit=None: reads.append(1) or
+                        inflate(data, limit))
+    for index in range(4):
+        (tmp_path / f"SUB_{index}.urp").write_text(_program(""))
+    caller = tmp_path / "main.urp"
+    caller.write_text("<URProgram><programFile>/programs/SUB_1.urp</programFile></URProgram>")
+    assert [check.calling_programs(tmp_path / f"SUB_{i}.urp") for i in range(4)] == [
+        [], ["main.urp"], [], []]
+    assert len(reads) == 5  # the five files, each once
+    caller.write_text("<URProgram><programFile>/programs/SUB_2.urp</programFile>"
+                      "<!-- saved again --></URProgram>")
+    assert check.calling_programs(tmp_path / "SUB_2.urp") == ["main.urp"]

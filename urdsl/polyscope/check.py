@@ -18,6 +18,7 @@ has URCap nodes (a URCap's result variables) are given unknown values, as a devi
 from __future__ import annotations
 
 import dataclasses
+import functools
 import re
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -389,9 +390,8 @@ def calling_programs(path: str | Path) -> list[str]:
     ``CallSubProgram`` or ``SubProgram`` node whose ``<programFile>`` names this file
     (``/programs/GD/SUB_104.urp``; PolyScope keeps the subprogram's nodes in the caller and
     syncs them with that file). Files that cannot be read are skipped; at most
-    :data:`CALLER_SCAN_LIMIT` files are read."""
-    from .gz import InflateError, inflate
-
+    :data:`CALLER_SCAN_LIMIT` files are read, each once per process while it is unchanged
+    (checking every program of a folder reads each file once, not once per program)."""
     target = Path(path)
     name = target.name.lower()
     found: list[str] = []
@@ -402,17 +402,29 @@ def calling_programs(path: str | Path) -> list[str]:
         return found
     for sibling in siblings[:CALLER_SCAN_LIMIT]:
         try:
-            if sibling.stat().st_size > CALLER_XML_LIMIT:
-                continue
-            data = inflate(sibling.read_bytes(), CALLER_XML_LIMIT)
-        except (OSError, InflateError):
+            stat = sibling.stat()
+        except OSError:
             continue
-        for match in _PROGRAM_FILE.finditer(data):
-            file = match.group(1).decode("utf-8", "replace").strip()
-            if re.split(r"[\\/]", file)[-1].lower() == name:
-                found.append(sibling.name)
-                break
+        if stat.st_size <= CALLER_XML_LIMIT and name in _called_files(
+                str(sibling), stat.st_mtime_ns, stat.st_size, CALLER_XML_LIMIT):
+            found.append(sibling.name)
     return found
+
+
+@functools.lru_cache(maxsize=CALLER_SCAN_LIMIT)
+def _called_files(path: str, _mtime_ns: int, _size: int, limit: int) -> frozenset[str]:
+    """The file names (lower case, no folder) that the ``<programFile>`` elements of the
+    ``.urp`` at ``path`` name; empty for a file that cannot be read or decompresses to more
+    than ``limit`` bytes. Keyed by the file's modification time and size too: a file saved
+    again is read again."""
+    from .gz import InflateError, inflate
+
+    try:
+        data = inflate(Path(path).read_bytes(), limit)
+    except (OSError, InflateError):
+        return frozenset()
+    return frozenset(re.split(r"[\\/]", match.group(1).decode("utf-8", "replace").strip())[-1]
+                     .lower() for match in _PROGRAM_FILE.finditer(data))
 
 
 def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=None,
