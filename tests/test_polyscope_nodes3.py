@@ -107,3 +107,32 @@ def test_later_polyscope_marks_a_script_file_and_titles_an_error_popup_error():
         lines = compiled(OLD_NODES, version=version)
         assert any(line.startswith("$") and "Script: hello.script" in line for line in lines)
         assert 'popup("Lost", "Error", False, True, blocking=True)' in lines
+
+
+TAUGHT_THEN_NAMED = """
+        <Move motionType="MoveJ" speed="1.05" acceleration="1.4" useActiveTCP="true">
+          <feature class="GeomFeatureReference" referencedName="Joint_0_name"/>
+          <children>
+            {waypoint}
+          </children>
+        </Move>
+        <Assignment valueSource="Expression">
+          <variable name="first_p_wp" prefersPersistentValue="false"/>
+          <expression>
+            <ExpressionWaypoint>
+              <Waypoint referenceName="first_p" reference="../../../../Move/children/Waypoint"/>
+            </ExpressionWaypoint>
+          </expression>
+        </Assignment>""".format(waypoint=WAYPOINT.format(name="first_p"))
+
+
+def test_polyscope_3_writes_a_waypoint_in_an_expression_as_its_pose():
+    # samho_main_Fillet (3.15.8): PolyScope 3 has no waypoint globals, so "first_p_wp≔first_p"
+    # is written ``global first_p_wp=p[.431245807847, ...]``, not first_p_p (not defined)
+    lines = compiled(TAUGHT_THEN_NAMED, version="3.15.8.106339")
+    [assignment] = [line for line in lines if line.startswith("global first_p_wp")]
+    assert assignment.startswith("global first_p_wp = p[")
+    assert not any("first_p_p" in line for line in lines)
+    # PolyScope 5 names the waypoint's global
+    lines = compiled(TAUGHT_THEN_NAMED)
+    assert "global first_p_wp = first_p_p" in lines

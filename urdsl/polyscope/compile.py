@@ -660,9 +660,21 @@ class _Compiler:
             elif kind == "feature" and text in poses:
                 # a feature as a constant: its installation pose (m, rad), written in place
                 out.append(print_tree(Pose(tuple(_num(v) for v in poses[text]))))
+            elif kind == "waypoint" and self.version < 5 and self._waypoint_literal(text):
+                # PolyScope 3 has no waypoint globals: a fixed waypoint in an expression is its
+                # pose, written in place (seen: 3.15.8, "first_p_wp≔first_p" is written
+                # ``global first_p_wp=p[.431245807847, ...]``, samho_main_Fillet)
+                out.append(self._waypoint_literal(text))
             else:
                 out.append(Expression(((kind, text),)).script)
         return "".join(out)
+
+    def _waypoint_literal(self, name: str) -> str | None:
+        """The pose of the program's fixed waypoint ``name`` as URScript text, or None when
+        the program has no such waypoint with a pose."""
+        waypoint = self.waypoints.get(name)
+        pose = self.pose_of(waypoint) if waypoint is not None else None
+        return print_tree(Pose(tuple(_num(v) for v in pose))) if pose is not None else None
 
     def code(self, text: str, node: Node) -> list[Item]:
         try:
