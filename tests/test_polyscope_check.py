@@ -267,6 +267,27 @@ def test_a_missing_installation_is_named(tmp_path, capsys):
         capsys.readouterr().out)["context"]
 
 
+def test_a_urcap_function_of_a_missing_installation_is_a_device(tmp_path, capsys):
+    # proprioception_expt_program (5.11.7, project 159): a Script node calls Robotiq's
+    # rq_activate_and_wait(), which the URCap's code in the preamble of the missing
+    # installation defines; a function no URCap is known for stays an error
+    from _urp import script_line
+
+    program = tmp_path / "grip.urp"
+    program.write_text(_program(script_line("rq_activate_and_wait()")))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    assert "URCap functions, defined by the URCaps' code of the missing installation, taken " \
+        "as devices: rq_activate_and_wait" in report["context"]
+    program.write_text(_program(script_line("rq_activate_and_wait()") +
+                                script_line("grab_part()")))
+    assert main(["check", str(program), "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert [f["message"].split(" [node")[0] for f in report["findings"]
+            if f["severity"] == "error"] == ["name 'grab_part' is not defined"]
+
+
 def test_io_named_only_in_a_missing_installation(tmp_path, capsys):
     # a user's name for an input or output (a renamed pin, a Modbus signal) is resolved by
     # the installation: without it the program still compiles; a read is a value the check

@@ -255,13 +255,19 @@ def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Modu
     a stand-in for each function the program calls but defines nowhere, taking a device's
     reply time (:data:`urdsl.runtime.unknown.DEVICE_REPLY_TIME`) and as many parameters as
     its calls pass (keywords as parameters with a default), so that the check runs the rest
-    of the program; and their names. Nothing changes without such code."""
+    of the program; and their names. Without such code, only where the installation is
+    missing: a known URCap function the program calls (``rq_activate_and_wait()`` in a Script
+    node) is one its URCap's preamble code defines there (PolyScope writes the installed
+    URCaps' code into every program). Nothing changes otherwise."""
     from ..project.check import needed_names
     from ..runtime.unknown import DEVICE_REPLY_TIME
+    from ..script.urcaps import urcap_of
 
-    if not urcap_sources(generated):
-        return module, []
     _reads, calls, _threads = needed_names(module)
+    if not urcap_sources(generated):
+        if generated.installation is not None:
+            return module, []
+        calls = {name for name in calls if urcap_of(name) is not None}
     if not calls:
         return module, []
     positional: dict[str, int] = {name: 0 for name in calls}
@@ -537,8 +543,10 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         file_options.unknown_globals[stand_in_reply(name)] = \
             f"the reply of {name}(), which code only a URCap generates defines"
     if stand_ins:
-        notes.append("functions defined by code urdsl cannot generate, taken as devices: "
-                     + ", ".join(stand_ins))
+        where = ("URCap functions, defined by the URCaps' code of the missing installation"
+                 if generated.installation is None and not urcap_sources(generated)
+                 else "functions defined by code urdsl cannot generate")
+        notes.append(f"{where}, taken as devices: " + ", ".join(stand_ins))
     urcaps = {number for number, _node in generated.urcap_nodes()}
     report = check_tree(with_urcap_time(module, urcaps), generated.filename, file_options)
     report.inferred = inference
