@@ -288,6 +288,22 @@ def test_a_urcap_function_of_a_missing_installation_is_a_device(tmp_path, capsys
             if f["severity"] == "error"] == ["name 'grab_part' is not defined"]
 
 
+def test_a_feature_constant_of_a_missing_installation_is_unknown(tmp_path, capsys):
+    # Main.urp of project 126 (3.12.1): "pose1≔pose_add(Point_1_const, p[...])", the feature
+    # written as <feature referencedName="Point_1"/> (no class); the installation is not in
+    # the repository, so its pose is unknown, not an undefined name
+    assignment = ('<Assignment valueSource="Expression"><variable name="pose1"/><expression>'
+                  + _chars("pose_add(") + '<ExpressionGeomFeature><feature referencedName='
+                  '"Point_1"/></ExpressionGeomFeature>' + _chars(", p[0.01, 0, 0.03, 0, 0, 0])")
+                  + "</expression></Assignment>")
+    program = tmp_path / "Main.urp"
+    program.write_text(_program(assignment, version="3.12.1.90940"))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    assert "Point_1" in report["context"]
+
+
 def test_io_named_only_in_a_missing_installation(tmp_path, capsys):
     # a user's name for an input or output (a renamed pin, a Modbus signal) is resolved by
     # the installation: without it the program still compiles; a read is a value the check

@@ -180,8 +180,9 @@ class Program:
     """The folder the program was saved in on the robot (``directory``: ``/programs/LE``);
     script files the program names are found relative to it."""
     feature_variables: frozenset[str] = frozenset()
-    """Installation features the program's expressions read as variables (a feature made a
-    variable in the installation: ``pose_trans(Plane_3, p)``); the preamble defines them."""
+    """Installation features the program's expressions read: as variables (a feature made a
+    variable in the installation: ``pose_trans(Plane_3, p)``; the preamble defines them) or
+    as constants (``Point_1_const``: PolyScope writes the installation's pose in place)."""
     installation_names: frozenset[str] = frozenset()
     """Every name the program takes from its installation: installation variables
     (``<installationVariable name="i_count"/>``) and the features its moves and expressions
@@ -496,7 +497,10 @@ class _Reader:
             if piece.tag == "ExpressionGeomFeature" and name:
                 # another feature as a constant: its pose in the installation (seen:
                 # "Base_var:=Base_1_const" is written ``global Base_var=p[...]``, the
-                # installation's pose of Base_1; PolyScope 5.8, loukjeab/WS2223...)
+                # installation's pose of Base_1; PolyScope 5.8, loukjeab/WS2223...); a name
+                # only the installation gives (seen: 3.12.1, "pose_add(Point_1_const, p)" in
+                # an Assignment of project 126, whose installation is not in the repository)
+                self.feature_variables.add(name)
                 return ("feature", name)
             if target.tag == "GeomFeatureVariable" and name:
                 self.feature_variables.add(name)
