@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from html import escape
+
 
 def program(children: str, kinematics: str = "", *, installation: str = "default",
             version: str = "5.11.1", name: str = "t", loops: bool = False) -> str:
@@ -14,8 +16,8 @@ def program(children: str, kinematics: str = "", *, installation: str = "default
 
 
 def chars(text: str) -> str:
-    """An expression as PolyScope stores it: one element a character."""
-    return "".join(f'<ExpressionChar character="{c}"/>' for c in text)
+    """An expression as PolyScope stores it: one element a character (XML-escaped)."""
+    return "".join(f'<ExpressionChar character="{escape(c, quote=True)}"/>' for c in text)
 
 
 def script_line(code: str) -> str:

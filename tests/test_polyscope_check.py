@@ -304,6 +304,28 @@ def test_a_feature_constant_of_a_missing_installation_is_unknown(tmp_path, capsy
     assert "Point_1" in report["context"]
 
 
+def test_a_socket_a_urcaps_code_opens_answers(tmp_path, capsys):
+    # Floor Corner Extended.urp (project 6): Vention's URCap opens socket MachineMotion1 in
+    # the installation's preamble, which urdsl does not generate for a .urp; the program's
+    # reads of it are a device's replies, not "nothing read" ([0], whose item 1 is missing)
+    from _urp import script_line
+
+    program = tmp_path / "lift.urp"
+    program.write_text(_program(
+        script_line('temp_drive = socket_read_ascii_float(1, "MachineMotion1", timeout=15)')
+        + script_line("height = temp_drive[1]")))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+    # a script that never opens the socket reads nothing: item 1 is missing
+    script = tmp_path / "lift.script"
+    script.write_text('temp_drive = socket_read_ascii_float(1, "MachineMotion1", timeout=15)\n'
+                      "height = temp_drive[1]\n")
+    program.unlink()
+    assert main(["check", str(script), "--json"]) == 1
+    assert json.loads(capsys.readouterr().out)["findings"][0]["code"] == "URS202"
+
+
 def test_io_named_only_in_a_missing_installation(tmp_path, capsys):
     # a user's name for an input or output (a renamed pin, a Modbus signal) is resolved by
     # the installation: without it the program still compiles; a read is a value the check

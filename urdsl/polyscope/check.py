@@ -547,6 +547,14 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
                  if generated.installation is None and not urcap_sources(generated)
                  else "functions defined by code urdsl cannot generate")
         notes.append(f"{where}, taken as devices: " + ", ".join(stand_ins))
+    if file_options.environment is None and (urcap_sources(generated)
+                                             or generated.installation is None):
+        # a URCap's code (of the installation, missing or not, or of a node) opens sockets
+        # the program then uses (seen: Vention's MachineMotion1, project 6)
+        from ..runtime import Environment
+
+        file_options = dataclasses.replace(
+            file_options, environment=Environment(devices="unknown", foreign_sockets=True))
     urcaps = {number for number, _node in generated.urcap_nodes()}
     report = check_tree(with_urcap_time(module, urcaps), generated.filename, file_options)
     report.inferred = inference

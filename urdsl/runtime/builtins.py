@@ -23,6 +23,7 @@ from ..script.builtins import Builtin, lookup
 from ..script.builtins import method as lookup_method
 from ..script.nodes import Node
 from . import motion_builtins  # noqa: F401 - registers motion, robot state and pose maths
+from .environment import SocketModel
 from .registry import IMPLEMENTATIONS, implements
 from .unknown import (
     DEVICE_READS,
@@ -741,8 +742,6 @@ def _set_analog_out(rt, node, n, f):
 
 @implements("socket_open")
 def _socket_open(rt, node, address, port, socket_name="socket_0"):
-    from .environment import SocketModel
-
     allowed = rt.env.connectable
     ok = allowed is None or address in allowed or f"{address}:{port}" in allowed
     model = SocketModel(address, int(port), connected=ok)
@@ -754,6 +753,10 @@ def _socket_open(rt, node, address, port, socket_name="socket_0"):
 
 def _socket(rt, node, name: str):
     model = rt.env.sockets.get(name)
+    if model is None and rt.unknown and rt.env.foreign_sockets:
+        # opened by code the script does not hold (a URCap's installation code, seen:
+        # Vention's MachineMotion1 in project 6): a device that answers, unknown offline
+        model = rt.env.sockets[name] = SocketModel("", 0)
     if model is None or not model.connected:
         return None
     return model

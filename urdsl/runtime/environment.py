@@ -43,6 +43,9 @@ class Environment:
     working device would answer (see :mod:`urdsl.runtime.unknown`; ``urdsl check`` uses it).
     ``connectable``: hosts (as strings, with or without ``:port``) a script's
     ``socket_open`` may "connect" to; ``None`` means every host (nothing is opened either way).
+    ``foreign_sockets``: code the script does not hold (a URCap's preamble, which urdsl
+    cannot generate for a ``.urp``) may have opened sockets: with unknown devices, a socket
+    the script uses without opening it is taken as open, to a device that answers.
     """
 
     standard_digital_in: list[bool] = field(default_factory=lambda: [False] * 8)
@@ -66,4 +69,5 @@ class Environment:
     unsupported: str = "default"
     devices: str = "quiet"
     connectable: set[str] | None = None
+    foreign_sockets: bool = False
     messages: list[tuple[float, str, str]] = field(default_factory=list)
