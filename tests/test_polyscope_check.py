@@ -326,6 +326,29 @@ def test_a_socket_a_urcaps_code_opens_answers(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["findings"][0]["code"] == "URS202"
 
 
+def test_a_variable_a_urcap_node_is_set_up_with_is_its_result(tmp_path, capsys):
+    # UR5e_Program.urp (project 82): an OPC UA URCap node reads into the program variable
+    # "service" (<data key="selectedProgramVariable" value="service"/>) before the program
+    # assigns it itself; the node's code, which urdsl does not generate, sets it
+    from _urp import script_line
+
+    read = ('<Contributed strategyClass="com.example.OpcuaRead" strategyProgramNodeType='
+            '"Read" strategyURCapDeveloper="Example Inc." strategyURCapName="Example_OPCUA">'
+            '<dataModel><data key="selectedProgramVariable" value="service"/></dataModel>'
+            "</Contributed>")
+    body = ('<CallSubProgram><subprogram name="Service" keepHidden="false" '
+            'keepSynchronizedWithDisk="false"><children>' + read
+            + script_line("switch_1 = service") + script_line("global service = 0")
+            + "</children></subprogram></CallSubProgram>")
+    program = tmp_path / "opc.urp"
+    program.write_text(_program(body).replace(
+        "</MainProgram>", '</MainProgram><SubProgram reference="../MainProgram/children/'
+        'CallSubProgram/subprogram"/>'))
+    assert main(["check", str(program), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not [f for f in report["findings"] if f["severity"] == "error"]
+
+
 def test_io_named_only_in_a_missing_installation(tmp_path, capsys):
     # a user's name for an input or output (a renamed pin, a Modbus signal) is resolved by
     # the installation: without it the program still compiles; a read is a value the check

@@ -242,6 +242,14 @@ def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
     if urcaps:
         names = ", ".join(dict.fromkeys(node.title for _number, node in urcaps))
         values = {name: f"a URCap node's result ({names})" for name in undefined_globals(module)}
+        # a variable a URCap node is set up with (``<data key="selectedProgramVariable"
+        # value="service"/>``, an OPC UA read of project 82): its code sets it, also where the
+        # program assigns it elsewhere too (so it is not undefined to the program as a whole)
+        for _number, node in urcaps:
+            for data in node.element.iter("data") if node.element is not None else ():
+                name = data.get("value") or ""
+                if "variable" in (data.get("key") or "").lower() and name.isidentifier():
+                    values.setdefault(name, f"a URCap node's result ({node.title})")
     # the missing installation's preamble would define each of its names the program uses
     # before the program runs, also one the program assigns itself (``i_count = i_count + 1``)
     used = {node.id for node in n.walk(module) if isinstance(node, n.Name)}
