@@ -280,6 +280,12 @@ def test_a_urcap_function_of_a_missing_installation_is_a_device(tmp_path, capsys
     assert not [f for f in report["findings"] if f["severity"] == "error"]
     assert "URCap functions, defined by the URCaps' code of the missing installation, taken " \
         "as devices: rq_activate_and_wait" in report["context"]
+    # lint: a warning naming the URCap and the missing installation
+    assert main(["lint", "--format", "json", str(program)]) == 0
+    [found] = json.loads(capsys.readouterr().out)
+    assert (found["code"], found["severity"]) == ("URS102", "warning")
+    assert "a function of the URCap" in found["message"] and "Robotiq_Grippers" in \
+        found["message"] and "default.installation" in found["message"]
     program.write_text(_program(script_line("rq_activate_and_wait()") +
                                 script_line("grab_part()")))
     assert main(["check", str(program), "--json"]) == 1

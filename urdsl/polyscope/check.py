@@ -161,6 +161,7 @@ def urcap_sources(generated: Generated) -> list[str]:
 
 
 _UNDEFINED_NAME = re.compile(r"name '(\w+)' is not defined")
+_UNKNOWN_FUNCTION = re.compile(r"unknown function '(\w+)'")
 
 
 def without_urcap_busy_loops(generated: Generated, found: list) -> list:
@@ -190,16 +191,29 @@ def soften_urcap_names(generated: Generated, found: list) -> list:
     complete: a name or function defined nowhere in what urdsl generated (URS101, URS102)
     may come from a URCap's code, and a feature the program reads from its installation is
     defined by the installation's preamble, which is not written when the installation is
-    missing: warnings that say so rather than errors."""
+    missing, as is a known URCap function (the installation's URCap code defines it):
+    warnings that say so rather than errors."""
+    from ..script.urcaps import urcap_of
+
     sources = urcap_sources(generated)
     features = missing_features(generated)
     out = []
     for finding in found:
         name = _UNDEFINED_NAME.match(finding.message) if finding.code == "URS101" else None
+        function = _UNKNOWN_FUNCTION.match(finding.message) if finding.code == "URS102" \
+            else None
         if name and name.group(1) in features and finding.severity == "error":
             finding = replace(finding, severity="warning",
                               message=f"{finding.message}: {features[name.group(1)]}",
                               hint="put the program's installation beside it")
+        elif function and generated.installation is None and finding.severity == "error" \
+                and urcap_of(function.group(1)) is not None:
+            named = generated.program.installation
+            finding = replace(finding, severity="warning", message=(
+                f"{finding.message}: a function of the URCap "
+                f"{' or '.join(urcap_of(function.group(1)) or ())}, whose code the "
+                f"installation {named + '.installation ' if named else ''}adds (not beside "
+                "the program)"), hint="put the program's installation beside it")
         elif sources and finding.code in ("URS101", "URS102") and finding.severity == "error":
             finding = replace(finding, severity="warning", message=(
                 f"{finding.message}; it may come from code only a URCap generates "
