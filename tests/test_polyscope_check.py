@@ -490,6 +490,32 @@ def test_an_export_is_checked_on_the_arm_of_the_program_beside_it(tmp_path, caps
     assert reach["severity"] == "warning" and "calibration decides" in reach["message"]
 
 
+def test_an_export_without_waypoints_is_checked_on_the_model_of_its_program(tmp_path, capsys):
+    # project 135's Program1.script (no waypoint pairs, so no model to infer from them) was
+    # checked on an assumed UR5e; the Program1.urp beside it keeps a UR5's factory table, on
+    # which `urdsl check Program1.urp` checks it: the export is checked on that arm too
+    ur10e = ('<kinematics><deltaTheta value="0, 0, 0, 0, 0, 0"/>'
+             '<a value="0.0, -0.6127, -0.57155, 0.0, 0.0, 0.0"/>'
+             '<d value="0.1807, 0.0, 0.0, 0.17415, 0.11985, 0.11655"/>'
+             '<alpha value="1.5707963267948966, 0, 0, 1.5707963267948966, '
+             '-1.5707963267948966, 0"/></kinematics>')
+    (tmp_path / "far.urp").write_text(_program(
+        '<Wait type="Sleep"><waitTime>0.1</waitTime></Wait>', ur10e))
+    export = tmp_path / "far.script"
+    export.write_text("def far():\n  movej(p[1.0, 0.2, 0.3, 0, 3.1416, 0], a=1.0, v=0.5)\n"
+                      "end\n")
+    assert main(["check", str(export), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["robot"] == "ur10e"
+    assert "calibration of far.urp's <kinematics>" in report["context"]
+    # alone, it is checked on an assumed UR5e, which cannot reach the pose: a warning
+    (tmp_path / "far.urp").unlink()
+    assert main(["check", str(export), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["robot"] == "ur5e" and [f["severity"] for f in report["findings"]
+                                          if f["code"] == "URS301"] == ["warning"]
+
+
 def test_a_polyscope_1_program_is_urdsls_limit_not_the_programs_mistake(tmp_path, capsys):
     # a CB2 controller runs it; urdsl cannot read it: a warning, never an error
     program = tmp_path / "old.urp"

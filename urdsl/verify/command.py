@@ -290,13 +290,22 @@ def _check_script(source, args: argparse.Namespace, options):
     inference = infer(module, source.path, robot=options.robot if args.robot else None,
                       start_joints=args.start_joints or args.start_joints_deg, tcp=args.tcp,
                       default_robot=options.robot)
+    export = _export_kinematics(source.path)
+    if export is not None and inference.robot_source == "default":
+        # no taught waypoint pairs: the arm whose factory table the PolyScope program of this
+        # export keeps is the robot the program was written on
+        inference.robot, inference.robot_source = export[1], "inferred"
+        inference.robot_from = f"the <kinematics> of {export[2]} (the arm's calibration)"
     file_options = apply(options, inference, tcp_given=args.tcp is not None)
     file_options.hostless = context is not None and context.hostless
     if args.cell and file_options.robot != options.robot:
         file_options.cell = load_cell(file_options.robot, args.cell)
     if context is not None and context.hosts:
         inference.polyscope = True  # a fragment of a program PolyScope runs: taught on an arm
-    calibrated = None if args.nominal else _export_calibration(source.path, file_options)
+    calibrated = None
+    if export is not None and not args.nominal and export[1] == file_options.robot:
+        file_options.calibration = export[0]
+        calibrated = f"on this very arm: the {export[1]} calibration of {export[2]}'s <kinematics>"
     report = check_tree(module, source.name, file_options, started=started)
     report.inferred = inference
     qualify_report(report, inference, calibrated=file_options.calibration is not None)
@@ -308,11 +317,11 @@ def _check_script(source, args: argparse.Namespace, options):
     return report
 
 
-def _export_calibration(path: str | None, options) -> str | None:
+def _export_kinematics(path: str | None):
     """For an export (``X.script`` with PolyScope's ``X.urp`` beside it, whose ``<kinematics>``
-    is the arm's factory calibration): check on that very arm, as ``urdsl check X.urp`` does
-    (``options.calibration`` set when the calibration is of the model checked). A note
-    saying so, or None (no such program, no such block, another model)."""
+    is the arm's factory calibration): ``(calibration, model, "X.urp")``, the arm ``urdsl
+    check X.urp`` checks on; None when there is no such program or block, or it matches no
+    model."""
     from pathlib import Path
 
     from ..polyscope.check import calibration_of
@@ -327,12 +336,10 @@ def _export_calibration(path: str | None, options) -> str | None:
         program = read_urp(program_path)
     except (UrpError, OSError):
         return None
-    calibration, model = calibration_of(program, options.robot)
-    if calibration is None or model != options.robot:
+    calibration, model = calibration_of(program)
+    if calibration is None or model is None:
         return None
-    options.calibration = calibration
-    return (f"on this very arm: the {model} calibration of {program_path.name}'s "
-            "<kinematics>")
+    return calibration, model, program_path.name
 
 
 def _check_urp(name: str, args: argparse.Namespace, options):

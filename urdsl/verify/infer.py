@@ -75,12 +75,15 @@ class Inference:
     installation: str | None = None
     notes: list[str] = field(default_factory=list)
     polyscope: bool = False  # written by PolyScope (waypoint pairs or `$` labels): taught
+    robot_from: str = ""  # where an inferred robot comes from, when not waypoint pairs
 
     def robot_line(self) -> str:
         """One sentence about the robot model."""
         found = self.identification
         if self.robot_source == "given":
             return f"robot {self.robot} as given"
+        if self.robot_from:
+            return f"robot {self.robot} from {self.robot_from}"
         if self.robot_source == "inferred":
             share = (f"{found.used} of {found.pairs}" if found.used < found.pairs
                      else str(found.pairs))
