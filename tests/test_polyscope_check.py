@@ -508,6 +508,8 @@ def test_an_export_without_waypoints_is_checked_on_the_model_of_its_program(tmp_
     report = json.loads(capsys.readouterr().out)
     assert report["robot"] == "ur10e"
     assert "calibration of far.urp's <kinematics>" in report["context"]
+    assert report["inferred"]["robot"]["from"] == "the <kinematics> of far.urp (the arm's " \
+        "calibration)" and "reason" not in report["inferred"]["robot"]
     # alone, it is checked on an assumed UR5e, which cannot reach the pose: a warning
     (tmp_path / "far.urp").unlink()
     assert main(["check", str(export), "--json"]) == 0

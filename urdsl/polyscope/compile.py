@@ -673,7 +673,9 @@ class _Compiler:
         """The pose of the program's fixed waypoint ``name`` as URScript text, or None when
         the program has no such waypoint with a pose."""
         waypoint = self.waypoints.get(name)
-        pose = self.pose_of(waypoint) if waypoint is not None else None
+        if waypoint is None or waypoint.fields.get("type") != "Fixed":
+            return None  # a relative waypoint's form is not seen: its global's name stays
+        pose = self.pose_of(waypoint)
         return print_tree(Pose(tuple(_num(v) for v in pose))) if pose is not None else None
 
     def code(self, text: str, node: Node) -> list[Item]:

@@ -140,8 +140,10 @@ class Inference:
             if found.runner_up is not None:
                 robot["runner_up"] = {"model": found.runner_up[0],
                                       "residual": round(found.runner_up[1], 6)}
-            if found.reason:
+            if found.reason and not self.robot_from:
                 robot["reason"] = found.reason
+        if self.robot_from:
+            robot["from"] = self.robot_from
         start: dict[str, Any] = {"joints": [round(v, 9) for v in self.start_joints],
                                  "source": self.start_source}
         if self.start_from and self.start_source == "inferred":
