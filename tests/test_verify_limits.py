@@ -267,8 +267,8 @@ def test_a_tcp_speed_a_move_ends_with_is_not_the_next_moves():
         [np.block([[np.eye(3), row[:3, None]], [np.zeros((1, 3)), np.ones((1, 1))]])
          for row in qs]))
     source = Source("movel(a)\nmovel(b)\n", "t.script")
-    segments = [SimpleNamespace(kind="movel", span=Span(source, 0, 8), tcp=None),
-                SimpleNamespace(kind="movel", span=Span(source, 9, 17), tcp=None)]
+    segments = [SimpleNamespace(kind="movel", span=Span(source, 0, 8), tcp=None, params={}),
+                SimpleNamespace(kind="movel", span=Span(source, 9, 17), tcp=None, params={})]
     trace = SimpleNamespace(q=q, times=np.arange(8) * dt, dt=dt, segments=segments,
                             segment=np.array([0, 0, 0, 0, 1, 1, 1, 1]))
     (finding,) = tcp_speed(trace, robot, 5.0)

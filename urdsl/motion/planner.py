@@ -382,8 +382,11 @@ class MotionPlanner:
         q_from = self._q
         delta = np.abs(q - q_from)
         lead = int(np.argmax(delta))  # equal a, v for all joints: the longest way leads
-        profile = Trapezoid.plan(float(delta[lead]), self._joint_speed(delta, lead, v), a, t)
+        speed = self._joint_speed(delta, lead, v)
+        profile = Trapezoid.plan(float(delta[lead]), speed, a, t)
         params = {"a": a, "v": v, "t": t, "lead": lead}
+        if t > 0:  # what its a and v alone would take (see urdsl.verify.checks.SCALED_MARGIN)
+            params["t_free"] = Trapezoid.plan(float(delta[lead]), speed, a).duration
         if solved:
             params["solved"] = True
         return self._add(self._segment("movej", profile, q_from, q, r, span, params), now)
@@ -432,6 +435,8 @@ class MotionPlanner:
         if a_rot is None:
             a_rot = ROTATION_PER_METRE * a
         profile = line_profile(pose_from, pose, v, a, t, v_rot, a_rot)
+        if t > 0:  # what its a and v alone would take (see urdsl.verify.checks.SCALED_MARGIN)
+            params["t_free"] = line_profile(pose_from, pose, v, a, 0.0, v_rot, a_rot).duration
         length = float(np.linalg.norm(pose[:3, 3] - pose_from[:3, 3]))
         if turn_rule and t <= 0 and \
                 profile.duration > Trapezoid.plan(length, v, a).duration + 1e-9:

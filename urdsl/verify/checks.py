@@ -187,8 +187,8 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
                 "measurement): the controller may turn the tool slower"
                 if move.params.get("turn_timed") else
                 f"{finding.message}; the controller slows a program's moves so that no joint "
-                f"exceeds its speed limit (UR user manual, safety joint limits): this "
-                f"{move.kind} takes longer than planned"))
+                f"exceeds its speed limit (UR user manual, safety joint limits): "
+                f"{_takes_longer(move)}"))
         if everywhere and segment in everywhere and trace.times[sample] <= everywhere[segment]:
             finding = replace(finding, cause=f"{JOINTS[joint]}, {EVERY_MODEL}", message=(
                 f"{finding.message}, on the way to where the path leaves every UR model's "
@@ -208,7 +208,16 @@ may also come from that undocumented rate. These stay errors: a speed over this 
 path near a singularity, where the joints speed up without bound: 30 rad/s in project 135, and
 UR's distributor notes say the arm stops [U]), a move whose time ``t`` the program gives
 (whether the controller stretches a given time is not documented [U]), servo and speed
-commands, and any speed on a move whose path fails (URS302/URS303).'''
+commands, and any speed on a move whose path fails (URS302/URS303).
+
+A move whose time ``t`` the program gives is judged at the speeds its ``a`` and ``v`` alone
+give (the segment's ``t_free``, s) when ``t`` is shorter: the joint speeds scale with
+``t_free / t``, so what a too short ``t`` adds is time the controller stretches, as for any
+move, and what stays is the path's own (a singularity). The manual's sentence covers every
+motion of a running program and names no exception for a given time; that the controller
+stretches a given ``t`` rather than stop is not documented [U] (project 26 of
+bench/realworld: a 0.1 s ``t`` for 0.1-0.7 m lines, run on a UR3 and a UR3e by its author's
+account).'''
 
 SCALED_KINDS = frozenset({"movej", "movel", "movep", "movec"})
 """Moves whose speed the controller's trajectory generator scales (:data:`SCALED_MARGIN`)."""
@@ -224,14 +233,32 @@ def _samples_of(trace: Trace, segment: int) -> slice:
 def _slowed(trace: Trace, segment: int, ratio: float, exclude: np.ndarray | None):
     """The move ``segment`` when the controller slows it rather than stop at a speed
     ``ratio`` times a limit (:data:`SCALED_MARGIN`); else None."""
-    if segment < 0 or ratio > SCALED_MARGIN:
+    if segment < 0:
         return None
     move = trace.segments[segment]
-    if move.kind not in SCALED_KINDS or move.params.get("t", 0) > 0:
+    if move.kind not in SCALED_KINDS:
+        return None
+    given = move.params.get("t", 0)
+    if given > 0:
+        free = move.params.get("t_free")
+        if not free:
+            return None
+        ratio *= min(1.0, given / free)  # the part of the speed a too short t adds
+    if ratio > SCALED_MARGIN:
         return None
     if exclude is not None and bool(exclude[_samples_of(trace, segment)].any()):
         return None  # the move's path fails: the speed is that failure's
     return move
+
+
+def _takes_longer(move) -> str:
+    """What slowing ``move`` (a trace segment) down means for its time, for a message."""
+    given, free = move.params.get("t", 0), move.params.get("t_free")
+    if given > 0 and free and given < free:
+        return (f"this {move.kind} takes longer than the t={given:g} s the program gives it "
+                f"(its a and v alone take {free:.2f} s; that the controller stretches a given "
+                "time is not documented)")
+    return f"this {move.kind} takes longer than planned"
 
 
 def _carried(trace: Trace, over: np.ndarray) -> np.ndarray:
@@ -571,8 +598,8 @@ def tcp_speed(trace: Trace, robot, limit: float, exclude: np.ndarray | None = No
         if move is not None:  # the controller reduces the speed to the safety limit
             finding = replace(finding, severity="warning", message=(
                 f"{finding.message}; the controller slows a program's moves to keep the TCP "
-                f"within the safety limit (UR user manual, software safety limits): this "
-                f"{move.kind} takes longer than planned"))
+                f"within the safety limit (UR user manual, software safety limits): "
+                f"{_takes_longer(move)}"))
         findings.append(finding)
     return findings
 
@@ -854,17 +881,22 @@ for the base and shoulder of a UR10; see 'urdsl models'). urdsl samples the plan
 the controller rate (2 ms e-Series, 8 ms CB3) and reports the first move in which a joint is
 faster than its limit, with the joint and its peak speed. A linear move near a singularity,
 where the joints must turn fast for a slow TCP, causes it (the robot speeds up and stops with
-a joint limit violation [U: UR distributor Zacobria's notes on singularities]), and so does a
-movej whose time t is too short. A movej with a v over a joint's top speed is not: it is
-timed at the fastest speed the joints allow [U], and 'urdsl lint' warns about the v (URS110).
-The controller slows a running program so that no joint exceeds its speed limit (the user
-manual's safety joint limits): a joint over its limit by at most 2x on a movej, movel, movep
-or movec is a warning that the move takes longer than planned, unless the program gives its
-time t. Faster, near a singularity, the arm stops. A movel or movep that mostly turns the
-tool is timed by its turn at 4·v rad/s, a rate a user measured and UR does not document [U]:
-its warning says so.""",
-    example=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], t=0.2)",
-    fixed=f"{_READY}\nmovej([3, -1.9, 1.9, -1.57, -1.57, 0], t=2.0)",
+a joint limit violation [U: UR distributor Zacobria's notes on singularities]). A movej with
+a v over a joint's top speed is not: it is timed at the fastest speed the joints allow [U],
+and 'urdsl lint' warns about the v (URS110). The controller slows a running program so that
+no joint exceeds its speed limit (the user manual's safety joint limits): a joint over its
+limit by at most 2x on a movej, movel, movep or movec is a warning that the move takes longer
+than planned. A move given a time t shorter than its own a and v take is judged at the
+speeds a and v give: what the short t adds is time the controller stretches (the warning
+names t; UR documents no exception for a given time, nor that it stretches one [U]).
+Faster, near a singularity, the arm stops. A movel or movep that mostly turns the tool is
+timed by its turn at 4·v rad/s, a rate a user measured and UR does not document [U]: its
+warning says so.""",
+    example=f"{_READY}\nmovel(p[-0.35, -0.14, 0.465, 2.2206, 2.2206, 0])\n"
+            "movel(p[0.35, -0.14, 0.465, 2.2206, 2.2206, 0], v=1.0)  # 5 cm from the "
+            "shoulder singularity",
+    fixed=f"{_READY}\nmovel(p[-0.35, -0.14, 0.465, 2.2206, 2.2206, 0])\n"
+          "movel(p[0.35, -0.14, 0.465, 2.2206, 2.2206, 0], v=0.25)  # slower near it",
 )
 def _joint_speeds(ctx: TraceContext) -> list[Finding]:
     qd_max = np.asarray(ctx.robot.qd_max, dtype=float)
