@@ -243,8 +243,30 @@ def missing_features(generated: Generated) -> dict[str, str]:
         for name in sorted(program.installation_names)}  # feature variables too
     # also with another installation found beside the program in its place
     for name, what in generated.compiled.unknown.items():
-        out.setdefault(name, f"{what} of the installation {named} (not beside the program)")
+        export = generated.compiled.exported.get(name)
+        out.setdefault(name, f"{what} of the installation {export} was exported with (the "
+                             f"{_installation_name(generated)} beside the program lacks it)"
+                       if export else
+                       f"{what} of the installation {named} (not beside the program)")
     return out
+
+
+def _installation_name(generated: Generated) -> str:
+    """The file name of the installation found for the program, for messages."""
+    return Path(str(generated.installation.path)).name if generated.installation else "?"
+
+
+def exported_values(generated: Generated, module: n.Module) -> dict[str, str]:
+    """Variables and features the program reads but defines nowhere, while the installation
+    found for it is there, that PolyScope's export beside the program defines (its preamble:
+    the installation the program ran with had them; see :mod:`urdsl.polyscope.export`):
+    each with where its unknown value comes from."""
+    export = generated.compiled.export
+    if export is None or generated.installation is None:
+        return {}
+    return {name: f"a name of the installation {export.path.name} was exported with (the "
+                  f"{_installation_name(generated)} beside the program lacks it)"
+            for name in undefined_globals(module) if name in export.names}
 
 
 def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
@@ -287,9 +309,13 @@ def with_urcap_functions(generated: Generated, module: n.Module) -> tuple[n.Modu
 
     _reads, calls, _threads = needed_names(module)
     if not urcap_sources(generated):
+        export = generated.compiled.export
         if generated.installation is not None:
-            return module, []
-        calls = {name for name in calls if urcap_of(name) is not None}
+            # a function the installation's URCaps define, which the installation beside
+            # the program lacks and the export's preamble has
+            calls = {name for name in calls if export is not None and name in export.functions}
+        else:
+            calls = {name for name in calls if urcap_of(name) is not None}
     if not calls:
         return module, []
     positional: dict[str, int] = {name: 0 for name in calls}
@@ -557,9 +583,18 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     borrowed_joints = borrowed and joints_open and file_options.q_min is not None
     borrowed_planes = borrowed and planes_open and bool(file_options.safety_planes)
     file_options.unknown_globals = urcap_values(generated, module)
-    if file_options.unknown_globals:
+    exported = exported_values(generated, module)
+    stale = sorted({*exported, *generated.compiled.exported})
+    missing = sorted(set(file_options.unknown_globals) - set(stale))
+    if missing:
         notes.append("unknown values (URCap nodes' results, names of a missing "
-                     "installation): " + ", ".join(sorted(file_options.unknown_globals)))
+                     "installation): " + ", ".join(missing))
+    if stale and generated.compiled.export is not None:
+        notes.append(f"names the {_installation_name(generated)} beside the program lacks and "
+                     f"{generated.compiled.export.path.name} (PolyScope's export of it) defines, "
+                     "read as unknown values of the installation the program ran with: "
+                     + ", ".join(stale))
+    file_options.unknown_globals |= exported
     module, stand_ins = with_urcap_functions(generated, module)
     for name in stand_ins:
         file_options.unknown_globals[stand_in_reply(name)] = \

@@ -16,6 +16,7 @@ from .compile import (
     names_installation,
     parse_variables,
 )
+from .export import exported_by
 from .installation import Installation, InstallationError, find_installation, read_installation
 from .urp import Node, Program, UrpError, read_urp
 
@@ -192,8 +193,14 @@ def load_all(path: str | Path, warn: Callable[[str], None] = _warn, *, once: boo
         file = folder / relative
         return file.read_bytes() if file.is_file() else None
 
-    compiled = compile_program(program, installation, variables, files)
-    if compiled.unknown:
+    export = exported_by(path) if installation is not None else None
+    compiled = compile_program(program, installation, variables, files, export)
+    if compiled.exported and installation is not None and export is not None:
+        warn(f"{path}: {Path(str(installation.path)).name} lacks "
+             f"{', '.join(compiled.exported)}, which {export.path.name} beside the program "
+             "adds (the installation the program ran with had them): read as unknown values, "
+             "the Set nodes writing them as their markers alone")
+    if set(compiled.unknown) - set(compiled.exported):
         warn(f"{path}: values only the missing installation gives ({compiled.unknown_text()}): "
              "read as names of their own, unknown to the check; the Set nodes writing such "
              "an I/O are written as their markers alone")

@@ -76,6 +76,7 @@ from ..script.nodes import (
 )
 from ..script.parser import keywords
 from ..script.printer import format as print_tree
+from .export import Export
 from .installation import Installation
 from .preamble import _call, _num, _stmt, _version, payload_statements, preamble
 from .urp import Expression, Kinematics, Node, Program
@@ -124,6 +125,12 @@ class Compiled:
     it stands for: its I/O names (a renamed pin or a Modbus signal: read as a name of that
     value, their Set nodes left with their marker alone) and its safe home position
     (``SAFE_HOME``). Unknown to the check; a controller would stop at the first of them."""
+    exported: dict[str, str] = field(default_factory=dict)
+    """Of :attr:`unknown`, the I/O names the installation beside the program lacks and the
+    export beside it (:mod:`urdsl.polyscope.export`) adds: name → that export's file name.
+    The installation the program ran with gave them."""
+    export: Export | None = None
+    """What that export defines (read when an installation was found for the program)."""
 
     def unknown_text(self) -> str:
         """:attr:`unknown` for a message: ``gripper (an I/O), urdsl_safe_home (the safe home
@@ -458,15 +465,17 @@ _POPUP_TITLES = {"Message": "Message", "Warning": "Warning", "Error": "Error"}
 
 def compile_program(program: Program, installation: Installation | None = None,
                     variables: list[tuple[str, str]] | None = None,
-                    files: FileReader | None = None) -> Compiled:
+                    files: FileReader | None = None, export: Export | None = None) -> Compiled:
     """Compile ``program`` as PolyScope does, with its installation and the installation's
     variables (``NAME.variables`` beside it: (name, value as written) pairs, see
     :func:`parse_variables`). ``files`` reads the script files the program's Script nodes
     name (see :func:`script_file_candidates`): PolyScope compiles a script file's current
     contents, and the copy the ``.urp`` keeps (``cachedContents``) only stands in when the
-    file is not found. Raises :class:`CompileError` naming the file and node for a node it
-    cannot compile."""
-    return _Compiler(program, installation, variables or [], files).run()
+    file is not found. ``export``: what PolyScope's export beside the program defines (see
+    :mod:`urdsl.polyscope.export`): an I/O the installation lacks and the export adds is an
+    unknown value (:attr:`Compiled.exported`), not a node that cannot compile. Raises
+    :class:`CompileError` naming the file and node for a node it cannot compile."""
+    return _Compiler(program, installation, variables or [], files, export).run()
 
 
 def script_file_candidates(program: Program, file: str) -> list[str]:
@@ -501,9 +510,12 @@ def parse_variables(data: bytes) -> list[tuple[str, str]]:
 
 class _Compiler:
     def __init__(self, program: Program, installation: Installation | None,
-                 variables: list[tuple[str, str]], files: FileReader | None = None) -> None:
+                 variables: list[tuple[str, str]], files: FileReader | None = None,
+                 export: Export | None = None) -> None:
         self.program = program
         self.files = files
+        self.export = export
+        self.exported: dict[str, str] = {}  # I/O names only the export gives: its file name
         self.installation = installation
         self.variables = variables
         self.numbers: dict[int, Node] = {}
@@ -611,7 +623,8 @@ class _Compiler:
             # [U: other words]
             name = "P" + name
         module = _ascii_names(Module((FunctionDef(name, (), tuple(body)),)))
-        return Compiled(module, self.numbers, self.labels, dict(self.unknown))
+        return Compiled(module, self.numbers, self.labels, dict(self.unknown),
+                        dict(self.exported), self.export)
 
     def _all_nodes(self, suppressed: bool = False):
         """Nodes in program order; with ``suppressed``, suppressed subtrees too (each node in
@@ -1001,10 +1014,15 @@ class _Compiler:
         """Whether ``pin`` is a name only the installation could resolve, and it is not
         there: a user's name for a pin (``gripperopen``) or a Modbus signal. PolyScope writes
         the pin's or signal's own function, which nothing here says; urdsl reads the name
-        as a value of its own (unknown to the check) and writes nothing for a Set of it."""
-        if (self.installation is not None and self.installation_named()) or \
-                pin in self.pins or _PIN.match(pin) or not pin.isidentifier():
+        as a value of its own (unknown to the check) and writes nothing for a Set of it.
+        So too for a Modbus signal the installation beside the program lacks and PolyScope's
+        export of the program adds (the installation it ran with had it)."""
+        if pin in self.pins or _PIN.match(pin) or not pin.isidentifier():
             return False
+        if self.installation is not None and self.installation_named():
+            if self.export is None or pin not in self.export.signals:
+                return False
+            self.exported[pin] = self.export.path.name
         self.unknown[pin] = "an I/O"
         return True
 
