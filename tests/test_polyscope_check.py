@@ -700,3 +700,21 @@ def test_limits_a_taught_waypoint_lies_beyond_in_a_borrowed_installation(cell, c
     assert planes and {f["severity"] for f in planes} == {severity}
     assert all(("was taught beyond this limit of cell.installation" in f["message"])
                == (severity == "warning") for f in planes)
+
+
+def test_an_empty_robot_program_says_it_holds_only_the_placeholder(tmp_path, capsys):
+    # a looping program saved before anything was put in it (project 53's test.urp): the
+    # runaway loop it would be says first that the program is unfinished
+    program = tmp_path / "test.urp"
+    program.write_text(_program("<Placeholder/>", loops=True))
+    assert main(["check", str(program)]) == 1
+    out = capsys.readouterr().out
+    assert "the Robot Program holds only PolyScope's <empty> placeholder" in out
+    assert "URS207" in out and "hint: put the program's nodes in the Robot Program" in out
+    # a loop of something that takes no time is the plain runaway loop
+    program.write_text(_program(
+        '<Script type="Line"><expression>' + _chars("x = 1") + "</expression></Script>",
+        loops=True))
+    assert main(["check", str(program)]) == 1
+    out = capsys.readouterr().out
+    assert "URS207" in out and "placeholder" not in out

@@ -117,6 +117,24 @@ def _located(generated: Generated, line: int, message: str) -> str:
     return f"{message} [{generated.where(generated.node_at(line))}]"
 
 
+def unfinished_main(generated: Generated, findings: list) -> list:
+    """``findings`` where the Robot Program holds nothing but PolyScope's ``<empty>``
+    placeholder (a program saved before anything was put in it, project 53's ``test.urp``):
+    the runaway loop (URS207) its looping Robot Program would be says so first: PolyScope
+    shows such a program as unfinished [U: whether Play refuses it is not documented]."""
+    main = generated.program.main
+    if main is None or not all(child.kind == "Placeholder" or child.suppressed
+                               for child in main.children):
+        return findings
+    return [dataclasses.replace(
+        finding, message="the Robot Program holds only PolyScope's <empty> placeholder: "
+        "PolyScope shows the program as unfinished; were it started, its loop would run "
+        f"without using physical time ({finding.message})",
+        hint="put the program's nodes in the Robot Program, or delete this program")
+        if finding.code == "URS207" and generated.node_at(finding.span.line) is main
+        else finding for finding in findings]
+
+
 def node_findings(generated: Generated, findings: list) -> list:
     """``findings`` (verifier :class:`~urdsl.verify.findings.Finding` or lint
     :class:`Diagnostic`) with the node each comes from named in its message."""
@@ -625,7 +643,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
     # as for a script: on a model only assumed, what depends on it is a warning; a target
     # a fraction of a millimetre beyond the nominal reach, the arm's calibration decides
     qualify_report(report, inference, calibrated=file_options.calibration is not None)
-    report.findings = node_findings(generated, report.findings)
+    report.findings = node_findings(generated, unfinished_main(generated, report.findings))
     source = module.span.source
     for diagnostic in urcap_diagnostics(generated):
         start = source.line_start(diagnostic.line)
