@@ -74,6 +74,19 @@ def test_a_feature_and_a_function_the_export_defines_are_not_undefined(tmp_path,
     assert "name 'nowhere' is not defined" in out and "'cam_bin1' is not defined" not in out
 
 
+def test_lint_says_the_export_defines_what_the_installation_lacks(tmp_path, capsys):
+    children = script_line("movej(cam_bin1)") + script_line("ok = rq_grip()")
+    program = _project(tmp_path, children, None)
+    assert main(["lint", str(program)]) == 1
+    assert "URS101 name 'cam_bin1' is not defined [" in capsys.readouterr().out
+    (tmp_path / "t.script").write_text(EXPORT, encoding="utf-8")
+    assert main(["lint", str(program)]) == 0
+    out = capsys.readouterr().out
+    assert ("name 'cam_bin1' is not defined: a name of the installation t.script was exported "
+            "with (the default.installation beside the program lacks it)") in out
+    assert "unknown function 'rq_grip': a name of the installation t.script" in out
+
+
 def test_what_an_export_defines(tmp_path):
     (tmp_path / "t.urp").write_text("", encoding="utf-8")
     assert exported_by(tmp_path / "t.urp") is None  # no export

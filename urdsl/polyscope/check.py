@@ -209,12 +209,14 @@ def soften_urcap_names(generated: Generated, found: list) -> list:
     complete: a name or function defined nowhere in what urdsl generated (URS101, URS102)
     may come from a URCap's code, and a feature the program reads from its installation is
     defined by the installation's preamble, which is not written when the installation is
-    missing, as is a known URCap function (the installation's URCap code defines it):
-    warnings that say so rather than errors."""
+    missing, as is a known URCap function (the installation's URCap code defines it), and a
+    name or function the export beside the program defines that the installation beside it
+    lacks (:func:`exported_names`): warnings that say so rather than errors."""
     from ..script.urcaps import urcap_of
 
     sources = urcap_sources(generated)
     features = missing_features(generated)
+    exported = exported_names(generated)
     out = []
     for finding in found:
         name = _UNDEFINED_NAME.match(finding.message) if finding.code == "URS101" else None
@@ -224,6 +226,11 @@ def soften_urcap_names(generated: Generated, found: list) -> list:
             finding = replace(finding, severity="warning",
                               message=f"{finding.message}: {features[name.group(1)]}",
                               hint="put the program's installation beside it")
+        elif (name or function) and (name or function).group(1) in exported and \
+                finding.severity == "error":
+            finding = replace(finding, severity="warning", message=(
+                f"{finding.message}: {exported[(name or function).group(1)]}"),
+                hint="put the installation the program ran with beside it")
         elif function and generated.installation is None and finding.severity == "error" \
                 and urcap_of(function.group(1)) is not None:
             named = generated.program.installation
@@ -279,12 +286,21 @@ def exported_values(generated: Generated, module: n.Module) -> dict[str, str]:
     found for it is there, that PolyScope's export beside the program defines (its preamble:
     the installation the program ran with had them; see :mod:`urdsl.polyscope.export`):
     each with where its unknown value comes from."""
+    exported = exported_names(generated)
+    return {name: exported[name] for name in undefined_globals(module)
+            if name in exported and name not in generated.compiled.export.functions}
+
+
+def exported_names(generated: Generated) -> dict[str, str]:
+    """The variables, features and functions PolyScope's export beside the program defines
+    while an installation was found for it, each with where it comes from for a message
+    (see :mod:`urdsl.polyscope.export`)."""
     export = generated.compiled.export
     if export is None or generated.installation is None:
         return {}
-    return {name: f"a name of the installation {export.path.name} was exported with (the "
-                  f"{_installation_name(generated)} beside the program lacks it)"
-            for name in undefined_globals(module) if name in export.names}
+    why = (f"a name of the installation {export.path.name} was exported with (the "
+           f"{_installation_name(generated)} beside the program lacks it)")
+    return dict.fromkeys(sorted(export.names | export.functions), why)
 
 
 def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
