@@ -95,6 +95,16 @@ def test_what_an_export_defines(tmp_path):
     assert export is not None
     assert (export.signals, export.names, export.functions) == (
         {"MODBUS_1"}, {"cam_bin1"}, {"rq_grip"})
+    # what the program tree's own nodes assign (after its first marker) is no installation's,
+    # nor is a subprogram of the tree
+    (tmp_path / "t.script").write_text(EXPORT.replace(
+        '  $ 1 "Robot Program"\n',
+        '  $ 1 "Robot Program"\n  global counter=0\n'
+        '  def sub():\n    $ 2 "sub"\n  end\n'), encoding="utf-8")
+    assert exported_by(tmp_path / "t.urp").names == {"cam_bin1"}
+    text = EXPORT.replace("  def rq_grip", '  def sub():\n    $ 2 "sub"\n  end\n  def rq_grip')
+    (tmp_path / "t.script").write_text(text, encoding="utf-8")
+    assert exported_by(tmp_path / "t.urp").functions == {"rq_grip"}
     # not a program PolyScope wrote: no evidence
     for text in ("def t(:\n", "movej(cam_bin1)\n", EXPORT + EXPORT.replace("def t", "def u"),
                  ""):

@@ -27,9 +27,11 @@ LIMIT = 16 * 1024 * 1024
 
 @dataclass(frozen=True)
 class Export:
-    """What an export defines: ``path`` (the ``.script``), ``names`` (variables and features
-    its program assigns at its top level), ``functions`` (functions it defines there) and
-    ``signals`` (the Modbus signals its preamble adds)."""
+    """What an export's preamble (the code before the program tree's first node marker)
+    defines: ``path`` (the ``.script``), ``names`` (the installation's variables and features
+    it assigns), ``functions`` (the URCaps' functions it defines) and ``signals`` (the Modbus
+    signals it adds). What the program tree's own nodes assign is left out: an older export's
+    variable is no evidence for the program as it is now."""
 
     path: Path
     names: frozenset[str]
@@ -64,6 +66,11 @@ def exported_by(urp_path: str | Path) -> Export | None:
     names: set[str] = set()
     functions: set[str] = set()
     for item in programs[0].body:
+        if isinstance(item, n.Marker):
+            break  # the program tree's own code begins: what follows is no installation's
+        if isinstance(item, n.FunctionDef) and any(isinstance(inner, n.Marker)
+                                                   for inner in n.walk(item)):
+            continue  # a subprogram of the program tree (its nodes' markers), not a URCap's
         if isinstance(item, n.Declare) and item.value is not None:
             names.add(item.name)
         elif isinstance(item, n.Assign) and isinstance(item.target, n.Name):
