@@ -100,8 +100,10 @@ def test_what_an_export_defines(tmp_path):
     (tmp_path / "t.script").write_text(EXPORT.replace(
         '  $ 1 "Robot Program"\n',
         '  $ 1 "Robot Program"\n  global counter=0\n'
+        '  modbus_add_signal("127.0.0.1", 255, 9, 1, "LATE", False)\n'
         '  def sub():\n    $ 2 "sub"\n  end\n'), encoding="utf-8")
-    assert exported_by(tmp_path / "t.urp").names == {"cam_bin1"}
+    export = exported_by(tmp_path / "t.urp")
+    assert (export.names, export.signals) == ({"cam_bin1"}, {"MODBUS_1"})
     text = EXPORT.replace("  def rq_grip", '  def sub():\n    $ 2 "sub"\n  end\n  def rq_grip')
     (tmp_path / "t.script").write_text(text, encoding="utf-8")
     assert exported_by(tmp_path / "t.urp").functions == {"rq_grip"}

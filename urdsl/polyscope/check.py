@@ -269,16 +269,18 @@ def missing_features(generated: Generated) -> dict[str, str]:
     # also with another installation found beside the program in its place
     for name, what in generated.compiled.unknown.items():
         export = generated.compiled.exported.get(name)
-        out.setdefault(name, f"{what} of the installation {export} was exported with (the "
-                             f"{_installation_name(generated)} beside the program lacks it)"
-                       if export else
+        out.setdefault(name, _from_export(generated, what, export) if export else
                        f"{what} of the installation {named} (not beside the program)")
     return out
 
 
-def _installation_name(generated: Generated) -> str:
-    """The file name of the installation found for the program, for messages."""
-    return Path(str(generated.installation.path)).name if generated.installation else "?"
+def _from_export(generated: Generated, what: str, export: str) -> str:
+    """Where ``what`` (``"an I/O"``, ``"a name"``) that the export file ``export`` defines
+    and the installation found for the program lacks comes from, for a message."""
+    installation = Path(str(generated.installation.path)).name if generated.installation \
+        else "?"
+    return (f"{what} of the installation {export} was exported with (the {installation} "
+            "beside the program lacks it)")
 
 
 def exported_values(generated: Generated, module: n.Module) -> dict[str, str]:
@@ -298,9 +300,8 @@ def exported_names(generated: Generated) -> dict[str, str]:
     export = generated.compiled.export
     if export is None or generated.installation is None:
         return {}
-    why = (f"a name of the installation {export.path.name} was exported with (the "
-           f"{_installation_name(generated)} beside the program lacks it)")
-    return dict.fromkeys(sorted(export.names | export.functions), why)
+    return dict.fromkeys(sorted(export.names | export.functions),
+                         _from_export(generated, "a name", export.path.name))
 
 
 def urcap_values(generated: Generated, module: n.Module) -> dict[str, str]:
@@ -624,7 +625,8 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         notes.append("unknown values (URCap nodes' results, names of a missing "
                      "installation): " + ", ".join(missing))
     if stale and generated.compiled.export is not None:
-        notes.append(f"names the {_installation_name(generated)} beside the program lacks and "
+        notes.append(f"names the {Path(str(generated.installation.path)).name} beside the "
+                     "program lacks and "
                      f"{generated.compiled.export.path.name} (PolyScope's export of it) defines, "
                      "read as unknown values of the installation the program ran with: "
                      + ", ".join(stale))

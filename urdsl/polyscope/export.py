@@ -38,9 +38,6 @@ class Export:
     functions: frozenset[str]
     signals: frozenset[str]
 
-    def __contains__(self, name: str) -> bool:
-        return name in self.names or name in self.functions or name in self.signals
-
 
 def exported_by(urp_path: str | Path) -> Export | None:
     """The export beside the ``.urp`` at ``urp_path`` (``X.script`` for ``X.urp``): what it
@@ -65,9 +62,11 @@ def exported_by(urp_path: str | Path) -> Export | None:
         return None
     names: set[str] = set()
     functions: set[str] = set()
+    preamble: list[n.Node] = []
     for item in programs[0].body:
         if isinstance(item, n.Marker):
             break  # the program tree's own code begins: what follows is no installation's
+        preamble.append(item)
         if isinstance(item, n.FunctionDef) and any(isinstance(inner, n.Marker)
                                                    for inner in n.walk(item)):
             continue  # a subprogram of the program tree (its nodes' markers), not a URCap's
@@ -78,7 +77,7 @@ def exported_by(urp_path: str | Path) -> Export | None:
         elif isinstance(item, n.FunctionDef):
             functions.add(item.name)
     signals = {
-        call.args[4].value for call in n.walk(programs[0])
+        call.args[4].value for item in preamble for call in n.walk(item)
         if isinstance(call, n.Call) and isinstance(call.func, n.Name)
         and call.func.id == "modbus_add_signal" and len(call.args) >= 5
         and isinstance(call.args[4], n.String)}

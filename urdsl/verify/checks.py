@@ -206,9 +206,8 @@ the e-Series' the same [U]), so such a move takes longer rather than stopping. O
 movep timed by its tool turn (:data:`urdsl.motion.planner.ROTATION_PER_METRE`, [U]) the speed
 may also come from that undocumented rate. These stay errors: a speed over this factor (a
 path near a singularity, where the joints speed up without bound: 30 rad/s in project 135, and
-UR's distributor notes say the arm stops [U]), a move whose time ``t`` the program gives
-(whether the controller stretches a given time is not documented [U]), servo and speed
-commands, and any speed on a move whose path fails (URS302/URS303).
+UR's distributor notes say the arm stops [U]), servo and speed commands, and any speed on a
+move whose path fails (URS302/URS303).
 
 A move whose time ``t`` the program gives is judged at the speeds its ``a`` and ``v`` alone
 give (the segment's ``t_free``, s) when ``t`` is shorter: the joint speeds scale with
