@@ -71,3 +71,44 @@ def _speeds(kind: str, factor: float, **params) -> list[str]:
 ])
 def test_which_speeds_the_controller_slows(kind, factor, params, severity):
     assert _speeds(kind, factor, **params) == [severity]
+
+
+_HOME = "movej([0, -1.57, 1.57, -1.57, -1.57, 0], a=1.4, v=1.0)"
+_LEFT = "movel(p[0.45, -0.3, 0.3, 0, 3.14, 0], a=10, v=0.25)"
+_RIGHT = "movel(p[0.45, 0.3, 0.3, 0, 3.14, 0], a=10, v=1.0)"  # on a UR10: base 1.1x its limit
+
+
+def _checked(*body: str, indent: str = "  "):
+    from urdsl.verify.run import check_text
+
+    text = "def prog():\n" + "".join(f"{indent}{line}\n" for line in body) + "end\n"
+    return check_text(text, "slowed.script", robot="ur10")
+
+
+def test_a_move_the_controller_slows_says_how_much_longer_the_cycle_may_take():
+    """The cycle time is the program as planned; the moves the controller slows add up to
+    their planned time times the factor their fastest joint exceeds its limit by."""
+    report = _checked(_HOME, _LEFT, _RIGHT)
+    [warning] = [f for f in report.findings if f.code == "URS304"]
+    assert warning.severity == "warning" and 1.0 < warning.slowed < 2.0
+    right = report.moves[-1]
+    assert report.slowed is not None and report.slowed.moves == 1
+    assert report.slowed.up_to == pytest.approx(right.duration * (warning.slowed - 1.0))
+    assert report.to_dict()["slowed"] == {"moves": 1, "up_to": round(report.slowed.up_to, 6)}
+    assert f"the controller slows 1 move: up to {report.slowed.up_to:.3f} s longer" \
+        in report.summary()
+
+
+def test_a_program_within_its_limits_is_not_slowed():
+    report = _checked(_HOME, _LEFT)
+    assert report.slowed is None and "slowed" not in report.to_dict()
+    assert "slows" not in report.summary()
+
+
+def test_a_loop_counts_what_its_slowed_moves_add_to_one_pass():
+    """The loop's passes each slow the same move: one move, its extra time once per pass."""
+    once = _checked(_HOME, _LEFT, _RIGHT).slowed
+    report = _checked(_HOME, "while True:", f"  {_LEFT}", f"  {_RIGHT}", "end")
+    assert report.loop is not None and report.loop.passes >= 2
+    assert report.slowed is not None and report.slowed.moves == 1
+    assert report.slowed.up_to == pytest.approx(once.up_to, rel=0.05)

@@ -181,7 +181,8 @@ def joint_speeds(trace: Trace, limits: np.ndarray, exclude: np.ndarray | None = 
             cause=JOINTS[joint])
         move = _slowed(trace, segment, peak / limits[joint], exclude)
         if move is not None:
-            finding = replace(finding, severity="warning", message=(
+            fastest = float(np.max(np.abs(trace.qd[samples][inside]) / limits))
+            finding = replace(finding, severity="warning", slowed=fastest, message=(
                 f"{finding.message}; this {move.kind} mostly turns the tool, and its time is "
                 "that turn's at 4·v rad/s, a rate UR does not document (a user's "
                 "measurement): the controller may turn the tool slower"
@@ -595,7 +596,7 @@ def tcp_speed(trace: Trace, robot, limit: float, exclude: np.ndarray | None = No
             cause="tcp")
         move = _slowed(trace, segment, peak / limit, exclude)
         if move is not None:  # the controller reduces the speed to the safety limit
-            finding = replace(finding, severity="warning", message=(
+            finding = replace(finding, severity="warning", slowed=peak / limit, message=(
                 f"{finding.message}; the controller slows a program's moves to keep the TCP "
                 f"within the safety limit (UR user manual, software safety limits): "
                 f"{_takes_longer(move)}"))

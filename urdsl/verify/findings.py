@@ -33,7 +33,10 @@ class Finding:
     the colliding pair); None: the message without its numbers does (:meth:`identity`).
     ``count`` is how many times the program ran into it (a statement in a loop); the
     finding is the first of them. ``beyond``: for a target beyond the arm's reach (URS301),
-    where it lies and how far out, ``((x, y, z), distance)`` in m.
+    where it lies and how far out, ``((x, y, z), distance)`` in m. ``slowed``: for a speed
+    the controller slows rather than stop (a URS304 or URS306 warning), the factor by which
+    the move's fastest joint or TCP exceeds its limit: slowed evenly, the move takes that many
+    times as long.
     """
 
     code: str
@@ -46,6 +49,7 @@ class Finding:
     count: int = field(default=1, compare=False)
     beyond: tuple[tuple[float, float, float], float] | None = field(default=None,
                                                                     compare=False)
+    slowed: float | None = field(default=None, compare=False)
 
     @classmethod
     def of(cls, code: str, message: str, span: Span = NO_SPAN, time: float | None = None,

@@ -11,6 +11,7 @@ JSON shape (``urdsl check --json``), one document::
                    "time": 2.31, "count": 1}],
      "moves": [{"kind": "movej", "line": 3, "column": 1, "start": 0.0,
                 "duration": 2.094}],
+     "slowed": {"moves": 1, "up_to": 0.35},
      "events": [{"time": 0.0, "kind": "textmsg", "message": "hello", "line": 2}],
      "inferred": {"robot": {"model": "ur10e", "source": "inferred", "pairs": 14, ...},
                   "start": {"joints": [...], "source": "inferred", "from": "Waypoint_1_q",
@@ -21,6 +22,9 @@ Times in s of robot time. ``loop`` is there only for a program that loops foreve
 ``cycle_time`` is then the mean time of one pass of that loop after the first (``first_pass``
 includes the way from where the arm started), ``passes`` the complete passes checked;
 otherwise ``cycle_time`` is the robot time from the start to the end of the program.
+``slowed`` is there only when the controller slows moves to keep a joint or the TCP within its
+limit (URS304 and URS306 warnings): ``cycle_time`` is the program as planned, and those
+``moves`` (of one pass, for a loop) add up to about ``up_to`` s to it (:class:`Slowed`).
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ from typing import Any
 from ..script.nodes import Span
 from .findings import Finding
 
-__all__ = ["Report", "Move", "dumps"]
+__all__ = ["Report", "Move", "Slowed", "dumps"]
 
 
 @dataclass(frozen=True)
@@ -54,7 +58,9 @@ class Move:
 class Loop:
     """The loop a program runs forever, as far as the check followed it: ``passes`` complete
     passes, the first taking ``first_pass`` s (with the way from the start), the others
-    ``pass_time`` s on average, ``shortest`` to ``longest`` s (s of robot time)."""
+    ``pass_time`` s on average, ``shortest`` to ``longest`` s (s of robot time).
+    ``averaged``: the robot time (s) from the start of the first pass ``pass_time`` averages
+    to the end of the last, and how many passes that is."""
 
     span: Span
     passes: int
@@ -62,6 +68,7 @@ class Loop:
     pass_time: float
     shortest: float
     longest: float
+    averaged: tuple[float, float, int] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {"line": self.span.line, "column": self.span.column, "passes": self.passes,
@@ -80,6 +87,26 @@ class Loop:
                 + ", ".join(extra))
 
 
+@dataclass(frozen=True)
+class Slowed:
+    """Moves the controller slows to keep a joint or the TCP within its speed limit, and the
+    time (s) that adds at most to the cycle time, or to one pass of the loop a program runs
+    forever: each move slowed evenly by the factor its fastest joint or TCP exceeds the limit
+    (:attr:`Finding.slowed`). The controller's own speed scaling slows only where it must and
+    is not documented [U], so the real cost lies between nothing and this bound."""
+
+    moves: int
+    up_to: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"moves": self.moves, "up_to": round(self.up_to, 6)}
+
+    def describe(self) -> str:
+        """``the controller slows 2 moves: up to 0.35 s longer``."""
+        plural = "s" if self.moves != 1 else ""
+        return f"the controller slows {self.moves} move{plural}: up to {self.up_to:.3f} s longer"
+
+
 @dataclass
 class Report:
     """Everything ``urdsl check`` found out about one program."""
@@ -91,6 +118,7 @@ class Report:
     events: list = field(default_factory=list)
     cycle_time: float = 0.0
     loop: Loop | None = None  # the loop the program runs forever: cycle_time is one pass
+    slowed: Slowed | None = None  # moves the controller slows: cycle_time is as planned
     trace: Any = field(default=None, repr=False)
     inferred: Any = None  # urdsl.verify.infer.Inference: robot, start, TCP the check used
     context: str | None = None  # the project context the program ran in, if any
@@ -141,6 +169,7 @@ class Report:
             "summary": {s: self.count(s) for s in ("error", "warning", "info")},
             "findings": [f.to_dict() for f in self.findings],
             "moves": _move_dicts(self.moves),
+            **({"slowed": self.slowed.to_dict()} if self.slowed is not None else {}),
             "events": [{"time": round(e.time, 6), "kind": e.kind, "message": e.message,
                         "line": e.span.line} for e in self.events],
             **({"inferred": self.inferred.to_dict()} if self.inferred is not None else {}),
@@ -172,10 +201,11 @@ class Report:
             return (f"{self.file}: not checked: {self.count('error')} error(s), "
                     f"{self.count('warning')} warning(s)")
         verdict = "FAILED" if self.has_errors else "ok"
+        about = [part.describe() for part in (self.loop, self.slowed) if part is not None]
         return (f"{self.file}: {verdict} on {self.robot}: {self.count('error')} error(s), "
                 f"{self.count('warning')} warning(s), {self.count('info')} info; "
                 f"{len(self.moves)} move(s), cycle time {self.cycle_time:.3f} s"
-                + (f" ({self.loop.describe()})" if self.loop is not None else ""))
+                + (f" ({'; '.join(about)})" if about else ""))
 
     def print_rich(self, console, moves: bool = True, max_moves: int = 20) -> None:
         """The report on a rich console: coloured findings, a table of moves."""

@@ -40,7 +40,7 @@ from ..script.parser import parse
 from ..script.urcaps import by_urcap_block, urcap_blocks
 from . import checks
 from .findings import Finding, nothing_runs
-from .report import Loop, Move, Report
+from .report import Loop, Move, Report, Slowed
 
 __all__ = ["CheckOptions", "Progress", "check_text", "check_tree", "check_file", "DEFAULT_START",
            "DEFAULT_TIMEOUT"]
@@ -306,6 +306,7 @@ def _check_tree(module, filename: str, options: CheckOptions, started: float) ->
         report.findings = device_paced(report.findings, result.paced)
     if result.shaped_moves:
         report.findings = device_shaped(report.findings, result.shaped_moves, planner)
+    report.slowed = slowed_moves(trace, report.findings, report.loop)
     report.sort()
     return report
 
@@ -358,8 +359,34 @@ def _forever(result) -> Loop | None:
     later = passes.count - 2  # complete passes after the first
     shortest = passes.shortest if later > 0 else passes.first_pass
     longest = passes.longest if later > 0 else passes.first_pass
+    averaged = (passes.second, passes.last, later) if later > 0 else \
+        (passes.first, passes.second, 1)
     return Loop(passes.span, passes.count - 1, passes.first_pass, passes.pass_time,
-                shortest, longest)
+                shortest, longest, averaged)
+
+
+def slowed_moves(trace, findings: list[Finding], loop: Loop | None) -> Slowed | None:
+    """The moves the controller slows (warnings with :attr:`Finding.slowed`; before
+    :meth:`Report.sort` merges a loop's passes), and at most how much longer they take: in
+    the whole run, or on average in one of the passes ``loop``'s pass time averages. None
+    when no move is slowed."""
+    factors: dict[int, float] = {}
+    for finding in findings:
+        if finding.slowed is None or finding.severity != "warning" or finding.time is None:
+            continue
+        sample = min(int(np.searchsorted(trace.times, finding.time - 1e-9)),
+                     len(trace.times) - 1)
+        segment = int(trace.segment[sample])
+        if segment >= 0:
+            factors[segment] = max(factors.get(segment, 1.0), finding.slowed)
+    begin, end, passes = (-np.inf, np.inf, 1) if loop is None or loop.averaged is None \
+        else loop.averaged
+    inside = [(trace.segments[segment], factor) for segment, factor in factors.items()
+              if begin - 1e-9 <= trace.segments[segment].start < end - 1e-9]
+    if not inside:
+        return None
+    extra = sum(move.duration * (factor - 1.0) for move, factor in inside)
+    return Slowed(max(1, round(len(inside) / passes)), extra / passes)
 
 
 def _stopped_finding(event, options: CheckOptions) -> Finding:
