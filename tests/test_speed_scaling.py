@@ -112,3 +112,28 @@ def test_a_loop_counts_what_its_slowed_moves_add_to_one_pass():
     assert report.loop is not None and report.loop.passes >= 2
     assert report.slowed is not None and report.slowed.moves == 1
     assert report.slowed.up_to == pytest.approx(once.up_to, rel=0.05)
+
+
+def _tcp(move: str) -> list:
+    """The URS306 findings of ``move`` from a UR5e's tool-down pose in a 0.25 m/s cell."""
+    from urdsl.verify.run import CheckOptions, check_text
+
+    text = ("movej([0, -1.9, 1.9, -1.57, -1.57, 0])\nhome = get_actual_tcp_pose()\n"
+            f"{move}\n")
+    report = check_text(text, "tcp.script", options=CheckOptions(
+        tcp_speed_limit=0.25, start_joints=(0, -1.9, 1.9, -1.57, -1.57, 0)))
+    return [f for f in report.findings if f.code == "URS306"]
+
+
+def test_a_move_far_over_the_cells_tcp_speed_is_slowed_not_stopped():
+    """A line asked at 1 m/s in a 0.25 m/s cell (4x) runs at the limit: the controller
+    slows a program's moves to the safety limit (Reduced mode slows a running 1 m/s program
+    to 0.25 m/s without stopping it); only the cycle takes longer."""
+    [finding] = _tcp("movel(pose_add(home, p[0.3, 0, 0, 0, 0, 0]), a=10, v=1.0)")
+    assert finding.severity == "warning" and "takes longer" in finding.message
+    assert finding.slowed == pytest.approx(4.0, rel=0.02)
+
+
+def test_a_speed_command_over_the_cells_tcp_speed_stays_an_error():
+    [finding] = _tcp("speedl([0.5, 0, 0, 0, 0, 0], a=2, t=0.5)")
+    assert finding.severity == "error" and finding.slowed is None

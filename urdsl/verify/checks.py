@@ -230,9 +230,11 @@ def _samples_of(trace: Trace, segment: int) -> slice:
                  int(np.searchsorted(trace.segment, segment, side="right")))
 
 
-def _slowed(trace: Trace, segment: int, ratio: float, exclude: np.ndarray | None):
+def _slowed(trace: Trace, segment: int, ratio: float, exclude: np.ndarray | None,
+            margin: float = SCALED_MARGIN):
     """The move ``segment`` when the controller slows it rather than stop at a speed
-    ``ratio`` times a limit (:data:`SCALED_MARGIN`); else None."""
+    ``ratio`` times a limit (up to ``margin`` times, :data:`SCALED_MARGIN` for joints);
+    else None."""
     if segment < 0:
         return None
     move = trace.segments[segment]
@@ -244,7 +246,7 @@ def _slowed(trace: Trace, segment: int, ratio: float, exclude: np.ndarray | None
         if not free:
             return None
         ratio *= min(1.0, given / free)  # the part of the speed a too short t adds
-    if ratio > SCALED_MARGIN:
+    if ratio > margin:
         return None
     if exclude is not None and bool(exclude[_samples_of(trace, segment)].any()):
         return None  # the move's path fails: the speed is that failure's
@@ -565,8 +567,18 @@ def tcp_speed(trace: Trace, robot, limit: float, exclude: np.ndarray | None = No
     """URS306: the TCP moves faster than the user's limit (m/s), e.g. 0.25 m/s in a
     collaborative cell. Where the program changed its TCP (``set_tcp``) between two samples,
     the TCP point jumps without the arm moving: each side is differentiated on its own.
-    Samples in ``exclude`` are left out. Up to :data:`SCALED_MARGIN` times the limit, as for
-    joint speeds, the controller slows the move: a warning."""
+    Samples in ``exclude`` are left out.
+
+    On a movej, movel, movep or movec whose path does not fail the controller slows the move
+    to the limit, however far over it (a warning; "the robot controller prevents violations
+    by making a robot stop or by reducing the speed", UR user manual, software safety
+    limits). The TCP speed a program asks for is bounded (it is ``v`` on a line), so the
+    argument that keeps a joint speed over :data:`SCALED_MARGIN` an error, joint speeds
+    without bound near a singularity, does not hold for it; and a cell whose safety system
+    switches from 1 m/s to Reduced mode's 0.25 m/s mid-move slows the running program, it does
+    not stop it (UR forum, "Smoother transition to reduced mode", topic 944). Which stops
+    the safety system makes for a program's own moves is not documented [U]. Servo and
+    speed commands stay errors."""
     positions, index = _tcp_positions(trace, robot)
     if len(positions) < 2:
         speed = np.zeros(len(positions))
@@ -594,7 +606,7 @@ def tcp_speed(trace: Trace, robot, limit: float, exclude: np.ndarray | None = No
             "URS306", f"the TCP moves at {peak:.3f} m/s, over the cell's limit of {limit:g} m/s",
             _span(trace, segment), float(trace.times[sample]), _speed_hint(trace, segment),
             cause="tcp")
-        move = _slowed(trace, segment, peak / limit, exclude)
+        move = _slowed(trace, segment, peak / limit, exclude, margin=np.inf)
         if move is not None:  # the controller reduces the speed to the safety limit
             finding = replace(finding, severity="warning", slowed=peak / limit, message=(
                 f"{finding.message}; the controller slows a program's moves to keep the TCP "
@@ -932,9 +944,11 @@ A collaborative cell limits the TCP speed in its safety configuration (often 0.2
 where people work); the controller then slows the robot to the limit or stops it ("the robot
 controller prevents violations by making a robot stop or by reducing the speed", UR user
 manual). This check runs when the limit is given (urdsl check --tcp-speed-limit, m/s, or the
-installation of a .urp) and reports the first move over it, with its peak TCP speed. Up to 2x
-over, on a movej/movel/movep/movec without a given t whose path does not fail, it is a
-warning that the move takes longer; how the controller chooses between slowing and stopping
+installation of a .urp) and reports each move over it, with its peak TCP speed. On a
+movej/movel/movep/movec whose path does not fail it is a warning that the move takes longer
+(however far over: a program's TCP speed is bounded, and a running program that Reduced mode
+slows from 1 m/s to 0.25 m/s goes on, UR forum topic 944); on servo and speed commands, and
+on a path that fails, an error. How the safety system chooses between slowing and stopping
 is not documented [U].""",
     example=f"# urdsl check --tcp-speed-limit 0.25 --start-joints {_START}\n"
             "home = get_actual_tcp_pose()\nmovel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), v=0.6)",
