@@ -222,15 +222,15 @@ def soften_urcap_names(generated: Generated, found: list) -> list:
         name = _UNDEFINED_NAME.match(finding.message) if finding.code == "URS101" else None
         function = _UNKNOWN_FUNCTION.match(finding.message) if finding.code == "URS102" \
             else None
+        either = (name or function).group(1) if name or function else None
         if name and name.group(1) in features and finding.severity == "error":
             finding = replace(finding, severity="warning",
                               message=f"{finding.message}: {features[name.group(1)]}",
                               hint="put the program's installation beside it")
-        elif (name or function) and (name or function).group(1) in exported and \
-                finding.severity == "error":
-            finding = replace(finding, severity="warning", message=(
-                f"{finding.message}: {exported[(name or function).group(1)]}"),
-                hint="put the installation the program ran with beside it")
+        elif either in exported and finding.severity == "error":
+            finding = replace(finding, severity="warning",
+                              message=f"{finding.message}: {exported[either]}",
+                              hint="put the installation the program ran with beside it")
         elif function and generated.installation is None and finding.severity == "error" \
                 and urcap_of(function.group(1)) is not None:
             named = generated.program.installation
@@ -274,13 +274,16 @@ def missing_features(generated: Generated) -> dict[str, str]:
     return out
 
 
+def _installation_name(generated: Generated) -> str:
+    """The file name of the installation found for the program, for messages."""
+    return Path(str(generated.installation.path)).name if generated.installation else "?"
+
+
 def _from_export(generated: Generated, what: str, export: str) -> str:
     """Where ``what`` (``"an I/O"``, ``"a name"``) that the export file ``export`` defines
     and the installation found for the program lacks comes from, for a message."""
-    installation = Path(str(generated.installation.path)).name if generated.installation \
-        else "?"
-    return (f"{what} of the installation {export} was exported with (the {installation} "
-            "beside the program lacks it)")
+    return (f"{what} of the installation {export} was exported with (the "
+            f"{_installation_name(generated)} beside the program lacks it)")
 
 
 def exported_values(generated: Generated, module: n.Module) -> dict[str, str]:
@@ -625,8 +628,7 @@ def check_urp(path: str, options, *, robot_given: bool, start_joints=None, tcp=N
         notes.append("unknown values (URCap nodes' results, names of a missing "
                      "installation): " + ", ".join(missing))
     if stale and generated.compiled.export is not None:
-        notes.append(f"names the {Path(str(generated.installation.path)).name} beside the "
-                     "program lacks and "
+        notes.append(f"names the {_installation_name(generated)} beside the program lacks and "
                      f"{generated.compiled.export.path.name} (PolyScope's export of it) defines, "
                      "read as unknown values of the installation the program ran with: "
                      + ", ".join(stale))
