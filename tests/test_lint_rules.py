@@ -165,6 +165,10 @@ def test_every_rule_example_triggers_it_and_its_fix_does_not():
         example = rule.example
         fixed = rule.fixed.replace("# urdsl lint --version 5.15\n", "")
         assert places(example, code, **settings), code
+        # the severity `urdsl rules` heads its text with is what the example shows
+        assert rule.severity in {d.severity for d in lint_text(example, "t.script",
+                                                               build_settings(**settings))
+                                 if d.code == code}, code
         fixed_settings = {"version": "5.15"} if code == "URS103" else {}
         assert not places(fixed, code, **fixed_settings), code
 

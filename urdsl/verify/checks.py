@@ -951,9 +951,10 @@ slows from 1 m/s to 0.25 m/s goes on, UR forum topic 944); on servo and speed co
 on a path that fails, an error. How the safety system chooses between slowing and stopping
 is not documented [U].""",
     example=f"# urdsl check --tcp-speed-limit 0.25 --start-joints {_START}\n"
-            "home = get_actual_tcp_pose()\nmovel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), v=0.6)",
+            "speedl([0, 0, -0.4, 0, 0, 0], a=2.0, t=0.5)  # a speed command: an error\n"
+            "stopl(2.0)",
     fixed=f"# urdsl check --tcp-speed-limit 0.25 --start-joints {_START}\n"
-          "home = get_actual_tcp_pose()\nmovel(pose_add(home, p[0.2, 0, 0, 0, 0, 0]), v=0.2)",
+          "speedl([0, 0, -0.2, 0, 0, 0], a=2.0, t=0.5)\nstopl(2.0)",
     applies=lambda options: options.tcp_speed_limit is not None,
 )
 def _tcp_speed(ctx: TraceContext) -> list[Finding]:
