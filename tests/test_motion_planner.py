@@ -159,6 +159,55 @@ def test_speedj_cruises_for_t_then_stops():
     assert arm.target_joints[0] == pytest.approx(0.2 * 1.0)
 
 
+
+def test_a_speed_command_shorter_than_its_ramp_reaches_only_a_t():
+    # the manual: with t "the function will return after time t, regardless of the target
+    # speed has been reached": 0.1 s at 0.5 m/s² reaches 0.05 m/s, not the asked 0.2
+    for command in ("speedj", "speedl"):
+        arm = planner()
+        resume = getattr(arm, command)(np.array([0.2, 0, 0, 0, 0, 0]), 0.5, 0.1, NO_SPAN, 0.0)
+        assert resume == pytest.approx(0.1)
+        arm.finish(arm.stop(resume))
+        assert arm.end_time == pytest.approx(0.2)  # and as long to stop
+        trace = sample(arm)
+        assert np.abs(trace.qd[:, 0]).max() == pytest.approx(0.05, rel=0.05)
+        assert arm.target_joints[0] == pytest.approx(0.5 * 0.1 ** 2)
+
+
+@pytest.mark.parametrize("command", ["speedj", "speedl"])
+def test_a_streamed_speed_goes_on_without_stopping_between_commands(command):
+    # a loop giving the same speed every 8 ms (until a force or a distance stops it): the
+    # arm ramps up once, cruises and stops once, as one command of 100 x 8 ms
+    arm = planner()
+    now = 0.0
+    speed = np.array([0, 0, -0.1, 0, 0, 0])
+    for _ in range(100):
+        now = getattr(arm, command)(speed, 0.5, 0.008, NO_SPAN, now)
+    assert now == pytest.approx(0.8)
+    arm.finish(arm.stop(now))
+    assert arm.end_time == pytest.approx(0.8 + 0.1 / 0.5)
+    assert len(arm.segments) == 1
+    assert arm.target_joints[2] == pytest.approx(-0.1 * 0.8)
+    trace = sample(arm)
+    assert np.abs(trace.qd[:, 2]).max() == pytest.approx(0.1, rel=0.01)
+    # what a read in the loop sees is where the arm is then, not where the chain ends
+    assert arm.joints_at(0.2)[2] == pytest.approx(-0.5 * 0.5 * 0.2 ** 2, abs=1e-9)
+
+
+def test_a_speed_chain_breaks_at_a_pause_a_stop_or_another_speed():
+    speed = np.array([0.1, 0, 0, 0, 0, 0])
+    arm = planner()
+    now = arm.speedj(speed, 0.5, 0.4, NO_SPAN, 0.0)
+    now = arm.speedj(speed, 0.5, 0.4, NO_SPAN, now + 0.1)  # a sleep between: it stopped
+    assert len(arm.segments) == 2
+    now = arm.speedj(speed, 0.5, 0.4, NO_SPAN, arm.stop(now))
+    assert len(arm.segments) == 3
+    now = arm.speedj(2 * speed, 0.5, 0.4, NO_SPAN, now)
+    assert len(arm.segments) == 4
+    now = arm.speedj(2 * speed, 0.5, 0.4, NO_SPAN, now)  # the same again: goes on
+    assert len(arm.segments) == 4 and arm.segments[-1].params["t"] == pytest.approx(0.8)
+
+
 @settings(max_examples=30, deadline=None)
 @given(st.lists(st.tuples(st.floats(-0.8, 0.8), st.floats(-0.8, 0.8), st.floats(0, 0.01)),
                 min_size=1, max_size=6),

@@ -10,6 +10,15 @@ Timing model
   time (:func:`line_profile`).
 * ``movep``: like ``movel`` (constant tool speed comes from blending consecutive moves).
 * ``movec``: circular arc through the via point's position, trapezoid on the arc length.
+* ``speedj``/``speedl``: accelerate with ``a`` toward the speed, hold it, return after
+  ``t``, then decelerate with ``a`` unless another speed command goes on. The manual: "if
+  provided the function will return after time t, regardless of the target speed has been
+  reached", so a ``t`` shorter than the ramp reaches only ``a·t``. Consecutive identical
+  speed commands (the same speed and ``a``, each given at the time the one before returns:
+  a loop that streams one speed until a force or a distance stops it) are one motion that
+  does not slow down between them; they are planned as one command with the sum of their
+  ``t`` (:class:`_SpeedChain`). Different speeds in a row are planned one after the other,
+  each from rest [U].
 
 Blends
 ------
@@ -174,6 +183,25 @@ class Segment:
         return kinematics.ik_many(self.path_poses(fraction), linear, tcp=self.tcp)
 
 
+
+@dataclass
+class _SpeedChain:
+    """The speed command planned last, while the next one may go on from it: ``segment`` is
+    its motion (from the chain's start), ``kind`` speedj/speedl, ``vector`` its speed (rad/s
+    or m/s and rad/s), ``a`` its acceleration, ``t`` the summed ``t`` (s) of the chain's
+    commands, ``returns`` the robot time (s) the last one returned, ``now`` the time the
+    first one was given, ``state`` the planner's state before the first one
+    (:meth:`MotionPlanner._state`)."""
+
+    segment: Segment
+    kind: str
+    vector: np.ndarray
+    a: float
+    t: float
+    returns: float
+    now: float
+    state: tuple
+
 class MotionPlanner:
     """Plans the moves of one program on one robot model, in robot time.
 
@@ -213,6 +241,7 @@ class MotionPlanner:
         self._unresolved: list[Segment] = []  # Cartesian moves whose joints are not solved
         self._free_at = 0.0  # when the arm is at rest at _q (no pending blend)
         self.end_time = 0.0
+        self._speed_chain: _SpeedChain | None = None  # the last speed command (speedj/l)
         self._poses: dict[tuple, np.ndarray] = {}  # see _pose_of
         # Solving the targets of straight-line moves in batches is what makes checking a
         # long toolpath fast; only a model that gives all analytic solutions at once can.
@@ -643,14 +672,20 @@ class MotionPlanner:
     def speedj(self, qd: np.ndarray, a: float, t: float, span: Span, now: float) -> float:
         """Accelerate with ``a`` rad/s² (leading axis) to joint speeds ``qd`` (rad/s), keep
         them until ``t`` s, then decelerate to rest (the stop a following ``stopj`` or the
-        end of the program commands). Returns when the cruise ends."""
+        end of the program commands). A ``t`` shorter than the ramp reaches ``a·t`` on the
+        leading axis. Returns when the cruise ends (after ``t``)."""
         qd = np.asarray(qd, dtype=float)
+        return self._speed("speedj", qd, a, t, span, now, self._plan_speedj)
+
+    def _plan_speedj(self, qd: np.ndarray, a: float, t: float, span: Span, now: float
+                     ) -> float:
         lead = float(np.max(np.abs(qd)))
         q_from = self._q
         if lead == 0.0:  # a zero speed command still lasts its t
             return max(self.stop(now), now + t)
         t = t if t > 0 else lead / a
-        profile = Trapezoid.plan(lead * t, lead, a)
+        cruise = min(lead, a * t)  # the speed reached when the function returns
+        profile = Trapezoid.plan(cruise * t, cruise, a)
         q_to = q_from + qd / lead * profile.distance
         segment = self._segment("speedj", profile, q_from, q_to, 0.0, span,
                                 {"a": a, "t": t, "qd": qd.tolist()})
@@ -671,25 +706,73 @@ class MotionPlanner:
 
     def speedl(self, xd: np.ndarray, a: float, t: float, span: Span, now: float) -> float:
         """Tool speed ``xd`` (m/s, rad/s in Base) like :meth:`speedj`, as a straight line."""
+        xd = np.asarray(xd, dtype=float)
+        return self._speed("speedl", xd, a, t, span, now, self._plan_speedl)
+
+    def _plan_speedl(self, xd: np.ndarray, a: float, t: float, span: Span, now: float
+                     ) -> float:
         from ..kinematics.pose import rotvec_to_matrix
 
-        xd = np.asarray(xd, dtype=float)
         linear = float(np.linalg.norm(xd[:3]))
         angular = float(np.linalg.norm(xd[3:]))
         if linear == 0.0 and angular == 0.0:
             return max(self.stop(now), now + t)
         speed = linear if linear > 0 else angular
         t = t if t > 0 else speed / a
+        scale = min(1.0, a * t / speed)  # to the speed reached when the function returns
+        xd, linear, angular = xd * scale, linear * scale, angular * scale
         pose_from = self._end_matrix()
         pose = pose_from.copy()
         pose[:3, 3] += xd[:3] * t
         pose[:3, :3] = rotvec_to_matrix(xd[3:] * t) @ pose_from[:3, :3]
         # speedl's rotational part is in rad/s and rad/s² as given (aRot defaults to a)
         unknown = self.unknown_at
+        count = len(self.segments)
         end = self.movel(pose, a, max(linear, 1e-12), 0.0, 0.0, span, now, kind="speedl",
                          a_rot=a, v_rot=max(angular, 1e-12))
         self._still_unknown(unknown)
-        return end - min(speed / a, end - now)
+        ramp = self.segments[-1].profile.t_acc if len(self.segments) > count else 0.0
+        return end - min(ramp, end - now)
+
+    def _speed(self, kind: str, vector: np.ndarray, a: float, t: float, span: Span,
+               now: float, plan) -> float:
+        """Plan a speed command with ``plan``; one identical to the last speed command and
+        given when that one returned goes on from it (:class:`_SpeedChain`): the chain is
+        planned again from its start as one command lasting the sum of their ``t``."""
+        chain = self._speed_chain
+        self._speed_chain = None
+        if (chain is not None and t > 0 and chain.kind == kind and chain.a == a
+                and np.array_equal(chain.vector, vector) and abs(now - chain.returns) <= 1e-9
+                and self.segments and self.segments[-1] is chain.segment
+                and chain.state[-1] == self._tcp_key()):
+            self._restore(chain.state)
+            total, first = chain.t + t, chain.now
+        else:
+            chain = None
+            total, first = t, now
+        state = self._state() if chain is None else chain.state
+        count = len(self.segments)
+        returns = plan(vector, a, total, span, first)
+        if t > 0 and len(self.segments) > count:
+            self._speed_chain = _SpeedChain(self.segments[-1], kind, vector.copy(), a, total,
+                                            returns, first, state)
+        return returns
+
+    def _tcp_key(self) -> tuple | None:
+        return None if self._tcp is None else tuple(self._tcp.tolist())
+
+    def _state(self) -> tuple:
+        """What planning a move changes, to plan a speed chain again from its start."""
+        return (self._q_end.copy(), self._end_pose, list(self._unresolved), self._free_at,
+                self.end_time, self._pending, self.unknown_at, self.drift, len(self.segments),
+                self._tcp_key())
+
+    def _restore(self, state: tuple) -> None:
+        (self._q_end, self._end_pose, unresolved, self._free_at, self.end_time,
+         self._pending, self.unknown_at, self.drift, count, _) = state
+        self._q_end = self._q_end.copy()
+        self._unresolved = list(unresolved)
+        self.segments = self.segments[:count]
 
     def stop(self, now: float) -> float:
         """``stopj``/``stopl``: no blend into what follows; returns when the arm is at rest."""

@@ -1143,11 +1143,15 @@ class _LockedPlanner:
         class Locked(MotionPlanner):
             def __init__(self, *args, **kwargs):
                 super().__init__(*args, **kwargs)
-                self._sample_lock = threading.Lock()
+                self._sample_lock = threading.RLock()
 
             def _add(self, segment, now):
                 with self._sample_lock:
                     return super()._add(segment, now)
+
+            def _speed(self, *args):  # a speed chain is planned again from its start
+                with self._sample_lock:
+                    return super()._speed(*args)
 
             def joints_at(self, t):
                 with self._sample_lock:
