@@ -183,7 +183,6 @@ class Segment:
         return kinematics.ik_many(self.path_poses(fraction), linear, tcp=self.tcp)
 
 
-
 @dataclass
 class _SpeedChain:
     """The speed command planned last, while the next one may go on from it: ``segment`` is
@@ -201,6 +200,7 @@ class _SpeedChain:
     returns: float
     now: float
     state: tuple
+
 
 class MotionPlanner:
     """Plans the moves of one program on one robot model, in robot time.
