@@ -159,7 +159,6 @@ def test_speedj_cruises_for_t_then_stops():
     assert arm.target_joints[0] == pytest.approx(0.2 * 1.0)
 
 
-
 def test_a_speed_command_shorter_than_its_ramp_reaches_only_a_t():
     # the manual: with t "the function will return after time t, regardless of the target
     # speed has been reached": 0.1 s at 0.5 m/s² reaches 0.05 m/s, not the asked 0.2
